@@ -1,0 +1,146 @@
+"""Planar Sopanen-Mikkola deep-groove ball bearing (spec §4).
+
+Python side: Hertz and film constants from the bearing geometry (computed once per scene).
+Kernel side: per-ball Hertz loads with clearance and film, bearing friction torque.
+"""
+import math
+from dataclasses import dataclass
+
+from ._jit import njit
+
+
+# ------------------------------------------------------------------------------- constants --
+def reduced_modulus(E: float, nu: float) -> float:
+    """E' = E / (1 - nu^2) (spec §4)."""
+    return E / (1.0 - nu * nu)
+
+
+def contact_radii(D: float, r_x: float, r_y: float) -> tuple[float, float]:
+    """Effective radii R_x = (2/D + 1/r_x)^-1, R_y = (2/D + 1/r_y)^-1 of a ball-race contact."""
+    return 1.0 / (2.0 / D + 1.0 / r_x), 1.0 / (2.0 / D + 1.0 / r_y)
+
+
+def hertz_constant(R_x: float, R_y: float, E_red: float) -> float:
+    """Brewe-Hamrock point-contact constant K in Q = K delta^1.5 [N/m^1.5]."""
+    R = 1.0 / (1.0 / R_x + 1.0 / R_y)
+    k = 1.0339 * (R_y / R_x) ** 0.636
+    E_bar = 1.0003 + 0.5968 * R_x / R_y
+    F_bar = 1.5277 + 0.6023 * math.log(R_y / R_x)
+    return math.pi * k * E_red * math.sqrt(R * E_bar / (4.5 * F_bar ** 3))
+
+
+@dataclass(frozen=True)
+class BearingConstants:
+    """Everything the kernels need from a 6016-type bearing description."""
+    K_in: float
+    K_out: float
+    K_tot: float        # N/m^1.5, series combination of inner and outer contacts
+    film_coef: float    # h = film_coef * |omega|^0.67 [m, omega in rad/s]
+    m0_low: float       # N m, Palmgren viscous torque below nu*n = 2000
+    m0_coef: float      # N m / (rad/s)^(2/3), Palmgren viscous torque above
+    m1_coef: float      # N m / N^1.5, load torque M_1 = m1_coef * P^1.5
+
+
+def bearing_constants(b, static_load: float) -> BearingConstants:
+    """Constants for a :class:`physics.scene.Bearing` carrying ``static_load`` newtons."""
+    D, dm, Pd, f = b.ball_diameter, b.pitch_diameter, b.clearance, b.conformity
+    E_red = reduced_modulus(b.youngs_modulus, b.poisson)
+    r_y = -f * D
+    races = []
+    for r_x in ((dm - D - Pd / 2.0) / 2.0, -(dm + D + Pd / 2.0) / 2.0):   # inner, outer raceway
+        R_x, R_y = contact_radii(D, r_x, r_y)
+        races.append((R_x, R_y, hertz_constant(R_x, R_y, E_red)))
+    K_in, K_out = races[0][2], races[1][2]
+    K_tot = (K_in ** (-2.0 / 3.0) + K_out ** (-2.0 / 3.0)) ** (-1.5)
+
+    # Hamrock-Dowson central film, h_c = 2.69 R_x U^.67 G^.53 W^-.067 (1 - .61 e^-.73k), with
+    # U proportional to the entrainment speed u_e = (dm^2 - D^2)/(4 dm) |omega|.
+    Q_n = 5.0 * static_load / b.balls
+    G = b.pressure_viscosity * E_red
+    film_coef = 0.0
+    for R_x, R_y, _ in races:
+        k = 1.0339 * (R_y / R_x) ** 0.636
+        U_per_omega = b.viscosity * (dm * dm - D * D) / (4.0 * dm) / (E_red * R_x)
+        W = Q_n / (E_red * R_x * R_x)
+        film_coef += (2.69 * R_x * U_per_omega ** 0.67 * G ** 0.53 * W ** -0.067
+                      * (1.0 - 0.61 * math.exp(-0.73 * k)))
+
+    # Friction torque in SI from the catalogue forms (N mm, cSt, rpm, mm).
+    dm_mm3 = (dm * 1e3) ** 3
+    nu_cst = b.viscosity / b.oil_density * 1e6
+    rpm_per_rad_s = 60.0 / (2.0 * math.pi)
+    m0_low = 160e-7 * b.f0 * dm_mm3 * 1e-3
+    m0_coef = 1e-7 * b.f0 * (nu_cst * rpm_per_rad_s) ** (2.0 / 3.0) * dm_mm3 * 1e-3
+    m1_coef = 0.0007 / math.sqrt(b.static_load_rating) * dm
+    return BearingConstants(K_in, K_out, K_tot, film_coef, m0_low, m0_coef, m1_coef)
+
+
+def cage_ratio(b) -> float:
+    """Cage speed / inner-ring speed with the outer ring still: (1 - D/d_m) / 2."""
+    return 0.5 * (1.0 - b.ball_diameter / b.pitch_diameter)
+
+
+# --------------------------------------------------------------------------------- kernels --
+@njit
+def film_thickness(omega_rel, film_coef):
+    """Total EHL film h(omega) [m]; smooth through omega = 0 (|omega| regularised at 1 rad/s)."""
+    return film_coef * ((omega_rel * omega_rel + 1.0) ** 0.335 - 1.0)
+
+
+@njit
+def ball_forces(ux, uy, cage, n_balls, half_play, h, K_tot):
+    """Sum of Hertz ball loads for inner-ring displacement (ux, uy) relative to the outer ring.
+
+    delta_j = ux cos(b_j) + uy sin(b_j) - P_d/2 + h,  Q_j = K_tot delta_j^1.5 (delta_j > 0),
+    b_j = cage + 2 pi j / z. Returns (Fx, Fy, V, dV/dcage, sum Q_j): the force on the outer ring
+    (the inner ring gets the opposite), the stored energy sum K_tot delta^2.5/2.5, its cage-angle
+    derivative (work the planar model does not return as a torque) and dV/dh (both for the
+    energy audit).
+    """
+    c0 = math.cos(cage)
+    s0 = math.sin(cage)
+    dc = math.cos(2.0 * math.pi / n_balls)
+    ds = math.sin(2.0 * math.pi / n_balls)
+    fx = 0.0
+    fy = 0.0
+    V = 0.0
+    dV = 0.0
+    qsum = 0.0
+    clear = half_play - h
+    for _ in range(n_balls):
+        d = ux * c0 + uy * s0 - clear
+        if d > 0.0:
+            q = K_tot * d * math.sqrt(d)
+            fx += q * c0
+            fy += q * s0
+            V += 0.4 * q * d
+            dV += q * (-ux * s0 + uy * c0)
+            qsum += q
+        c0, s0 = c0 * dc - s0 * ds, s0 * dc + c0 * ds
+    return fx, fy, V, dV, qsum
+
+
+@njit
+def ball_load_max(ux, uy, cage, n_balls, half_play, h, K_tot):
+    """Largest single-ball load Q_max [N] (diagnostics)."""
+    qmax = 0.0
+    clear = half_play - h
+    for j in range(n_balls):
+        b = cage + 2.0 * math.pi * j / n_balls
+        d = ux * math.cos(b) + uy * math.sin(b) - clear
+        if d > 0.0:
+            qmax = max(qmax, K_tot * d * math.sqrt(d))
+    return qmax
+
+
+@njit
+def drag_torque_magnitude(omega_rel, load, m0_low, m0_coef, m1_coef, seal):
+    """|M| = M_0 + M_1 + M_s [N m] (Palmgren viscous, load-dependent, seal).
+
+    M_0 uses max(low-speed value, high-speed law): equal to the catalogue form except within 1 %
+    around nu*n = 2000, where it removes the catalogue's small jump.
+    """
+    m0 = m0_coef * abs(omega_rel) ** (2.0 / 3.0)
+    if m0 < m0_low:
+        m0 = m0_low
+    return m0 + m1_coef * load * math.sqrt(load) + seal

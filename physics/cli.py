@@ -1,0 +1,126 @@
+"""The ``rotordrop`` command line.
+
+Subcommands ``drop`` and ``params`` live here; other modules add theirs through a
+``register(subparsers)`` function listed in ``COMMAND_MODULES`` (missing optional extras are
+reported when the command is used, not when the CLI starts). Registration must stay light:
+heavy imports (SB3, torch) happen inside the handlers.
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+import sys
+from pathlib import Path
+
+COMMAND_MODULES = ("physics.study", "physics.accuracy", "agents.cli")
+
+
+def add_scene_args(p: argparse.ArgumentParser) -> None:
+    """--scene and --set, shared by every command that runs the simulator."""
+    p.add_argument("--scene", default="paper",
+                   help="preset name (see `rotordrop params --presets`) or a TOML file")
+    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a parameter by dotted key (repeatable), e.g. contact.friction=0.4")
+
+
+def scene_from_args(args):
+    from .scene import load_scene, parse_assignment
+    return load_scene(args.scene, dict(parse_assignment(a) for a in args.overrides))
+
+
+def cmd_drop(args) -> int:
+    from .metrics import compute_metrics
+    from .plots import plot_drop
+    from .simulate import simulate
+
+    scene = scene_from_args(args)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    result = simulate(scene, t_end=args.t_end, progress=not args.quiet)
+    metrics = compute_metrics(result)
+    (out / "metrics.json").write_text(json.dumps(metrics, indent=2))
+    (out / "scene.toml").write_text(result.model.scene.to_toml())
+    result.save_npz(out / "timeseries.npz")
+    figures = [] if args.no_plots else plot_drop(result, out, f"(mu = {scene.contact.friction:g})")
+    print(summary_table(metrics))
+    print(f"wrote {out / 'metrics.json'}, {out / 'timeseries.npz'}, {out / 'scene.toml'}"
+          + "".join(f", {f.name}" for f in figures))
+    return 0
+
+
+def summary_table(m: dict) -> str:
+    """A short human-readable table of the drop metrics."""
+    fc = m["first_contact_after_fault_s"]
+    lines = [f"scene {m['scene']}: {m['t_end']:g} s simulated in {m['wall_time_s']:.3f} s "
+             f"({m['rhs_evaluations']} rhs evaluations, {m['n_state']} states; compile/cache load "
+             f"{m['compile_time_s']:.2f} s)",
+             f"first contact {fc * 1e3:.2f} ms after the fault" if fc is not None else "no contact",
+             f"final rotor speed {m['final_rotor_speed_rpm']:.0f} rpm",
+             f"{'plane':6}{'max disp [µm]':>15}{'peak F_r [N]':>14}{'whirl':>7}{'f_whirl [Hz]':>14}"
+             f"{'sleeve [rpm]':>14}"]
+    for p, v in m["planes"].items():
+        f = v["whirl_frequency_hz"]
+        lines.append(f"{p:6}{v['max_displacement_um']:15.1f}{v['peak_contact_force_N']:14.0f}"
+                     f"{'yes' if v['backward_whirl'] else 'no':>7}{f'{f:.1f}' if f else '-':>14}"
+                     f"{v['final_sleeve_speed_rpm']:14.0f}")
+    return "\n".join(lines)
+
+
+def cmd_params(args) -> int:
+    from .scene import parameter_table, preset_names
+    if args.presets:
+        print("\n".join(preset_names()))
+        return 0
+    rows = parameter_table()
+    if args.json:
+        print(json.dumps(rows, indent=1, default=str))
+        return 0
+    print(f"{'key':32}{'default':>18}  {'unit':9}{'allowed':26}{'tag':4} description")
+    for r in rows:
+        print(f"{r['key']:32}{str(r['default']):>18}  {r['unit']:9}{r['allowed']:26}{r['tag']:4} {r['doc']}")
+    print("\ntags: P = paper, A = assumed, D = derived. Override any key with --set KEY=VALUE.")
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="rotordrop", description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    p = sub.add_parser("drop", help="simulate a drop: summary table, metrics.json, time series, plots")
+    add_scene_args(p)
+    p.add_argument("--t-end", type=float, default=None, help="simulated time [s] (solver.t_end)")
+    p.add_argument("--out", default="out/drop", help="output directory")
+    p.add_argument("--no-plots", action="store_true", help="skip the PNG figures")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=cmd_drop)
+
+    p = sub.add_parser("params", help="list every scene parameter with unit, default and range")
+    p.add_argument("--json", action="store_true", help="machine-readable output")
+    p.add_argument("--presets", action="store_true", help="list the preset scene names")
+    p.set_defaults(func=cmd_params)
+
+    for name in COMMAND_MODULES:
+        try:
+            module = importlib.import_module(name)
+        except ImportError as exc:          # an optional extra is not installed
+            if exc.name and name.startswith(exc.name):
+                continue
+            raise
+        module.register(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    from .scene import SceneError
+    from .simulate import IntegrationError
+    args = build_parser().parse_args(argv)
+    try:
+        return args.func(args)
+    except (SceneError, IntegrationError) as exc:
+        print(f"rotordrop: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

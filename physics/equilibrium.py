@@ -1,0 +1,61 @@
+"""The steady levitated state before the fault (issue: start the drop clean).
+
+The AMBs carry the rotor's weight and the unbalance orbit has settled (closed form), each sleeve
+rests on its ball set under its own weight and each housing sags on its springs (Newton solve).
+"""
+import math
+
+import numpy as np
+
+from .ball_bearing import ball_forces
+from .model import (I_PLANES, J_HVX, J_HX, J_SVX, J_SX, N_PLANE_IDX, P_CAGE, P_G, P_HALF_PLAY,
+                    P_KLIN, P_KS, P_KTOT, P_MH, P_MS, P_NB, P_UB_PHASE, RB_LINEAR, RB_SM, F_RB, F_AMB,
+                    AMB_LINEAR, S_PHI, S_VX, S_X, S_W, Model)
+from .rotor import steady_unbalance_orbit
+
+
+def sleeve_rest_offset(P: np.ndarray, I: np.ndarray) -> float:
+    """Vertical inner-ring offset u_y at which the bearing carries the sleeve's weight."""
+    weight = P[P_MS] * P[P_G]
+    if weight == 0.0:
+        return 0.0
+    if I[F_RB] == RB_LINEAR:
+        return -weight / P[P_KLIN]
+
+    def lift(uy):                       # upward bearing force on the inner ring
+        return -ball_forces(0.0, uy, 0.0, int(P[P_NB]), P[P_HALF_PLAY], 0.0, P[P_KTOT])[1]
+
+    lo, hi = -P[P_HALF_PLAY] - 1e-3, 0.0    # lift(lo) >> weight, lift(0) = 0
+    for _ in range(200):                # bisection: robust for the clearance kink
+        mid = 0.5 * (lo + hi)
+        if lift(mid) > weight:
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+def levitated_state(model: Model) -> np.ndarray:
+    """State vector at t = 0: rotor on its settled unbalance orbit, bodies in static balance."""
+    s, P, I = model.scene, model.P, model.I
+    y = np.zeros(model.n_state)
+    omega = s.rotor.speed_rpm * math.pi / 30.0
+    y[I[S_W]] = omega
+    if I[S_PHI] >= 0 and I[F_AMB] == AMB_LINEAR:
+        Z = steady_unbalance_orbit(s.unbalance.mass * s.unbalance.radius, omega, s.rotor.mass,
+                                   2 * s.amb.stiffness, 2 * s.amb.damping)
+        pos = Z * complex(math.cos(P[P_UB_PHASE]), math.sin(P[P_UB_PHASE]))
+        vel = 1j * omega * pos
+        y[I[S_X]], y[I[S_X] + 1] = pos.real, pos.imag
+        y[I[S_VX]], y[I[S_VX] + 1] = vel.real, vel.imag
+    uy = sleeve_rest_offset(P, I) if I[F_RB] in (RB_SM, RB_LINEAR) else 0.0
+    sleeve_mass = P[P_MS] if I[I_PLANES + J_SX] >= 0 else 0.0
+    for k in range(2):
+        base = I_PLANES + k * N_PLANE_IDX
+        hy = 0.0
+        if I[base + J_HX] >= 0:
+            hy = -(P[P_MH] + sleeve_mass) * P[P_G] / P[P_KS]
+            y[I[base + J_HX] + 1] = hy
+        if I[base + J_SX] >= 0:
+            y[I[base + J_SX] + 1] = hy + uy
+    return y

@@ -1,0 +1,124 @@
+"""Dormand-Prince 5(4) integration of the model: adaptive or fixed step, dense output.
+
+One kernel serves both modes; it stops exactly at the segment end (the driver splits the run at
+the fault time and at control steps) and samples the solution at requested output times with
+the method's 4th-order continuous extension. It never raises: it returns a status code that
+the Python layer turns into a clear error.
+"""
+import math
+
+import numpy as np
+
+from ._jit import njit
+from .model import N_AUX, rhs
+
+OK, STEP_COLLAPSE, TOO_MANY_STEPS, NOT_FINITE = 0, 1, 2, 3
+
+# Butcher tableau (Dormand & Prince 1980) and dense-output polynomial (Hairer et al.)
+_C = np.array([0.0, 1 / 5, 3 / 10, 4 / 5, 8 / 9, 1.0, 1.0])
+_A = np.array([
+    [0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+    [1 / 5, 0.0, 0.0, 0.0, 0.0, 0.0],
+    [3 / 40, 9 / 40, 0.0, 0.0, 0.0, 0.0],
+    [44 / 45, -56 / 15, 32 / 9, 0.0, 0.0, 0.0],
+    [19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729, 0.0, 0.0],
+    [9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656, 0.0],
+    [35 / 384, 0.0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84],
+])
+_E = np.array([-71 / 57600, 0.0, 71 / 16695, -71 / 1920, 17253 / 339200, -22 / 525, 1 / 40])
+_PD = np.array([
+    [1.0, -8048581381 / 2820520608, 8663915743 / 2820520608, -12715105075 / 11282082432],
+    [0.0, 0.0, 0.0, 0.0],
+    [0.0, 131558114200 / 32700410799, -68118460800 / 10900136933, 87487479700 / 32700410799],
+    [0.0, -1754552775 / 470086768, 14199869525 / 1410260304, -10690763975 / 1880347072],
+    [0.0, 127303824393 / 49829197408, -318862633887 / 49829197408, 701980252875 / 199316789632],
+    [0.0, -282668133 / 205662961, 2019193451 / 616988883, -1453857185 / 822651844],
+    [0.0, 40617522 / 29380423, -110615467 / 29380423, 69997945 / 29380423],
+])
+
+
+@njit
+def integrate_segment(y, t0, t1, P, I, U, rtol, atol, h, h_max, h_min, fixed, max_steps,
+                      t_out, Y_out, out_pos, work):
+    """Advance ``y`` (in place) from t0 to exactly t1.
+
+    Samples the solution into ``Y_out[out_pos:]`` for every ``t_out[j]`` in (t0, t1].
+    ``work`` is a (9, n) scratch array (stages and a trial state), so nothing is allocated per
+    step. Returns (status, t reached, next step size, output position, rhs calls, steps,
+    rejected steps).
+    """
+    n = y.shape[0]
+    K = work[:7]
+    ytry = work[7]
+    aux = np.empty(N_AUX)
+    n_rhs = 0
+    n_steps = 0
+    n_rej = 0
+    t = t0
+    h = min(h, h_max, t1 - t0)
+    rhs(t, y, P, I, U, K[0], aux)
+    n_rhs += 1
+    n_out = t_out.shape[0]
+    while out_pos < n_out and t_out[out_pos] <= t0:
+        out_pos += 1
+    while t < t1:
+        if n_steps >= max_steps:
+            return TOO_MANY_STEPS, t, h, out_pos, n_rhs, n_steps, n_rej
+        last = t + h >= t1 - 1e-15 * abs(t1)
+        h_free = h
+        if last:
+            h = t1 - t
+        # stages 2..7 (the 7th is evaluated at the new point: first-same-as-last)
+        for s in range(1, 7):
+            for i in range(n):
+                acc = 0.0
+                for j in range(s):
+                    acc += _A[s, j] * K[j, i]
+                ytry[i] = y[i] + h * acc
+            rhs(t + _C[s] * h, ytry, P, I, U, K[s], aux)
+        n_rhs += 6
+        n_steps += 1
+        err = 0.0
+        finite = True
+        for i in range(n):
+            e = 0.0
+            for j in range(7):
+                e += _E[j] * K[j, i]
+            sc = atol[i] + rtol * max(abs(y[i]), abs(ytry[i]))
+            r = h * e / sc
+            err += r * r
+            if not math.isfinite(ytry[i]):
+                finite = False
+        err = math.sqrt(err / n)
+        if not finite or not math.isfinite(err):
+            if fixed:
+                return NOT_FINITE, t, h, out_pos, n_rhs, n_steps, n_rej
+            err = 1e10
+        if fixed or err <= 1.0:
+            t_new = t1 if last else t + h
+            # dense output for samples in (t, t_new]
+            while out_pos < n_out and t_out[out_pos] <= t_new:
+                th = (t_out[out_pos] - t) / h
+                for i in range(n):
+                    acc = 0.0
+                    for j in range(7):
+                        if j == 1:
+                            continue
+                        acc += K[j, i] * th * (_PD[j, 0] + th * (_PD[j, 1] + th * (_PD[j, 2] + th * _PD[j, 3])))
+                    Y_out[out_pos, i] = y[i] + h * acc
+                out_pos += 1
+            for i in range(n):
+                y[i] = ytry[i]
+                K[0, i] = K[6, i]
+            t = t_new
+            if not fixed:
+                fac = 10.0 if err == 0.0 else min(10.0, max(0.2, 0.9 * err ** -0.2))
+                h = min(h * fac, h_max)
+                if last:
+                    h = max(h, min(h_free, h_max))
+        else:
+            n_rej += 1
+            h = h * min(1.0, max(0.2, 0.9 * err ** -0.2))
+            if h < h_min:
+                return STEP_COLLAPSE, t, h, out_pos, n_rhs, n_steps, n_rej
+    return OK, t, h, out_pos, n_rhs, n_steps, n_rej

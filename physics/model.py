@@ -1,0 +1,423 @@
+"""The drop-down model compiled from a scene: state layout, packed parameters, right-hand side.
+
+Effects are runtime flags in an int array (one compiled, disk-cached kernel serves every scene);
+the state vector holds only the bodies and coordinates the scene enables. Index -1 marks an
+absent coordinate, and the kernel never touches it.
+
+Packed arrays passed to every kernel:
+
+* ``P`` float64 parameters (indices ``P_*``),
+* ``I`` int64 flags and state indices (``F_*`` flags, ``S_*`` rotor indices, per-plane blocks),
+* ``U`` float64 controls that may change between integration segments (``U_*``).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import amb as amb_mod
+from .ball_bearing import (ball_forces, bearing_constants, cage_ratio, drag_torque_magnitude,
+                           film_thickness)
+from .contact import contact_potential, friction_force, geometry, normal_force, smooth_sign
+from ._jit import njit
+from .rotor import axis_at, steady_unbalance_orbit, tilt_accelerations, unbalance_force
+from .scene import Scene
+from .support import housing_force
+
+# ---------------------------------------------------------------------------- parameters P --
+(P_M, P_IP, P_ID, P_G, P_RJ, P_RS, P_CLR,
+ P_Z_RB1, P_Z_RB2, P_Z_AMB1, P_Z_AMB2,
+ P_MUE, P_UB_PHASE, P_Z_UB,
+ P_K_AMB, P_C_AMB, P_AMB_BIAS1, P_AMB_BIAS2,
+ P_KC, P_EC, P_CMAX, P_DC, P_MU, P_WL, P_VL,
+ P_MS, P_JS,
+ P_NB, P_HALF_PLAY, P_KTOT, P_FILM, P_CB, P_KLIN, P_CAGE, P_M0_LOW, P_M0_COEF, P_M1_COEF, P_MSEAL,
+ P_KS, P_MH, N_P) = range(41)
+
+# ------------------------------------------------------------------- flags and indices I --
+(F_GRAV, F_UNB, F_GYRO, F_AMB, F_RB, F_FILM, F_BFRIC, F_HOUSING, F_SLEEVE_J, F_FRIC, F_AUDIT,
+ S_X, S_Y, S_A, S_B, S_VX, S_VY, S_VA, S_VB, S_W, S_PHI, S_EDISS, S_WEXT, I_PLANES) = range(24)
+# per retainer plane k, the block I[I_PLANES + k*N_PLANE_IDX + j]:
+(J_SX, J_SY, J_SVX, J_SVY, J_TH, J_WS, J_HX, J_HY, J_HVX, J_HVY, N_PLANE_IDX) = range(11)
+N_I = I_PLANES + 2 * N_PLANE_IDX
+
+AMB_NONE, AMB_LINEAR = 0, 1
+RB_RIGID, RB_LINEAR, RB_SM = 0, 1, 2
+FRIC_NONE, FRIC_PAPER, FRIC_KINEMATIC = 0, 1, 2
+
+# ------------------------------------------------------------------------- controls U --
+U_AMB_POWER, U_CS1, U_CS2, N_U = range(4)
+
+# ------------------------------------------------------------------- diagnostics aux --
+# per plane k at aux[k*N_AUX_PLANE + j]
+(A_FR, A_FMU, A_DELTA, A_LOAD, A_WS, A_DRAG, N_AUX_PLANE) = range(7)
+N_AUX = 2 * N_AUX_PLANE
+
+PLANES = ("RB1", "RB2")
+
+
+@dataclass(frozen=True)
+class Model:
+    """A scene compiled for the kernels. ``names[i]`` names state i; ``scale[i]`` its size."""
+    scene: Scene
+    P: np.ndarray
+    I: np.ndarray
+    names: tuple[str, ...]
+    scale: np.ndarray
+
+    @property
+    def n_state(self) -> int:
+        return len(self.names)
+
+    def index(self, name: str) -> int:
+        return self.names.index(name)
+
+    def controls(self, amb_power: bool) -> np.ndarray:
+        """The control vector for a segment: AMB power and the support damping of each housing."""
+        U = np.zeros(N_U)
+        U[U_AMB_POWER] = 1.0 if amb_power else 0.0
+        U[U_CS1] = U[U_CS2] = self.scene.support.damping
+        return U
+
+
+def build_model(scene: Scene) -> Model:
+    """Compile a scene: pack parameters, lay out only the enabled states."""
+    s, fx = scene, scene.effects
+    P = np.zeros(N_P)
+    I = np.full(N_I, -1, dtype=np.int64)
+    names: list[str] = []
+    scale: list[float] = []
+    c = s.contact.clearance
+    omega0 = s.rotor.speed_rpm * math.pi / 30.0
+
+    def add(name: str, size: float) -> int:
+        names.append(name)
+        scale.append(size)
+        return len(names) - 1
+
+    # flags
+    I[F_GRAV] = fx.gravity
+    I[F_UNB] = fx.unbalance and s.unbalance.mass * s.unbalance.radius > 0.0
+    I[F_GYRO] = fx.gyroscopic
+    I[F_AMB] = {"none": AMB_NONE, "linear": AMB_LINEAR}[fx.amb]
+    I[F_RB] = {"rigid": RB_RIGID, "linear": RB_LINEAR, "sopanen_mikkola": RB_SM}[fx.retainer_bearing]
+    I[F_FILM] = fx.ehl_film and fx.retainer_bearing == "sopanen_mikkola"
+    I[F_BFRIC] = fx.bearing_friction
+    I[F_HOUSING] = fx.housing
+    I[F_SLEEVE_J] = fx.sleeve_inertia
+    I[F_FRIC] = {"none": FRIC_NONE, "paper": FRIC_PAPER, "kinematic": FRIC_KINEMATIC}[fx.friction]
+    I[F_AUDIT] = 1
+
+    # rotor states (positions, then velocities)
+    tilt = c / max(abs(s.positions.rb1), abs(s.positions.rb2), 1e-3)
+    for key, name, size in ((S_X, "x", c), (S_Y, "y", c), (S_A, "a", tilt), (S_B, "b", tilt),
+                            (S_VX, "vx", 0.1), (S_VY, "vy", 0.1), (S_VA, "va", 0.1 * tilt),
+                            (S_VB, "vb", 0.1 * tilt), (S_W, "Omega", max(omega0, 100.0))):
+        I[key] = add(name, size)
+    if I[F_UNB]:
+        I[S_PHI] = add("phi", math.pi)
+    has_sleeve_xy = fx.retainer_bearing != "rigid"
+    for k, plane in enumerate(PLANES):
+        base = I_PLANES + k * N_PLANE_IDX
+        if has_sleeve_xy:
+            for j, n, sz in ((J_SX, "sx", c), (J_SY, "sy", c), (J_SVX, "svx", 0.1), (J_SVY, "svy", 0.1)):
+                I[base + j] = add(f"{plane}.{n}", sz)
+        if fx.retainer_bearing == "sopanen_mikkola":
+            I[base + J_TH] = add(f"{plane}.theta", math.pi)
+        if fx.sleeve_inertia:
+            I[base + J_WS] = add(f"{plane}.omega_s", max(omega0, 100.0))
+        if fx.housing:
+            for j, n, sz in ((J_HX, "hx", 0.1 * c), (J_HY, "hy", 0.1 * c),
+                             (J_HVX, "hvx", 0.01), (J_HVY, "hvy", 0.01)):
+                I[base + j] = add(f"{plane}.{n}", sz)
+    # energy-audit quadratures: dissipated energy and work of external / non-potential forces
+    e_scale = 0.5 * s.rotor.mass * 0.1 ** 2
+    I[S_EDISS] = add("E_dissipated", e_scale)
+    I[S_WEXT] = add("W_external", e_scale)
+
+    # parameters
+    g = s.world.gravity if fx.gravity else 0.0
+    P[P_M], P[P_IP], P[P_ID], P[P_G] = s.rotor.mass, s.rotor.polar_inertia, s.rotor.diametral_inertia, g
+    P[P_RJ], P[P_CLR] = s.rotor.journal_radius, c
+    P[P_RS] = s.rotor.journal_radius + c
+    P[P_Z_RB1], P[P_Z_RB2] = s.positions.rb1, s.positions.rb2
+    P[P_Z_AMB1], P[P_Z_AMB2] = s.positions.amb1, s.positions.amb2
+    P[P_MUE] = s.unbalance.mass * s.unbalance.radius
+    P[P_UB_PHASE] = math.radians(s.unbalance.angle_deg)
+    P[P_Z_UB] = s.unbalance.z
+    P[P_K_AMB], P[P_C_AMB] = s.amb.stiffness, s.amb.damping
+    P[P_AMB_BIAS1], P[P_AMB_BIAS2] = amb_mod.weight_shares(s.rotor.mass * g, s.positions.amb1,
+                                                           s.positions.amb2)
+    P[P_KC], P[P_EC], P[P_CMAX], P[P_DC] = (s.contact.stiffness, s.contact.exponent,
+                                            s.contact.damping, s.contact.damping_depth)
+    P[P_MU] = s.contact.friction
+    P[P_WL] = s.contact.threshold_rpm * math.pi / 30.0
+    P[P_VL] = P[P_WL] * s.rotor.journal_radius
+    P[P_MS], P[P_JS] = s.sleeve.mass, s.sleeve.spin_inertia
+    b = s.bearing
+    static_load = max(amb_mod.weight_shares(s.rotor.mass * s.world.gravity,
+                                            s.positions.rb1, s.positions.rb2))
+    bc = bearing_constants(b, static_load)
+    P[P_NB], P[P_HALF_PLAY], P[P_KTOT], P[P_FILM] = b.balls, b.clearance / 2.0, bc.K_tot, bc.film_coef
+    P[P_CB], P[P_KLIN], P[P_CAGE] = b.damping, b.linear_stiffness, cage_ratio(b)
+    P[P_M0_LOW], P[P_M0_COEF], P[P_M1_COEF], P[P_MSEAL] = bc.m0_low, bc.m0_coef, bc.m1_coef, b.seal_torque
+    P[P_KS] = s.support.stiffness
+    P[P_MH] = s.support.housing_mass + (0.0 if has_sleeve_xy else s.sleeve.mass)
+    return Model(scene, P, I, tuple(names), np.asarray(scale))
+
+
+# ------------------------------------------------------------------------------- kernels --
+@njit
+def _get(y, i):
+    return y[i] if i >= 0 else 0.0
+
+
+@njit
+def rhs(t, y, P, I, U, dy, aux):
+    """dy/dt of the drop-down model (spec §1, §3-6). Fills ``aux`` with per-plane diagnostics."""
+    for i in range(dy.shape[0]):
+        dy[i] = 0.0
+    m = P[P_M]
+    g = P[P_G]
+    x, yy, a, b = y[I[S_X]], y[I[S_Y]], y[I[S_A]], y[I[S_B]]
+    vx, vy, va, vb = y[I[S_VX]], y[I[S_VY]], y[I[S_VA]], y[I[S_VB]]
+    W = y[I[S_W]]
+    Fx = 0.0
+    Fy = -m * g
+    Ma = 0.0            # sum z Fx
+    Mb = 0.0            # sum z Fy
+    T = 0.0             # spin torque
+    p_diss = 0.0        # power dissipated by dampers, friction and drag
+    p_ext = 0.0         # power of external and non-potential forces (unbalance, AMB, film, cage)
+
+    # unbalance
+    if I[F_UNB]:
+        iphi = I[S_PHI]
+        ux, uy = unbalance_force(P[P_MUE], W, y[iphi] + P[P_UB_PHASE])
+        z = P[P_Z_UB]
+        Fx += ux
+        Fy += uy
+        Ma += z * ux
+        Mb += z * uy
+        p_ext += ux * (vx + z * va) + uy * (vy + z * vb)
+        dy[iphi] = W
+
+    # AMBs (hold the rotor until the fault)
+    if I[F_AMB] == AMB_LINEAR and U[U_AMB_POWER] > 0.0:
+        for k in range(2):
+            z = P[P_Z_AMB1 + k]
+            dx, dyy = axis_at(z, x, yy, a, b)
+            ddx, ddy = axis_at(z, vx, vy, va, vb)
+            fx = amb_mod.linear_force(dx, ddx, P[P_K_AMB], P[P_C_AMB], 0.0)
+            fy = amb_mod.linear_force(dyy, ddy, P[P_K_AMB], P[P_C_AMB], P[P_AMB_BIAS1 + k])
+            Fx += fx
+            Fy += fy
+            Ma += z * fx
+            Mb += z * fy
+            p_ext += fx * ddx + fy * ddy
+
+    # retainer planes: rotor-sleeve contact, sleeve on ball bearing, housing
+    for k in range(2):
+        base = I_PLANES + k * N_PLANE_IDX
+        z = P[P_Z_RB1 + k]
+        px, py = axis_at(z, x, yy, a, b)
+        pvx, pvy = axis_at(z, vx, vy, va, vb)
+        i_sx = I[base + J_SX]
+        i_hx = I[base + J_HX]
+        hx, hy = _get(y, i_hx), _get(y, i_hx + 1 if i_hx >= 0 else -1)
+        hvx, hvy = _get(y, I[base + J_HVX]), _get(y, I[base + J_HVY])
+        if i_sx >= 0:
+            sx, sy = y[i_sx], y[I[base + J_SY]]
+            svx, svy = y[I[base + J_SVX]], y[I[base + J_SVY]]
+        else:                                   # sleeve rigidly mounted in the housing
+            sx, sy, svx, svy = hx, hy, hvx, hvy
+        i_ws = I[base + J_WS]
+        ws = y[i_ws] if i_ws >= 0 else 0.0
+
+        # --- contact, eqs. 14-19 ---
+        er, nx, ny = geometry(px - sx, py - sy)
+        tx, ty = -ny, nx
+        delta = er - P[P_CLR]
+        rel_vx, rel_vy = pvx - svx, pvy - svy
+        f_r = 0.0
+        f_mu = 0.0
+        if delta > 0.0:
+            ddelta = nx * rel_vx + ny * rel_vy
+            f_r = normal_force(delta, ddelta, P[P_KC], P[P_EC], P[P_CMAX], P[P_DC])
+            p_diss += (f_r - P[P_KC] * delta ** P[P_EC]) * ddelta
+        et = tx * rel_vx + ty * rel_vy           # whirl velocity along t
+        fric = I[F_FRIC]
+        if fric != FRIC_NONE and f_r > 0.0:
+            if I[F_SLEEVE_J]:
+                if fric == FRIC_PAPER:
+                    f_mu = friction_force(P[P_MU], f_r, W - ws, P[P_WL])
+                else:
+                    f_mu = friction_force(P[P_MU], f_r, et + W * P[P_RJ] - ws * P[P_RS], P[P_VL])
+                p_diss += f_mu * (et + W * P[P_RJ] - ws * P[P_RS])
+            else:
+                # massless-sleeve limit: the sleeve rolls at w* and passes on only the drag torque
+                if fric == FRIC_PAPER:
+                    w_roll = W
+                    sgn = smooth_sign(W, P[P_WL])
+                else:
+                    w_roll = (et + W * P[P_RJ]) / P[P_RS]
+                    sgn = smooth_sign(et + W * P[P_RJ], P[P_VL])
+                drag = 0.0
+                if I[F_BFRIC]:
+                    drag = drag_torque_magnitude(w_roll, f_r, P[P_M0_LOW], P[P_M0_COEF],
+                                                 P[P_M1_COEF], P[P_MSEAL]) / P[P_RS]
+                f_mu = sgn * min(P[P_MU] * f_r, drag)
+                ws = w_roll * min(1.0, P[P_MU] * f_r / drag) if drag > 0.0 else w_roll
+                p_diss += f_mu * (et + W * P[P_RJ])
+        # forces on the rotor at this plane: -F_r n - F_mu t, spin torque -r F_mu
+        cfx = f_r * nx + f_mu * tx               # force on the sleeve side
+        cfy = f_r * ny + f_mu * ty
+        Fx -= cfx
+        Fy -= cfy
+        Ma -= z * cfx
+        Mb -= z * cfy
+        T -= P[P_RJ] * f_mu
+
+        # --- retainer bearing between sleeve (inner ring) and housing (outer ring) ---
+        bfx = 0.0                                # bearing force on the sleeve
+        bfy = 0.0
+        load = f_r
+        qsum = 0.0
+        ux, uy = sx - hx, sy - hy
+        uvx, uvy = svx - hvx, svy - hvy
+        i_th = I[base + J_TH]
+        if I[F_RB] == RB_SM:
+            h = film_thickness(ws, P[P_FILM]) if I[F_FILM] else 0.0
+            cage = P[P_CAGE] * y[i_th]
+            qx, qy, V, dV, qsum = ball_forces(ux, uy, cage, int(P[P_NB]), P[P_HALF_PLAY], h, P[P_KTOT])
+            bfx = -qx - P[P_CB] * uvx
+            bfy = -qy - P[P_CB] * uvy
+            load = math.sqrt(qx * qx + qy * qy)
+            p_diss += P[P_CB] * (uvx * uvx + uvy * uvy)
+            p_ext += dV * P[P_CAGE] * ws          # cage rotation under load (no torque in the model)
+            dy[i_th] = ws
+        elif I[F_RB] == RB_LINEAR:
+            bfx = -P[P_KLIN] * ux - P[P_CB] * uvx
+            bfy = -P[P_KLIN] * uy - P[P_CB] * uvy
+            load = P[P_KLIN] * math.sqrt(ux * ux + uy * uy)
+            p_diss += P[P_CB] * (uvx * uvx + uvy * uvy)
+
+        # --- sleeve spin ---
+        drag_t = 0.0
+        if i_ws >= 0:
+            if I[F_BFRIC]:
+                drag_t = drag_torque_magnitude(ws, load, P[P_M0_LOW], P[P_M0_COEF], P[P_M1_COEF],
+                                               P[P_MSEAL]) * smooth_sign(ws, P[P_WL])
+                p_diss += drag_t * ws
+            dws = (P[P_RS] * f_mu - drag_t) / P[P_JS]
+            dy[i_ws] = dws
+            if I[F_RB] == RB_SM and I[F_FILM]:
+                # film growth changes the ball potential without a force doing work
+                dh = P[P_FILM] * 0.67 * ws * (ws * ws + 1.0) ** -0.665 * dws
+                p_ext += qsum * dh
+
+        # --- sleeve translation ---
+        if i_sx >= 0:
+            ms = P[P_MS]
+            dy[i_sx] = svx
+            dy[I[base + J_SY]] = svy
+            dy[I[base + J_SVX]] = (cfx + bfx) / ms
+            dy[I[base + J_SVY]] = (cfy + bfy) / ms - g
+        # --- housing ---
+        if i_hx >= 0:
+            cs = U[U_CS1 + k]
+            gx, gy = housing_force(hx, hy, hvx, hvy, P[P_KS], cs)
+            p_diss += cs * (hvx * hvx + hvy * hvy)
+            if i_sx >= 0:                        # reaction of the bearing
+                gx -= bfx
+                gy -= bfy
+            else:                                # sleeve in the housing: contact acts directly
+                gx += cfx
+                gy += cfy
+            dy[i_hx] = hvx
+            dy[i_hx + 1] = hvy
+            dy[I[base + J_HVX]] = gx / P[P_MH]
+            dy[I[base + J_HVY]] = gy / P[P_MH] - g
+
+        o = k * N_AUX_PLANE
+        aux[o + A_FR] = f_r
+        aux[o + A_FMU] = f_mu
+        aux[o + A_DELTA] = delta
+        aux[o + A_LOAD] = load
+        aux[o + A_WS] = ws
+        aux[o + A_DRAG] = drag_t
+
+    # rotor equations of motion
+    dy[I[S_X]] = vx
+    dy[I[S_Y]] = vy
+    dy[I[S_A]] = va
+    dy[I[S_B]] = vb
+    dy[I[S_VX]] = Fx / m
+    dy[I[S_VY]] = Fy / m
+    aa, ab = tilt_accelerations(Ma, Mb, va, vb, W, P[P_ID], P[P_IP], I[F_GYRO])
+    dy[I[S_VA]] = aa
+    dy[I[S_VB]] = ab
+    dy[I[S_W]] = T / P[P_IP]
+    if I[F_AUDIT]:
+        dy[I[S_EDISS]] = p_diss
+        dy[I[S_WEXT]] = p_ext
+
+
+@njit
+def mechanical_energy(y, P, I):
+    """Kinetic + gravitational + elastic energy (contact, balls, housing springs) [J]."""
+    m = P[P_M]
+    g = P[P_G]
+    x, yy, a, b = y[I[S_X]], y[I[S_Y]], y[I[S_A]], y[I[S_B]]
+    vx, vy, va, vb = y[I[S_VX]], y[I[S_VY]], y[I[S_VA]], y[I[S_VB]]
+    W = y[I[S_W]]
+    E = 0.5 * m * (vx * vx + vy * vy) + 0.5 * P[P_ID] * (va * va + vb * vb) + 0.5 * P[P_IP] * W * W
+    E += m * g * yy
+    for k in range(2):
+        base = I_PLANES + k * N_PLANE_IDX
+        px, py = axis_at(P[P_Z_RB1 + k], x, yy, a, b)
+        i_sx = I[base + J_SX]
+        i_hx = I[base + J_HX]
+        hx, hy = _get(y, i_hx), _get(y, i_hx + 1 if i_hx >= 0 else -1)
+        if i_hx >= 0:
+            hvx, hvy = y[I[base + J_HVX]], y[I[base + J_HVY]]
+            E += 0.5 * P[P_MH] * (hvx * hvx + hvy * hvy) + P[P_MH] * g * hy
+            E += 0.5 * P[P_KS] * (hx * hx + hy * hy)
+        sx, sy = hx, hy
+        if i_sx >= 0:
+            sx, sy = y[i_sx], y[I[base + J_SY]]
+            svx, svy = y[I[base + J_SVX]], y[I[base + J_SVY]]
+            E += 0.5 * P[P_MS] * (svx * svx + svy * svy) + P[P_MS] * g * sy
+        i_ws = I[base + J_WS]
+        ws = y[i_ws] if i_ws >= 0 else 0.0
+        if i_ws >= 0:
+            E += 0.5 * P[P_JS] * ws * ws
+        er, _, _ = geometry(px - sx, py - sy)
+        E += contact_potential(er - P[P_CLR], P[P_KC], P[P_EC])
+        ux, uy = sx - hx, sy - hy
+        if I[F_RB] == RB_SM:
+            h = film_thickness(ws, P[P_FILM]) if I[F_FILM] else 0.0
+            _, _, V, _, _ = ball_forces(ux, uy, P[P_CAGE] * y[I[base + J_TH]], int(P[P_NB]),
+                                        P[P_HALF_PLAY], h, P[P_KTOT])
+            E += V
+        elif I[F_RB] == RB_LINEAR:
+            E += 0.5 * P[P_KLIN] * (ux * ux + uy * uy)
+    return E
+
+
+@njit
+def diagnostics(T, Y, P, I, U, AUX):
+    """Fill AUX[k] with the per-plane diagnostics at each output sample (post-processing)."""
+    dy = np.empty(Y.shape[1])
+    for k in range(Y.shape[0]):
+        rhs(T[k], Y[k], P, I, U, dy, AUX[k])
+
+
+@njit
+def energies(Y, P, I):
+    out = np.empty(Y.shape[0])
+    for k in range(Y.shape[0]):
+        out[k] = mechanical_energy(Y[k], P, I)
+    return out

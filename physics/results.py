@@ -1,0 +1,118 @@
+"""Results of a run: time, states, per-plane diagnostics and named accessors (SI units)."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .model import (A_DELTA, A_DRAG, A_FMU, A_FR, A_LOAD, A_WS, I_PLANES, J_HX, J_SX, N_AUX_PLANE,
+                    N_PLANE_IDX, P_Z_RB1, PLANES, S_EDISS, S_W, S_WEXT, S_X, Model, energies)
+
+
+@dataclass
+class RunStats:
+    rhs_evaluations: int = 0
+    steps: int = 0
+    rejected_steps: int = 0
+    wall_time_s: float = 0.0       # integration only, JIT compilation excluded
+    compile_time_s: float = 0.0    # JIT compilation or cache load before the run
+
+
+@dataclass
+class Result:
+    model: Model
+    t: np.ndarray                  # (N,)
+    Y: np.ndarray                  # (N, n_state)
+    aux: np.ndarray                # (N, N_AUX) per-plane diagnostics
+    stats: RunStats = field(default_factory=RunStats)
+    t_fault: float | None = None   # time the AMBs switched off (None: never on)
+
+    # -- rotor ----------------------------------------------------------------------------
+    def state(self, name: str) -> np.ndarray:
+        return self.Y[:, self.model.index(name)]
+
+    @property
+    def rotor_speed(self) -> np.ndarray:
+        """Rotor spin speed Omega [rad/s]."""
+        return self.Y[:, self.model.I[S_W]]
+
+    def _plane(self, plane: str) -> int:
+        try:
+            return PLANES.index(plane)
+        except ValueError:
+            raise ValueError(f"plane must be one of {PLANES}, got {plane!r}") from None
+
+    def orbit(self, plane: str) -> np.ndarray:
+        """Rotor axis position (x, y) at a retainer plane, relative to the nominal centre [m]."""
+        k = self._plane(plane)
+        z = self.model.P[P_Z_RB1 + k]
+        i = self.model.I[S_X]
+        return np.stack([self.Y[:, i] + z * self.Y[:, i + 2], self.Y[:, i + 1] + z * self.Y[:, i + 3]], 1)
+
+    def orbit_velocity(self, plane: str) -> np.ndarray:
+        k = self._plane(plane)
+        z = self.model.P[P_Z_RB1 + k]
+        i = self.model.I[S_X] + 4
+        return np.stack([self.Y[:, i] + z * self.Y[:, i + 2], self.Y[:, i + 1] + z * self.Y[:, i + 3]], 1)
+
+    def _body(self, plane: str, j: int) -> np.ndarray:
+        i = self.model.I[I_PLANES + self._plane(plane) * N_PLANE_IDX + j]
+        return np.zeros((len(self.t), 2)) if i < 0 else self.Y[:, i:i + 2]
+
+    def housing(self, plane: str) -> np.ndarray:
+        """Housing (outer ring) position [m]; zeros when housings are fixed."""
+        return self._body(plane, J_HX)
+
+    def sleeve(self, plane: str) -> np.ndarray:
+        """Sleeve (inner ring) centre [m]; equals the housing when the sleeve is rigidly mounted."""
+        i = self.model.I[I_PLANES + self._plane(plane) * N_PLANE_IDX + J_SX]
+        return self.housing(plane) if i < 0 else self.Y[:, i:i + 2]
+
+    def _aux(self, plane: str, j: int) -> np.ndarray:
+        return self.aux[:, self._plane(plane) * N_AUX_PLANE + j]
+
+    def contact_force(self, plane: str) -> np.ndarray:
+        """Radial rotor-sleeve contact force F_r [N]."""
+        return self._aux(plane, A_FR)
+
+    def friction_force(self, plane: str) -> np.ndarray:
+        """Signed friction force F_mu [N] (on the sleeve along +t)."""
+        return self._aux(plane, A_FMU)
+
+    def penetration(self, plane: str) -> np.ndarray:
+        """e_r - c [m]: negative while the rotor is free in the gap."""
+        return self._aux(plane, A_DELTA)
+
+    def bearing_load(self, plane: str) -> np.ndarray:
+        """Radial load carried by the retainer bearing [N]."""
+        return self._aux(plane, A_LOAD)
+
+    def sleeve_speed(self, plane: str) -> np.ndarray:
+        """Sleeve spin speed omega_s [rad/s] (rolling speed in the massless-sleeve limit)."""
+        return self._aux(plane, A_WS)
+
+    def drag_torque(self, plane: str) -> np.ndarray:
+        return self._aux(plane, A_DRAG)
+
+    # -- energy audit ---------------------------------------------------------------------
+    def energy(self) -> dict[str, np.ndarray]:
+        """Mechanical energy, dissipated energy and external work [J] at each sample.
+
+        Balance: E_mech(t) + E_dissipated(t) - W_external(t) = E_mech(0).
+        """
+        E = energies(self.Y, self.model.P, self.model.I)
+        return dict(mechanical=E, dissipated=self.Y[:, self.model.I[S_EDISS]],
+                    external=self.Y[:, self.model.I[S_WEXT]])
+
+    def save_npz(self, path) -> None:
+        """Time series with named columns (SI units)."""
+        cols = {"t": self.t, "rotor_speed": self.rotor_speed}
+        for p in PLANES:
+            o, s, h = self.orbit(p), self.sleeve(p), self.housing(p)
+            cols.update({f"{p}_x": o[:, 0], f"{p}_y": o[:, 1], f"{p}_sleeve_x": s[:, 0],
+                         f"{p}_sleeve_y": s[:, 1], f"{p}_housing_x": h[:, 0],
+                         f"{p}_housing_y": h[:, 1], f"{p}_contact_force": self.contact_force(p),
+                         f"{p}_friction_force": self.friction_force(p),
+                         f"{p}_sleeve_speed": self.sleeve_speed(p),
+                         f"{p}_bearing_load": self.bearing_load(p)})
+        np.savez_compressed(path, states=self.Y, state_names=np.array(self.model.names), **cols)

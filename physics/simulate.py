@@ -1,0 +1,143 @@
+"""Run a scene: levitated start, exact stop at the fault, dense output, clear errors."""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from .equilibrium import levitated_state
+from .integrate import NOT_FINITE, OK, STEP_COLLAPSE, TOO_MANY_STEPS, integrate_segment
+from .model import N_AUX, AMB_LINEAR, F_AMB, Model, build_model, diagnostics
+from .results import Result, RunStats
+from .scene import Scene
+
+CHUNK_S = 0.01      # the run is advanced in chunks of this length (progress bar granularity)
+
+
+class IntegrationError(RuntimeError):
+    """The integrator could not advance (step-size collapse, step budget, non-finite state)."""
+
+
+class Integrator:
+    """Integrates one model; keeps the scratch arrays and the last step size between calls.
+
+    ``advance(y, t0, t1, U, t_out, Y_out, pos)`` is what the drop driver and the environments
+    call; it allocates nothing per call.
+    """
+
+    def __init__(self, model: Model):
+        self.model = model
+        sv = model.scene.solver
+        self.fixed = sv.method == "fixed"
+        self.rtol = sv.rtol
+        self.atol = sv.rtol * model.scale
+        self.h = sv.dt if self.fixed else min(1e-6, sv.max_step)
+        self.h_max = sv.dt if self.fixed else sv.max_step
+        self.h_min = sv.min_step
+        self.max_steps = sv.max_steps
+        self.work = np.empty((8, model.n_state))
+        self.stats = RunStats()
+        self._no_out = np.empty(0)
+        self._no_Y = np.empty((0, model.n_state))
+
+    def advance(self, y, t0, t1, U, t_out=None, Y_out=None, pos=0) -> int:
+        if t_out is None:
+            t_out, Y_out = self._no_out, self._no_Y
+        budget = self.max_steps - self.stats.steps
+        status, t, h, pos, n_rhs, n_steps, n_rej = integrate_segment(
+            y, t0, t1, self.model.P, self.model.I, U, self.rtol, self.atol, self.h, self.h_max,
+            self.h_min, self.fixed, budget, t_out, Y_out, pos, self.work)
+        st = self.stats
+        st.rhs_evaluations += n_rhs
+        st.steps += n_steps
+        st.rejected_steps += n_rej
+        if not self.fixed:
+            self.h = h
+        if status != OK:
+            raise IntegrationError(_explain(status, t, h, self.model))
+        return pos
+
+
+def _explain(status: int, t: float, h: float, model: Model) -> str:
+    sv = model.scene.solver
+    if status == STEP_COLLAPSE:
+        return (f"step size collapsed to {h:.3g} s (< solver.min_step = {sv.min_step:g} s) at "
+                f"t = {t:.6f} s: the scene is too stiff or singular there; loosen solver.rtol "
+                f"(now {sv.rtol:g}) or soften contact.stiffness / support.stiffness")
+    if status == TOO_MANY_STEPS:
+        return (f"step budget solver.max_steps = {sv.max_steps} exhausted at t = {t:.6f} s "
+                f"(last step {h:.3g} s); raise solver.max_steps or loosen solver.rtol")
+    if status == NOT_FINITE:
+        return (f"the fixed-step solution became non-finite at t = {t:.6f} s with solver.dt = "
+                f"{sv.dt:g} s: the step is beyond the stability limit; reduce solver.dt or use "
+                f"solver.method = adaptive")
+    return f"integration failed with status {status} at t = {t}"
+
+
+def warm_up(model: Model) -> float:
+    """Compile (or load from numba's disk cache) the kernels; returns the seconds it took."""
+    t0 = time.perf_counter()
+    y = levitated_state(model)
+    Integrator(model).advance(y, 0.0, 1e-9, model.controls(True))
+    diagnostics(np.zeros(1), y[None, :].copy(), model.P, model.I, model.controls(True),
+                np.empty((1, N_AUX)))
+    return time.perf_counter() - t0
+
+
+def segments(model: Model, t_end: float) -> list[tuple[float, float, bool]]:
+    """(start, end, AMB powered) pieces of the run, split exactly at the fault time."""
+    t_off = model.scene.amb.off_time
+    if model.I[F_AMB] != AMB_LINEAR:
+        return [(0.0, t_end, False)]
+    if t_off >= t_end:
+        return [(0.0, t_end, True)]
+    if t_off <= 0.0:
+        return [(0.0, t_end, False)]
+    return [(0.0, t_off, True), (t_off, t_end, False)]
+
+
+def simulate(scene: Scene, t_end: float | None = None, progress: bool = False) -> Result:
+    """Simulate a scene from the levitated state to ``t_end`` (default ``solver.t_end``)."""
+    if t_end is not None:
+        scene = scene.with_overrides({"solver.t_end": t_end})
+    model = build_model(scene)
+    t_end = scene.solver.t_end
+    compile_s = warm_up(model)
+    n_out = int(round(t_end * scene.solver.output_rate)) + 1
+    t_out = np.linspace(0.0, t_end, n_out)
+    Y = np.empty((n_out, model.n_state))
+    y = levitated_state(model)
+    Y[0] = y
+    integ = Integrator(model)
+    bar = _progress(progress, t_end, scene.name)
+    pos = 1
+    wall0 = time.perf_counter()
+    for a, b, powered in segments(model, t_end):
+        U = model.controls(powered)
+        edges = np.append(np.arange(a, b, CHUNK_S), b)
+        for c0, c1 in zip(edges[:-1], edges[1:]):
+            if c1 - c0 <= 0.0:
+                continue
+            pos = integ.advance(y, c0, c1, U, t_out, Y, pos)
+            if bar is not None:
+                bar.update(c1 - c0)
+    integ.stats.wall_time_s = time.perf_counter() - wall0
+    integ.stats.compile_time_s = compile_s
+    if bar is not None:
+        bar.close()
+    aux = np.empty((n_out, N_AUX))
+    for a, b, powered in segments(model, t_end):
+        sel = np.flatnonzero((t_out >= a) & ((t_out <= b) if powered else True))
+        chunk = np.empty((len(sel), N_AUX))
+        diagnostics(t_out[sel], Y[sel], model.P, model.I, model.controls(powered), chunk)
+        aux[sel] = chunk
+    t_fault = next((a for a, _, powered in segments(model, t_end) if not powered), None)
+    return Result(model, t_out, Y, aux, integ.stats, t_fault)
+
+
+def _progress(enabled: bool, total: float, name: str):
+    if not enabled:
+        return None
+    from tqdm.auto import tqdm
+    return tqdm(total=total, desc=f"drop {name}", unit="s sim", bar_format=
+                "{l_bar}{bar}| {n:.3f}/{total:.3f} s [{elapsed}<{remaining}]")
