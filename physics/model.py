@@ -157,8 +157,10 @@ def build_model(scene: Scene) -> Model:
     P[P_VL] = P[P_WL] * s.rotor.journal_radius
     P[P_MS], P[P_JS] = s.sleeve.mass, s.sleeve.spin_inertia
     b = s.bearing
-    static_load = max(amb_mod.weight_shares(s.rotor.mass * s.world.gravity,
-                                            s.positions.rb1, s.positions.rb2))
+    # film reference load (spec §4: Q_n = 5 x static bearing load / z): the rotor's weight share;
+    # at zero gravity the share under standard gravity keeps the film law defined
+    g_ref = s.world.gravity if s.world.gravity > 0.0 else 9.80665
+    static_load = max(amb_mod.weight_shares(s.rotor.mass * g_ref, s.positions.rb1, s.positions.rb2))
     bc = bearing_constants(b, static_load)
     P[P_NB], P[P_HALF_PLAY], P[P_KTOT], P[P_FILM] = b.balls, b.clearance / 2.0, bc.K_tot, bc.film_coef
     P[P_CB], P[P_KLIN], P[P_CAGE] = b.damping, b.linear_stiffness, cage_ratio(b)

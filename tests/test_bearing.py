@@ -1,0 +1,76 @@
+"""Retainer ball bearing against the spec's derived numbers (spec §4)."""
+import math
+
+import numpy as np
+import pytest
+
+from physics.ball_bearing import (ball_forces, ball_load_max, bearing_constants,
+                                  drag_torque_magnitude, film_thickness)
+from physics.scene import Scene
+
+B = Scene().bearing
+BC = bearing_constants(B, 477.0)
+HALF = B.clearance / 2
+
+
+def approach_under(load, cage):
+    """Inner-ring approach [m] under a downward radial load (bisection, no film)."""
+    lo, hi = -1e-3, 0.0
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if -ball_forces(0.0, mid, cage, B.balls, HALF, 0.0, BC.K_tot)[1] > load:
+            lo = mid
+        else:
+            hi = mid
+    return -0.5 * (lo + hi)
+
+
+def test_hertz_constant_matches_spec():
+    assert BC.K_tot == pytest.approx(1.444e10, rel=2e-3)
+
+
+def test_static_approach_and_largest_ball_load_under_477N():
+    cage = math.pi / B.balls           # a ball straight under the load (270 deg)
+    u = approach_under(477.0, cage)
+    assert u * 1e6 == pytest.approx(14.6, rel=0.01)
+    assert ball_load_max(0.0, -u, cage, B.balls, HALF, 0.0, BC.K_tot) == pytest.approx(271, rel=0.01)
+    # linear stiffness at that load
+    dk = 1e-8
+    k = (ball_forces(0.0, -u - dk, cage, B.balls, HALF, 0.0, BC.K_tot)[1]
+         - ball_forces(0.0, -u + dk, cage, B.balls, HALF, 0.0, BC.K_tot)[1]) / (2 * dk)
+    assert -k == pytest.approx(1.16e8, rel=0.02)
+
+
+def test_ball_loads_balance_the_load_and_vanish_inside_the_play():
+    u = approach_under(477.0, 0.0)
+    fx, fy, V, _, qsum = ball_forces(0.0, -u, 0.0, B.balls, HALF, 0.0, BC.K_tot)
+    assert fy == pytest.approx(-477.0, rel=1e-6) and abs(fx) < 1e-6 * 477
+    assert qsum >= 477.0 and V > 0.0
+    assert ball_forces(0.0, -0.9 * HALF, 0.0, B.balls, HALF, 0.0, BC.K_tot)[:2] == (0.0, 0.0)
+
+
+def test_film_is_6um_at_spun_up_sleeve_speed_zero_at_rest_and_smooth():
+    assert film_thickness(1037.0, BC.film_coef) * 1e6 == pytest.approx(6.0, rel=0.03)
+    assert film_thickness(0.0, BC.film_coef) == 0.0
+    w = np.linspace(-2.0, 2.0, 81)
+    h = np.array([film_thickness(v, BC.film_coef) for v in w])
+    assert np.all(np.abs(np.diff(h, 2)) < 1e-9)       # no kink through zero speed
+    assert film_thickness(-500.0, BC.film_coef) == film_thickness(500.0, BC.film_coef)
+
+
+def test_film_closes_most_of_the_radial_play():
+    h = film_thickness(1037.0, BC.film_coef)
+    assert 0.7 * HALF < h < HALF
+
+
+def test_friction_torque_follows_palmgren_and_load_terms():
+    dm_mm, nu = 110.0, B.viscosity / B.oil_density * 1e6
+    w = 1047.2                                        # 10 000 rpm
+    n = w * 30 / math.pi
+    m0 = 1e-7 * B.f0 * (nu * n) ** (2 / 3) * dm_mm ** 3 * 1e-3
+    P = 477.0
+    m1 = 0.0007 * (P / B.static_load_rating) ** 0.5 * P * dm_mm * 1e-3
+    got = drag_torque_magnitude(w, P, BC.m0_low, BC.m0_coef, BC.m1_coef, 0.0)
+    assert got == pytest.approx(m0 + m1, rel=1e-9)
+    low = drag_torque_magnitude(0.1, 0.0, BC.m0_low, BC.m0_coef, BC.m1_coef, 0.0)
+    assert low == pytest.approx(160e-7 * B.f0 * dm_mm ** 3 * 1e-3, rel=1e-9)

@@ -1,0 +1,45 @@
+"""The rotordrop command line: drop outputs, params listing, clear errors."""
+import json
+import subprocess
+import sys
+
+import numpy as np
+
+from physics.cli import main
+
+
+def test_drop_writes_metrics_timeseries_and_plots(tmp_path, capsys):
+    out = tmp_path / "drop"
+    assert main(["drop", "--t-end", "0.2", "--set", "contact.friction=0.1", "--out", str(out),
+                 "--quiet"]) == 0
+    m = json.loads((out / "metrics.json").read_text())
+    for key in ("t_end", "first_contact_time_s", "final_rotor_speed_rpm", "wall_time_s",
+                "compile_time_s", "rhs_evaluations", "planes"):
+        assert key in m
+    assert m["t_end"] == 0.2 and m["rhs_evaluations"] > 1000
+    for p in ("RB1", "RB2"):
+        for key in ("max_displacement_um", "peak_contact_force_N", "backward_whirl",
+                    "whirl_frequency_hz", "final_sleeve_speed_rpm"):
+            assert key in m["planes"][p]
+    assert 300 < m["planes"]["RB1"]["max_displacement_um"] < 700
+    for png in ("orbits.png", "contact_forces.png", "speeds.png"):
+        assert (out / png).stat().st_size > 10_000
+    ts = np.load(out / "timeseries.npz")
+    assert ts["t"][-1] == 0.2 and ts["RB1_contact_force"].max() == m["planes"]["RB1"]["peak_contact_force_N"]
+    assert "contact.friction" not in capsys.readouterr().err
+    assert "friction = 0.1" in (out / "scene.toml").read_text()
+
+
+def test_params_lists_every_key(capsys):
+    assert main(["params"]) == 0
+    text = capsys.readouterr().out
+    for key in ("contact.friction", "support.damping", "effects.retainer_bearing", "solver.rtol"):
+        assert key in text
+
+
+def test_bad_override_is_a_one_line_error_not_a_traceback():
+    proc = subprocess.run([sys.executable, "-m", "physics.cli", "drop", "--set",
+                           "contact.friction=2", "--out", "/tmp/never"], capture_output=True, text=True)
+    assert proc.returncode == 2
+    assert "contact.friction" in proc.stderr and "[0, 1]" in proc.stderr
+    assert "Traceback" not in proc.stderr
