@@ -6,6 +6,8 @@ Kernel side: per-ball Hertz loads with clearance and film, bearing friction torq
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from ._jit import njit
 
 
@@ -83,8 +85,11 @@ def cage_ratio(b) -> float:
 # --------------------------------------------------------------------------------- kernels --
 @njit
 def film_thickness(omega_rel, film_coef):
-    """Total EHL film h(omega) [m]; smooth through omega = 0 (|omega| regularised at 1 rad/s)."""
-    return film_coef * ((omega_rel * omega_rel + 1.0) ** 0.335 - 1.0)
+    """Total EHL film h(omega) [m] and dh/domega; h ~ |omega|^0.67, regularised at 1 rad/s so it
+    is smooth through omega = 0."""
+    w2 = omega_rel * omega_rel + 1.0
+    p = w2 ** 0.335
+    return film_coef * (p - 1.0), film_coef * 0.67 * omega_rel * p / w2
 
 
 @njit
@@ -140,7 +145,7 @@ def drag_torque_magnitude(omega_rel, load, m0_low, m0_coef, m1_coef, seal):
     M_0 uses max(low-speed value, high-speed law): equal to the catalogue form except within 1 %
     around nu*n = 2000, where it removes the catalogue's small jump.
     """
-    m0 = m0_coef * abs(omega_rel) ** (2.0 / 3.0)
+    m0 = m0_coef * np.cbrt(omega_rel * omega_rel)
     if m0 < m0_low:
         m0 = m0_low
     return m0 + m1_coef * load * math.sqrt(load) + seal

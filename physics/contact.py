@@ -17,11 +17,15 @@ def step(g, g0, h0, g1, h1):
 
 @njit
 def normal_force(delta, delta_dot, K, e, c_max, d):
-    """Radial contact force F_r >= 0 for penetration delta and its rate, eq. 14."""
+    """Radial contact force F_r >= 0 for penetration delta and its rate, eq. 14.
+
+    Returns (F_r, K delta^e): the force and its elastic part (the energy audit needs both).
+    """
     if delta <= 0.0:
-        return 0.0
-    f = K * delta ** e + step(delta, 0.0, 0.0, d, c_max) * delta_dot
-    return f if f > 0.0 else 0.0
+        return 0.0, 0.0
+    elastic = K * delta ** e
+    f = elastic + step(delta, 0.0, 0.0, d, c_max) * delta_dot
+    return (f if f > 0.0 else 0.0), elastic
 
 
 @njit

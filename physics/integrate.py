@@ -55,6 +55,7 @@ def integrate_segment(y, t0, t1, P, I, U, rtol, atol, h, h_max, h_min, fixed, ma
     n_steps = 0
     n_rej = 0
     t = t0
+    err_old = 1e-4
     h = min(h, h_max, t1 - t0)
     rhs(t, y, P, I, U, K[0], aux)
     n_rhs += 1
@@ -112,7 +113,9 @@ def integrate_segment(y, t0, t1, P, I, U, rtol, atol, h, h_max, h_min, fixed, ma
                 K[0, i] = K[6, i]
             t = t_new
             if not fixed:
-                fac = 10.0 if err == 0.0 else min(10.0, max(0.2, 0.9 * err ** -0.2))
+                # PI step control (Hairer & Wanner, DOPRI5: beta = 0.04) limits step rejections
+                fac = 10.0 if err == 0.0 else min(10.0, max(0.2, 0.9 * err ** -0.17 * err_old ** 0.04))
+                err_old = max(err, 1e-4)
                 h = min(h * fac, h_max)
                 if last:
                     h = max(h, min(h_free, h_max))

@@ -247,8 +247,8 @@ def rhs(t, y, P, I, U, dy, aux):
         f_mu = 0.0
         if delta > 0.0:
             ddelta = nx * rel_vx + ny * rel_vy
-            f_r = normal_force(delta, ddelta, P[P_KC], P[P_EC], P[P_CMAX], P[P_DC])
-            p_diss += (f_r - P[P_KC] * delta ** P[P_EC]) * ddelta
+            f_r, f_el = normal_force(delta, ddelta, P[P_KC], P[P_EC], P[P_CMAX], P[P_DC])
+            p_diss += (f_r - f_el) * ddelta
         et = tx * rel_vx + ty * rel_vy           # whirl velocity along t
         fric = I[F_FRIC]
         if fric != FRIC_NONE and f_r > 0.0:
@@ -287,11 +287,14 @@ def rhs(t, y, P, I, U, dy, aux):
         bfy = 0.0
         load = f_r
         qsum = 0.0
+        dh_dw = 0.0
         ux, uy = sx - hx, sy - hy
         uvx, uvy = svx - hvx, svy - hvy
         i_th = I[base + J_TH]
         if I[F_RB] == RB_SM:
-            h = film_thickness(ws, P[P_FILM]) if I[F_FILM] else 0.0
+            h = 0.0
+            if I[F_FILM]:
+                h, dh_dw = film_thickness(ws, P[P_FILM])
             cage = P[P_CAGE] * y[i_th]
             qx, qy, V, dV, qsum = ball_forces(ux, uy, cage, int(P[P_NB]), P[P_HALF_PLAY], h, P[P_KTOT])
             bfx = -qx - P[P_CB] * uvx
@@ -317,8 +320,7 @@ def rhs(t, y, P, I, U, dy, aux):
             dy[i_ws] = dws
             if I[F_RB] == RB_SM and I[F_FILM]:
                 # film growth changes the ball potential without a force doing work
-                dh = P[P_FILM] * 0.67 * ws * (ws * ws + 1.0) ** -0.665 * dws
-                p_ext += qsum * dh
+                p_ext += qsum * dh_dw * dws
 
         # --- sleeve translation ---
         if i_sx >= 0:
@@ -400,7 +402,7 @@ def mechanical_energy(y, P, I):
         E += contact_potential(er - P[P_CLR], P[P_KC], P[P_EC])
         ux, uy = sx - hx, sy - hy
         if I[F_RB] == RB_SM:
-            h = film_thickness(ws, P[P_FILM]) if I[F_FILM] else 0.0
+            h = film_thickness(ws, P[P_FILM])[0] if I[F_FILM] else 0.0
             _, _, V, _, _ = ball_forces(ux, uy, P[P_CAGE] * y[I[base + J_TH]], int(P[P_NB]),
                                         P[P_HALF_PLAY], h, P[P_KTOT])
             E += V

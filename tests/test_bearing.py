@@ -50,16 +50,18 @@ def test_ball_loads_balance_the_load_and_vanish_inside_the_play():
 
 
 def test_film_is_6um_at_spun_up_sleeve_speed_zero_at_rest_and_smooth():
-    assert film_thickness(1037.0, BC.film_coef) * 1e6 == pytest.approx(6.0, rel=0.03)
-    assert film_thickness(0.0, BC.film_coef) == 0.0
+    assert film_thickness(1037.0, BC.film_coef)[0] * 1e6 == pytest.approx(6.0, rel=0.03)
+    assert film_thickness(0.0, BC.film_coef)[0] == 0.0
     w = np.linspace(-2.0, 2.0, 81)
-    h = np.array([film_thickness(v, BC.film_coef) for v in w])
+    h = np.array([film_thickness(v, BC.film_coef)[0] for v in w])
     assert np.all(np.abs(np.diff(h, 2)) < 1e-9)       # no kink through zero speed
-    assert film_thickness(-500.0, BC.film_coef) == film_thickness(500.0, BC.film_coef)
+    assert film_thickness(-500.0, BC.film_coef)[0] == film_thickness(500.0, BC.film_coef)[0]
+    dh = (film_thickness(800.0 + 1e-3, BC.film_coef)[0] - film_thickness(800.0 - 1e-3, BC.film_coef)[0]) / 2e-3
+    assert film_thickness(800.0, BC.film_coef)[1] == pytest.approx(dh, rel=1e-6)
 
 
 def test_film_closes_most_of_the_radial_play():
-    h = film_thickness(1037.0, BC.film_coef)
+    h = film_thickness(1037.0, BC.film_coef)[0]
     assert 0.7 * HALF < h < HALF
 
 

@@ -4,6 +4,10 @@ import pytest
 
 from physics.contact import friction_force, normal_force, smooth_sign, step
 
+
+def fr(*args):
+    return normal_force(*args)[0]
+
 K, E, C, D = 1e8, 1.1, 1000.0, 1e-5
 
 
@@ -24,19 +28,19 @@ def test_step_is_monotone_between_levels():
 
 
 def test_normal_force_is_zero_outside_contact_and_elastic_at_rest():
-    assert normal_force(-1e-6, -5.0, K, E, C, D) == 0.0
-    assert normal_force(0.0, 1.0, K, E, C, D) == 0.0
+    assert fr(-1e-6, -5.0, K, E, C, D) == 0.0
+    assert fr(0.0, 1.0, K, E, C, D) == 0.0
     delta = 20e-6
-    assert normal_force(delta, 0.0, K, E, C, D) == pytest.approx(K * delta ** E)
+    assert fr(delta, 0.0, K, E, C, D) == pytest.approx(K * delta ** E)
 
 
 def test_damping_ramps_in_with_penetration_and_never_pulls():
     v = 0.1
-    shallow = normal_force(1e-9, v, K, E, C, D) - K * 1e-9 ** E         # damping ~0 at contact
+    shallow = fr(1e-9, v, K, E, C, D) - K * 1e-9 ** E         # damping ~0 at contact
     assert abs(shallow) < 1e-3 * C * v
-    deep = normal_force(2 * D, v, K, E, C, D) - K * (2 * D) ** E        # full C_max beyond d
+    deep = fr(2 * D, v, K, E, C, D) - K * (2 * D) ** E        # full C_max beyond d
     assert deep == pytest.approx(C * v)
-    assert normal_force(2 * D, -10.0, K, E, C, D) == 0.0                 # no adhesion
+    assert fr(2 * D, -10.0, K, E, C, D) == 0.0                 # no adhesion
 
 
 def test_friction_magnitude_direction_and_regularisation():
