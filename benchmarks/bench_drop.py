@@ -1,0 +1,134 @@
+"""Drop-simulator speed: wall seconds per simulated second, rhs evaluations, cost of each effect.
+
+    python benchmarks/bench_drop.py [--repeats 5] [--t-end 1.0] [--json out.json]
+
+Every figure is the median of ``--repeats`` runs after a JIT warm-up, on one core (numba kernels
+are single-threaded). Also times a cold compile (empty numba cache, in a subprocess) and a warm
+start (kernels loaded from the on-disk cache).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+from physics import load_scene, simulate
+from physics.model import N_AUX, build_model, rhs
+from physics.simulate import warm_up
+
+EFFECTS_OFF = [
+    ("full model (paper)", {}),
+    ("no EHL film", {"effects.ehl_film": False}),
+    ("no bearing friction torque", {"effects.bearing_friction": False}),
+    ("linear retainer bearing", {"effects.retainer_bearing": "linear"}),
+    ("rigid retainer bearing", {"effects.retainer_bearing": "rigid"}),
+    ("no housing flexibility", {"effects.housing": False}),
+    ("no sleeve inertia", {"effects.sleeve_inertia": False}),
+    ("no unbalance", {"effects.unbalance": False}),
+    ("no gyroscopic coupling", {"effects.gyroscopic": False}),
+    ("kinematic slip", {"effects.friction": "kinematic"}),
+    ("no friction", {"effects.friction": "none"}),
+]
+
+
+def ns_per_rhs(scene, samples=400, reps=50) -> float:
+    """Median cost of one right-hand-side evaluation over states sampled from a real run [ns]."""
+    r = simulate(scene, t_end=0.5)
+    m = r.model
+    Y = r.Y[:: max(1, len(r.Y) // samples)].copy()
+    U = m.controls(False)
+    dy, aux = np.empty(m.n_state), np.empty(N_AUX)
+    times = []
+    for _ in range(5):
+        t0 = time.perf_counter()
+        _rhs_loop(Y, m.P, m.I, U, dy, aux, reps)
+        times.append((time.perf_counter() - t0) / (reps * len(Y)) * 1e9)
+    return statistics.median(times)
+
+
+def _make_loop():
+    from physics._jit import njit
+
+    @njit
+    def loop(Y, P, I, U, dy, aux, reps):
+        for _ in range(reps):
+            for k in range(Y.shape[0]):
+                rhs(0.5, Y[k], P, I, U, dy, aux)
+    return loop
+
+
+_rhs_loop = _make_loop()
+
+
+def run_case(overrides: dict, t_end: float, repeats: int) -> dict:
+    scene = load_scene("paper", overrides)
+    walls, last = [], None
+    for _ in range(repeats):
+        last = simulate(scene, t_end=t_end)
+        walls.append(last.stats.wall_time_s)
+    wall = statistics.median(walls)
+    return dict(n_state=last.model.n_state, wall_s_per_sim_s=wall / t_end,
+                rhs_evaluations=last.stats.rhs_evaluations, steps=last.stats.steps,
+                rejected=last.stats.rejected_steps, ns_per_rhs=ns_per_rhs(scene))
+
+
+def compile_times() -> dict:
+    """Seconds to compile from an empty cache and to load from a warm cache (fresh processes)."""
+    code = ("import time; t=time.perf_counter(); from physics import load_scene, build_model;"
+            "from physics.simulate import warm_up; warm_up(build_model(load_scene('paper')));"
+            "print(time.perf_counter()-t)")
+    with tempfile.TemporaryDirectory() as cache:
+        env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+        cold = float(subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                                    text=True, check=True).stdout)
+        warm = float(subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                                    text=True, check=True).stdout)
+    return dict(cold_compile_s=cold, warm_cache_load_s=warm)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeats", type=int, default=5)
+    ap.add_argument("--t-end", type=float, default=1.0)
+    ap.add_argument("--json", default=None, help="also write the figures to this JSON file")
+    ap.add_argument("--skip-compile", action="store_true")
+    args = ap.parse_args()
+    warm_up(build_model(load_scene("paper")))
+    out: dict = {"repeats": args.repeats, "t_end": args.t_end}
+    if not args.skip_compile:
+        out["compile"] = compile_times()
+        print(f"compile from empty cache {out['compile']['cold_compile_s']:.1f} s, "
+              f"warm start {out['compile']['warm_cache_load_s']:.2f} s (process import + cache load)")
+
+    print(f"\npaper scene, default tolerance, median of {args.repeats} runs of {args.t_end:g} s:")
+    out["paper"] = {}
+    for mu in (0.25, 0.5):
+        for slip in ("paper", "kinematic"):
+            row = run_case({"contact.friction": mu, "effects.friction": slip}, args.t_end, args.repeats)
+            out["paper"][f"mu={mu} {slip}"] = row
+            print(f"  mu = {mu:<5} {slip:9} slip: {row['wall_s_per_sim_s']:.4f} wall s per simulated s, "
+                  f"{row['rhs_evaluations']} rhs evaluations, {row['ns_per_rhs']:.0f} ns per rhs")
+
+    print(f"\ncost of each effect (mu = 0.25, median of {args.repeats}):")
+    print(f"  {'scene':30}{'states':>7}{'wall s/sim s':>14}{'rhs evals':>11}{'ns/rhs':>8}")
+    out["effects"] = {}
+    for name, ov in EFFECTS_OFF:
+        row = run_case(ov, args.t_end, args.repeats)
+        out["effects"][name] = row
+        print(f"  {name:30}{row['n_state']:7d}{row['wall_s_per_sim_s']:14.4f}"
+              f"{row['rhs_evaluations']:11d}{row['ns_per_rhs']:8.0f}")
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(out, f, indent=2)
+        print(f"\nwrote {args.json}")
+
+
+if __name__ == "__main__":
+    main()
