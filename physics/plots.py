@@ -33,43 +33,39 @@ def plot_orbits(result: Result, path: Path, title: str = "") -> Path:
     return _save(fig, path)
 
 
+def plot_time_series(t, series: dict, ylabel: str, title: str, path: Path, **style) -> Path:
+    """One figure of several labelled time series against t."""
+    fig, ax = plt.subplots(figsize=(9, 4), constrained_layout=True)
+    for label, values in series.items():
+        ax.plot(t, values, lw=style.get("lw", 0.8), label=label)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel(ylabel)
+    ax.set_title(title.strip())
+    ax.legend(ncol=style.get("ncol", 1), fontsize=8)
+    return _save(fig, path)
+
+
 def plot_forces(result: Result, path: Path, title: str = "") -> Path:
     """Contact force at both retainer planes (Fig. 4)."""
-    fig, ax = plt.subplots(figsize=(9, 4), constrained_layout=True)
-    for p in PLANES:
-        ax.plot(result.t, result.contact_force(p), lw=0.6, label=p)
-    ax.set_xlabel("time [s]")
-    ax.set_ylabel("contact force F_r [N]")
-    ax.set_title(f"Rotor-sleeve contact force {title}".strip())
-    ax.legend()
-    return _save(fig, path)
+    return plot_time_series(result.t, {p: result.contact_force(p) for p in PLANES},
+                            "contact force F_r [N]", f"Rotor-sleeve contact force {title}", path, lw=0.6)
 
 
 def plot_speeds(result: Result, path: Path, title: str = "") -> Path:
     """Rotor and sleeve spin speeds (Fig. 5)."""
-    fig, ax = plt.subplots(figsize=(9, 4), constrained_layout=True)
-    ax.plot(result.t, result.rotor_speed * RPM, "k", lw=1, label="rotor")
-    for p in PLANES:
-        ax.plot(result.t, result.sleeve_speed(p) * RPM, lw=1, label=f"sleeve {p}")
-    ax.set_xlabel("time [s]")
-    ax.set_ylabel("speed [rpm]")
-    ax.set_title(f"Spin speeds {title}".strip())
-    ax.legend()
-    return _save(fig, path)
+    series = {"rotor": result.rotor_speed * RPM}
+    series.update({f"sleeve {p}": result.sleeve_speed(p) * RPM for p in PLANES})
+    return plot_time_series(result.t, series, "speed [rpm]", f"Spin speeds {title}", path, lw=1.0)
 
 
 def plot_housing(result: Result, path: Path, title: str = "") -> Path:
     """Housing displacement (X and Y) at both planes."""
-    fig, ax = plt.subplots(figsize=(9, 4), constrained_layout=True)
+    series = {}
     for p in PLANES:
         h = result.housing(p) * 1e6
-        ax.plot(result.t, h[:, 0], lw=0.6, label=f"{p} X")
-        ax.plot(result.t, h[:, 1], lw=0.6, label=f"{p} Y")
-    ax.set_xlabel("time [s]")
-    ax.set_ylabel("housing displacement [µm]")
-    ax.set_title(f"Housing motion {title}".strip())
-    ax.legend(ncol=2, fontsize=8)
-    return _save(fig, path)
+        series[f"{p} X"], series[f"{p} Y"] = h[:, 0], h[:, 1]
+    return plot_time_series(result.t, series, "housing displacement [µm]", f"Housing motion {title}",
+                            path, lw=0.6, ncol=2)
 
 
 def plot_drop(result: Result, out_dir: Path, title: str = "") -> list[Path]:
