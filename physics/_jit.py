@@ -1,4 +1,58 @@
-"""The one numba decorator used by every kernel: compiled once, cached on disk, no Python objects."""
-import numba
+"""The numba decorators used by every kernel: compiled once, cached on disk, no Python objects.
 
-njit = numba.njit(cache=True, fastmath=False, nogil=True)
+numba's disk cache checks only the source file of the function it caches, so a kernel that calls a
+kernel in another file (``integrate_segment`` -> ``model.rhs``) would silently keep stale machine
+code after that other file changes. We therefore cache into a directory named by a hash of every
+kernel source of the package: any change to any kernel recompiles everything once. The directory
+is set only while our own functions are decorated; numba's global configuration is left as found.
+Base directory: ``$ROTORDROP_CACHE_DIR``, else ``$NUMBA_CACHE_DIR``, else ``~/.cache/rotordrop``.
+"""
+from __future__ import annotations
+
+import hashlib
+import os
+from pathlib import Path
+
+import numba
+from numba.core import config as _numba_config
+
+_PACKAGES = ("physics", "rotordrop_env")
+
+
+def _kernel_sources_hash(root: Path | None = None) -> str:
+    root = root or Path(__file__).resolve().parent.parent
+    digest = hashlib.sha1(numba.__version__.encode())
+    for pkg in _PACKAGES:
+        for path in sorted((root / pkg).rglob("*.py")):
+            text = path.read_bytes()
+            if b"njit" in text:
+                digest.update(path.relative_to(root).as_posix().encode())
+                digest.update(text)
+    return digest.hexdigest()[:16]
+
+
+def _cache_dir() -> str:
+    base = (os.environ.get("ROTORDROP_CACHE_DIR") or os.environ.get("NUMBA_CACHE_DIR")
+            or os.path.join(os.path.expanduser("~"), ".cache", "rotordrop"))
+    return os.path.join(base, f"numba-{_kernel_sources_hash()}")
+
+
+CACHE_DIR = _cache_dir()
+
+
+def _cached(**options):
+    def decorate(func):
+        previous = _numba_config.CACHE_DIR
+        _numba_config.CACHE_DIR = CACHE_DIR
+        try:
+            return numba.njit(cache=True, nogil=True, **options)(func)
+        finally:
+            _numba_config.CACHE_DIR = previous
+    return decorate
+
+
+njit = _cached()
+"""Serial kernel decorator (``@njit``)."""
+
+njit_parallel = _cached(parallel=True)
+"""Kernel decorator for ``prange`` loops over environments (``@njit_parallel``)."""

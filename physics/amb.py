@@ -1,9 +1,29 @@
-"""Active magnetic bearings (spec §5). Level 'linear': F = -k_amb x - c_amb x' + weight share.
+"""Active magnetic bearings (spec §5): two levels, chosen by ``effects.amb``.
 
-The actuator level (differential electromagnets, current limit, PID) is added with the
-re-levitation environment; the kernel dispatches on the scene's AMB level flag.
+* ``linear``: F = -k_amb x - c_amb x' + weight share, per AMB and axis.
+* ``actuator``: a differential electromagnet pair per AMB axis (bias current i_0, control
+  current i, nonlinear gap law, current limit, force capacity from iron saturation), an optional
+  first-order coil lag and a PID position controller with a filtered derivative and a gravity
+  feed-forward current. After a fault the controller can be switched back on with a reference
+  ramped from the landing position to the centre and a reset integrator, or the control
+  currents can be commanded directly (reactivation, spec §5).
+
+Force of one axis (spec §5), positive towards +x::
+
+    F = k cos(alpha) [(i_0 + i)^2 / (g_0 - x)^2 - (i_0 - i)^2 / (g_0 + x)^2],   k = mu_0 N^2 A_g / 4
+
+Each magnet's term is capped at B_sat^2 A_g cos(alpha) / mu_0 (flux density at most B_sat), which
+bounds the force near the stator. At the centre: k_i = 4 k cos(alpha) i_0 / g_0^2 (current gain),
+k_s = 4 k cos(alpha) i_0^2 / g_0^3 (negative stiffness).
 """
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
 from ._jit import njit
+
+MU_0 = 4e-7 * math.pi
 
 
 @njit
@@ -15,3 +35,96 @@ def linear_force(d, v, k_amb, c_amb, bias):
 def weight_shares(weight: float, z1: float, z2: float) -> tuple[float, float]:
     """Static weight carried by supports at z1 and z2 (centre of mass at z = 0), lever rule."""
     return weight * z2 / (z2 - z1), -weight * z1 / (z2 - z1)
+
+
+# ------------------------------------------------------------------------- actuator level --
+@njit
+def magnet_pair_force(i, x, k_mag, g0, i0, ratio_max):
+    """Force of a differential electromagnet pair along +x (spec §5).
+
+    ``k_mag`` = k cos(alpha); ``ratio_max`` caps the current-to-gap ratio of each magnet
+    (flux density B = mu_0 N i / (2 g) <= B_sat); the gaps are floored at 1 % of g_0.
+    """
+    g_pos = max(g0 - x, 0.01 * g0)
+    g_neg = max(g0 + x, 0.01 * g0)
+    r_pos = min(abs(i0 + i) / g_pos, ratio_max)
+    r_neg = min(abs(i0 - i) / g_neg, ratio_max)
+    return k_mag * (r_pos * r_pos - r_neg * r_neg)
+
+
+@njit
+def ramp_reference(t, t_on, r0, ramp_time):
+    """Lift-off reference: from the landing position r0 at t_on linearly to the centre."""
+    if ramp_time <= 0.0:
+        return 0.0
+    s = (t - t_on) / ramp_time
+    if s >= 1.0:
+        return 0.0
+    if s <= 0.0:
+        return r0
+    return r0 * (1.0 - s)
+
+
+@njit
+def pid_current(e, z_int, q, kp, ki, kd, tau_d, i_ff):
+    """Control current of the PID: i_ff - (kp e + ki int(e) + kd de/dt filtered).
+
+    The filtered derivative is (e - q) / tau_d with the filter state q' = (e - q) / tau_d.
+    """
+    return i_ff - (kp * e + ki * z_int + kd * (e - q) / tau_d)
+
+
+@njit
+def clamp(v, lo, hi):
+    return lo if v < lo else (hi if v > hi else v)
+
+
+@dataclass(frozen=True)
+class ActuatorConstants:
+    """Derived constants of the actuator level (spec §5), per AMB axis."""
+    force_constant: float        # k cos(alpha) = mu_0 N^2 A_g cos(alpha) / 4 [N m^2 / A^2]
+    current_gain: float          # k_i at the centre [N/A]
+    negative_stiffness: float    # k_s at the centre [N/m]
+    ratio_max: float             # largest current / gap ratio of one magnet (saturation) [A/m]
+    force_capacity: float        # force of one magnet at saturation [N]
+    feedforward: tuple[float, float]   # gravity current of AMB1 and AMB2 (y axes) [A]
+
+    def force(self, i: float, x: float, g0: float, i0: float) -> float:
+        return magnet_pair_force(i, x, self.force_constant, g0, i0, self.ratio_max)
+
+
+def actuator_constants(amb, weight1: float, weight2: float) -> ActuatorConstants:
+    """Constants of a scene's ``amb`` group; ``weight1/2`` are the weight shares of AMB1/2 [N]."""
+    k_mag = MU_0 * amb.turns ** 2 * amb.pole_area / 4.0 * math.cos(math.radians(amb.pole_angle_deg))
+    g0, i0 = amb.air_gap, amb.bias_current
+    k_i = 4.0 * k_mag * i0 / g0 ** 2
+    k_s = 4.0 * k_mag * i0 ** 2 / g0 ** 3
+    ratio_max = 2.0 * amb.saturation_flux / (MU_0 * amb.turns)
+    cap = k_mag * ratio_max ** 2
+    ff = (weight1 / k_i, weight2 / k_i) if k_i > 0.0 else (0.0, 0.0)
+    return ActuatorConstants(k_mag, k_i, k_s, ratio_max, cap, ff)
+
+
+def pid_dynamic_stiffness(amb, k_i: float, k_s: float, omega: float) -> complex:
+    """Closed-loop dynamic stiffness K(j omega) of one actuator axis around the centre.
+
+    F = -K x with K = k_i C(j omega) L(j omega) - k_s, C the filtered PID, L the coil lag.
+    """
+    s = 1j * omega
+    C = amb.kp + amb.kd * s / (1.0 + s * amb.derivative_filter)
+    if omega > 0.0:
+        C += amb.ki / s
+    L = 1.0 / (1.0 + s * amb.coil_time_constant)
+    return k_i * C * L - k_s
+
+
+def pid_steady_states(amb, X: complex, omega: float) -> tuple[complex, complex, complex]:
+    """Complex amplitudes of (integral, filter state, coil control current) on the periodic
+    orbit x = Re(X e^{j omega t}) (zero mean; the caller adds the feed-forward current)."""
+    if omega <= 0.0:
+        return 0j, 0j, 0j
+    s = 1j * omega
+    Z = X / s
+    Q = X / (1.0 + s * amb.derivative_filter)
+    I_cmd = -(amb.kp * X + amb.ki * Z + amb.kd * (X - Q) / amb.derivative_filter)
+    return Z, Q, I_cmd / (1.0 + s * amb.coil_time_constant)

@@ -10,7 +10,9 @@ import numpy as np
 from .ball_bearing import ball_forces
 from .model import (I_PLANES, J_HVX, J_HX, J_SVX, J_SX, N_PLANE_IDX, P_CAGE, P_G, P_HALF_PLAY,
                     P_KLIN, P_KS, P_KTOT, P_MH, P_MS, P_NB, P_UB_PHASE, RB_LINEAR, RB_SM, F_RB, F_AMB,
-                    AMB_LINEAR, S_PHI, S_VX, S_X, S_W, Model)
+                    AMB_LINEAR, S_PHI, S_VX, S_X, S_W, Model, AMB_ACTUATOR, AMB_AXES, I_AMB_INT,
+                    I_AMB_FILT, I_AMB_COIL, P_AMB_IFF1, I_CS)
+from .amb import actuator_constants, pid_dynamic_stiffness, pid_steady_states
 from .rotor import steady_unbalance_orbit
 
 
@@ -41,13 +43,18 @@ def levitated_state(model: Model) -> np.ndarray:
     y = np.zeros(model.n_state)
     omega = s.rotor.speed_rpm * math.pi / 30.0
     y[I[S_W]] = omega
-    if I[S_PHI] >= 0 and I[F_AMB] == AMB_LINEAR:
-        Z = steady_unbalance_orbit(s.unbalance.mass * s.unbalance.radius, omega, s.rotor.mass,
-                                   2 * s.amb.stiffness, 2 * s.amb.damping)
+    pos = 0j
+    if I[S_PHI] >= 0 and I[F_AMB] in (AMB_LINEAR, AMB_ACTUATOR):
+        k, c = _amb_support(model, omega)
+        Z = steady_unbalance_orbit(s.unbalance.mass * s.unbalance.radius, omega, s.rotor.mass, k, c)
         pos = Z * complex(math.cos(P[P_UB_PHASE]), math.sin(P[P_UB_PHASE]))
         vel = 1j * omega * pos
         y[I[S_X]], y[I[S_X] + 1] = pos.real, pos.imag
         y[I[S_VX]], y[I[S_VX] + 1] = vel.real, vel.imag
+    if I[F_AMB] == AMB_ACTUATOR:
+        _actuator_states(model, y, pos, omega)
+    if I[I_CS] >= 0:
+        y[I[I_CS]] = y[I[I_CS] + 1] = s.support.damping
     uy = sleeve_rest_offset(P, I) if I[F_RB] in (RB_SM, RB_LINEAR) else 0.0
     sleeve_mass = P[P_MS] if I[I_PLANES + J_SX] >= 0 else 0.0
     for k in range(2):
@@ -59,3 +66,25 @@ def levitated_state(model: Model) -> np.ndarray:
         if I[base + J_SX] >= 0:
             y[I[base + J_SX] + 1] = hy + uy
     return y
+
+
+def _amb_support(model: Model, omega: float) -> tuple[float, float]:
+    """Total AMB stiffness and damping (both bearings) that the unbalance orbit sees at omega."""
+    a = model.scene.amb
+    if model.I[F_AMB] == AMB_LINEAR:
+        return 2 * a.stiffness, 2 * a.damping
+    ac = actuator_constants(a, 0.0, 0.0)
+    K = pid_dynamic_stiffness(a, ac.current_gain, ac.negative_stiffness, omega)
+    return 2 * K.real, (2 * K.imag / omega if omega > 0.0 else 0.0)
+
+
+def _actuator_states(model: Model, y: np.ndarray, pos: complex, omega: float) -> None:
+    """PID and coil states on the settled orbit x + i y = pos e^{i omega t} (AMB axes in order)."""
+    I, P, a = model.I, model.P, model.scene.amb
+    for j in range(len(AMB_AXES)):
+        X = pos if j % 2 == 0 else -1j * pos          # y = Re(-i pos e^{i omega t})
+        Z, Q, Ic = pid_steady_states(a, X, omega)
+        y[I[I_AMB_INT] + j] = Z.real
+        y[I[I_AMB_FILT] + j] = Q.real
+        if I[I_AMB_COIL] >= 0:
+            y[I[I_AMB_COIL] + j] = Ic.real + (P[P_AMB_IFF1 + j // 2] if j % 2 == 1 else 0.0)

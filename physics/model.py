@@ -34,21 +34,36 @@ from .support import housing_force
  P_KC, P_EC, P_CMAX, P_DC, P_MU, P_WL, P_VL,
  P_MS, P_JS,
  P_NB, P_HALF_PLAY, P_KTOT, P_FILM, P_CB, P_KLIN, P_CAGE, P_M0_LOW, P_M0_COEF, P_M1_COEF, P_MSEAL,
- P_KS, P_MH, N_P) = range(41)
+ P_KS, P_MH,
+ # actuator AMBs (spec §5): k cos(alpha), g_0, i_0, current limit, current/gap cap, PID gains,
+ # derivative filter, coil lag, lift-off ramp, gravity feed-forward currents of AMB1/AMB2
+ P_AMB_KMAG, P_AMB_G0, P_AMB_I0, P_AMB_ILIM, P_AMB_RMAX, P_AMB_KP, P_AMB_KI, P_AMB_KD, P_AMB_TD,
+ P_AMB_TL, P_AMB_RAMP, P_AMB_IFF1, P_AMB_IFF2,
+ # semi-active support damper (spec §6): C_min, C_max, lag time constant
+ P_CS_MIN, P_CS_MAX, P_CS_TAU, N_P) = range(57)
 
 # ------------------------------------------------------------------- flags and indices I --
 (F_GRAV, F_UNB, F_GYRO, F_AMB, F_RB, F_FILM, F_BFRIC, F_HOUSING, F_SLEEVE_J, F_FRIC, F_AUDIT,
  S_X, S_Y, S_A, S_B, S_VX, S_VY, S_VA, S_VB, S_W, S_PHI, S_EDISS, S_WEXT, I_PLANES) = range(24)
 # per retainer plane k, the block I[I_PLANES + k*N_PLANE_IDX + j]:
 (J_SX, J_SY, J_SVX, J_SVY, J_TH, J_WS, J_HX, J_HY, J_HVX, J_HVY, N_PLANE_IDX) = range(11)
-N_I = I_PLANES + 2 * N_PLANE_IDX
+N_I_CORE = I_PLANES + 2 * N_PLANE_IDX
+# appended blocks (first state index, -1 when absent): actuator PID integrals, derivative-filter
+# states and coil currents (4 axes each: AMB1 x, AMB1 y, AMB2 x, AMB2 y), damper C_s (2 housings)
+I_AMB_INT, I_AMB_FILT, I_AMB_COIL, I_CS, N_I = range(N_I_CORE, N_I_CORE + 5)
+AMB_AXES = ("AMB1.x", "AMB1.y", "AMB2.x", "AMB2.y")
 
-AMB_NONE, AMB_LINEAR = 0, 1
+AMB_NONE, AMB_LINEAR, AMB_ACTUATOR = 0, 1, 2
 RB_RIGID, RB_LINEAR, RB_SM = 0, 1, 2
 FRIC_NONE, FRIC_PAPER, FRIC_KINEMATIC = 0, 1, 2
 
 # ------------------------------------------------------------------------- controls U --
-U_AMB_POWER, U_CS1, U_CS2, N_U = range(4)
+# U_AMB_POWER > 0: the AMBs run under their built-in controller (linear law or PID);
+# U_CS1/2: support damping of each housing (the damper's command with effects.semi_active_damper).
+# Actuator level only: U_AMB_DIRECT > 0 applies the control currents U_ICMD + j (j = axis, see
+# AMB_AXES) instead of the PID; U_T_ON is the time the PID was switched on and U_REF0 + j the
+# reference it ramps from (spec §5 reactivation).
+U_AMB_POWER, U_CS1, U_CS2, U_AMB_DIRECT, U_ICMD, U_T_ON, U_REF0, N_U = 0, 1, 2, 3, 4, 8, 9, 13
 
 # ------------------------------------------------------------------- diagnostics aux --
 # per plane k at aux[k*N_AUX_PLANE + j]
@@ -101,7 +116,7 @@ def build_model(scene: Scene) -> Model:
     I[F_GRAV] = fx.gravity
     I[F_UNB] = fx.unbalance and s.unbalance.mass * s.unbalance.radius > 0.0
     I[F_GYRO] = fx.gyroscopic
-    I[F_AMB] = {"none": AMB_NONE, "linear": AMB_LINEAR}[fx.amb]
+    I[F_AMB] = {"none": AMB_NONE, "linear": AMB_LINEAR, "actuator": AMB_ACTUATOR}[fx.amb]
     I[F_RB] = {"rigid": RB_RIGID, "linear": RB_LINEAR, "sopanen_mikkola": RB_SM}[fx.retainer_bearing]
     I[F_FILM] = fx.ehl_film and fx.retainer_bearing == "sopanen_mikkola"
     I[F_BFRIC] = fx.bearing_friction
@@ -132,6 +147,21 @@ def build_model(scene: Scene) -> Model:
             for j, n, sz in ((J_HX, "hx", 0.1 * c), (J_HY, "hy", 0.1 * c),
                              (J_HVX, "hvx", 0.01), (J_HVY, "hvy", 0.01)):
                 I[base + j] = add(f"{plane}.{n}", sz)
+    if fx.amb == "actuator":            # PID and coil states per AMB axis (spec §5)
+        I[I_AMB_INT] = len(names)
+        for ax in AMB_AXES:
+            add(f"{ax}.integral", 0.01 * c)
+        I[I_AMB_FILT] = len(names)
+        for ax in AMB_AXES:
+            add(f"{ax}.filter", c)
+        if s.amb.coil_time_constant > 0.0:
+            I[I_AMB_COIL] = len(names)
+            for ax in AMB_AXES:
+                add(f"{ax}.current", max(s.amb.current_limit, 1e-3))
+    if fx.semi_active_damper:           # damper C_s of each housing (spec §6)
+        I[I_CS] = len(names)
+        for plane in PLANES:
+            add(f"{plane}.Cs", s.support.damping_max)
     # energy-audit quadratures: dissipated energy and work of external / non-potential forces
     e_scale = 0.5 * s.rotor.mass * 0.1 ** 2
     I[S_EDISS] = add("E_dissipated", e_scale)
@@ -167,6 +197,16 @@ def build_model(scene: Scene) -> Model:
     P[P_M0_LOW], P[P_M0_COEF], P[P_M1_COEF], P[P_MSEAL] = bc.m0_low, bc.m0_coef, bc.m1_coef, b.seal_torque
     P[P_KS] = s.support.stiffness
     P[P_MH] = s.support.housing_mass + (0.0 if has_sleeve_xy else s.sleeve.mass)
+    if fx.amb == "actuator":
+        a = s.amb
+        ac = amb_mod.actuator_constants(a, P[P_AMB_BIAS1], P[P_AMB_BIAS2])
+        P[P_AMB_KMAG], P[P_AMB_G0], P[P_AMB_I0] = ac.force_constant, a.air_gap, a.bias_current
+        P[P_AMB_ILIM], P[P_AMB_RMAX] = a.current_limit, ac.ratio_max
+        P[P_AMB_KP], P[P_AMB_KI], P[P_AMB_KD], P[P_AMB_TD] = a.kp, a.ki, a.kd, a.derivative_filter
+        P[P_AMB_TL], P[P_AMB_RAMP] = a.coil_time_constant, a.liftoff_ramp_time
+        P[P_AMB_IFF1], P[P_AMB_IFF2] = ac.feedforward
+    P[P_CS_MIN], P[P_CS_MAX] = s.support.damping_min, s.support.damping_max
+    P[P_CS_TAU] = s.support.damper_time_constant
     return Model(scene, P, I, tuple(names), np.asarray(scale))
 
 
@@ -214,6 +254,18 @@ def rhs(t, y, P, I, U, dy, aux):
             ddx, ddy = axis_at(z, vx, vy, va, vb)
             fx = amb_mod.linear_force(dx, ddx, P[P_K_AMB], P[P_C_AMB], 0.0)
             fy = amb_mod.linear_force(dyy, ddy, P[P_K_AMB], P[P_C_AMB], P[P_AMB_BIAS1 + k])
+            Fx += fx
+            Fy += fy
+            Ma += z * fx
+            Mb += z * fy
+            p_ext += fx * ddx + fy * ddy
+    elif I[F_AMB] == AMB_ACTUATOR:
+        for k in range(2):
+            z = P[P_Z_AMB1 + k]
+            dx, dyy = axis_at(z, x, yy, a, b)
+            ddx, ddy = axis_at(z, vx, vy, va, vb)
+            fx = _actuator_axis(t, 2 * k, dx, y, P, I, U, dy)
+            fy = _actuator_axis(t, 2 * k + 1, dyy, y, P, I, U, dy)
             Fx += fx
             Fy += fy
             Ma += z * fx
@@ -332,6 +384,10 @@ def rhs(t, y, P, I, U, dy, aux):
         # --- housing ---
         if i_hx >= 0:
             cs = U[U_CS1 + k]
+            if I[I_CS] >= 0:                     # semi-active damper lags its command (spec §6)
+                i_cs = I[I_CS] + k
+                dy[i_cs] = (amb_mod.clamp(cs, P[P_CS_MIN], P[P_CS_MAX]) - y[i_cs]) / P[P_CS_TAU]
+                cs = y[i_cs]
             gx, gy = housing_force(hx, hy, hvx, hvy, P[P_KS], cs)
             p_diss += cs * (hvx * hvx + hvy * hvy)
             if i_sx >= 0:                        # reaction of the bearing
@@ -367,6 +423,59 @@ def rhs(t, y, P, I, U, dy, aux):
     if I[F_AUDIT]:
         dy[I[S_EDISS]] = p_diss
         dy[I[S_WEXT]] = p_ext
+
+
+@njit
+def _actuator_command(t, j, d, y, P, I, U):
+    """Commanded control current of actuator axis j, its error e and integral rate (spec §5).
+
+    Direct mode: U_ICMD + j. PID mode: feed-forward minus PID of e = d - ramped reference, with
+    conditional-integration anti-windup (the integral stops while the current is saturated and
+    the error would saturate it further). Off: zero.
+    """
+    lim = P[P_AMB_ILIM]
+    if U[U_AMB_DIRECT] > 0.0:
+        return amb_mod.clamp(U[U_ICMD + j], -lim, lim), 0.0, 0.0
+    if U[U_AMB_POWER] <= 0.0:
+        return 0.0, 0.0, 0.0
+    e = d - amb_mod.ramp_reference(t, U[U_T_ON], U[U_REF0 + j], P[P_AMB_RAMP])
+    i_ff = P[P_AMB_IFF1 + j // 2] if j % 2 == 1 else 0.0
+    raw = amb_mod.pid_current(e, y[I[I_AMB_INT] + j], y[I[I_AMB_FILT] + j], P[P_AMB_KP],
+                              P[P_AMB_KI], P[P_AMB_KD], P[P_AMB_TD], i_ff)
+    if (raw > lim and e < 0.0) or (raw < -lim and e > 0.0):
+        return (lim if raw > lim else -lim), e, 0.0
+    return amb_mod.clamp(raw, -lim, lim), e, e
+
+
+@njit
+def _actuator_axis(t, j, d, y, P, I, U, dy):
+    """Force of actuator axis j at displacement d; sets its controller and coil state rates."""
+    i_cmd, e, de_int = _actuator_command(t, j, d, y, P, I, U)
+    i_act = i_cmd
+    if I[I_AMB_COIL] >= 0:
+        ic = I[I_AMB_COIL] + j
+        i_act = y[ic]
+        dy[ic] = (i_cmd - i_act) / P[P_AMB_TL]
+    on = U[U_AMB_POWER] > 0.0 and U[U_AMB_DIRECT] <= 0.0
+    if on:
+        iq = I[I_AMB_FILT] + j
+        dy[I[I_AMB_INT] + j] = de_int
+        dy[iq] = (e - y[iq]) / P[P_AMB_TD]
+    if not on and U[U_AMB_DIRECT] <= 0.0:
+        return 0.0
+    return amb_mod.magnet_pair_force(i_act, d, P[P_AMB_KMAG], P[P_AMB_G0], P[P_AMB_I0], P[P_AMB_RMAX])
+
+
+@njit
+def amb_currents(t, y, P, I, U, out):
+    """Control currents of the 4 actuator axes (AMB1 x, AMB1 y, AMB2 x, AMB2 y) now [A]."""
+    x, yy, a, b = y[I[S_X]], y[I[S_Y]], y[I[S_A]], y[I[S_B]]
+    for j in range(4):
+        dx, dyy = axis_at(P[P_Z_AMB1 + j // 2], x, yy, a, b)
+        if I[I_AMB_COIL] >= 0:
+            out[j] = y[I[I_AMB_COIL] + j]
+        else:
+            out[j] = _actuator_command(t, j, dx if j % 2 == 0 else dyy, y, P, I, U)[0]
 
 
 @njit

@@ -70,6 +70,27 @@ class Amb:
     off_time: float = param(0.1, "s", 0.0, 100.0, "time at which both AMB forces vanish (fault)")
     stiffness: float = param(1e6, "N/m", 0.0, 1e9, "linear AMB stiffness k_amb per AMB and axis", "A")
     damping: float = param(2e3, "N s/m", 0.0, 1e7, "linear AMB damping c_amb per AMB and axis", "A")
+    # actuator level (effects.amb = "actuator", spec §5)
+    air_gap: float = param(0.6e-3, "m", 1e-5, 0.1,
+                           "nominal magnetic air gap g_0 (the stator: environments end when the rotor"
+                           " reaches it at an AMB plane)", "P")
+    turns: int = param(250, "-", 1, 100_000, "coil turns N per electromagnet", "A")
+    pole_area: float = param(1e-3, "m^2", 1e-7, 1.0, "pole face area A_g", "A")
+    pole_angle_deg: float = param(22.5, "deg", 0.0, 60.0, "pole angle alpha to the force axis", "A")
+    bias_current: float = param(3.0, "A", 0.0, 1e3, "bias current i_0", "A")
+    current_limit: float = param(3.0, "A", 0.0, 1e3, "control current limit |i| <= i_max (<= i_0)", "A")
+    saturation_flux: float = param(1.6, "T", 0.1, 5.0,
+                                   "iron saturation flux density B_sat: caps each magnet's force"
+                                   " at B_sat^2 A_g cos(alpha) / mu_0 (force capacity)", "A")
+    kp: float = param(8000.0, "A/m", 0.0, 1e9, "PID proportional gain (per AMB axis)", "A")
+    ki: float = param(1e5, "A/(m s)", 0.0, 1e12, "PID integral gain", "A")
+    kd: float = param(15.0, "A s/m", 0.0, 1e6, "PID derivative gain", "A")
+    derivative_filter: float = param(2e-4, "s", 1e-6, 1.0, "time constant of the derivative filter", "A")
+    coil_time_constant: float = param(0.0, "s", 0.0, 1.0,
+                                      "coil current lag L/R (0: ideal current amplifier, no state)", "A")
+    liftoff_ramp_time: float = param(0.05, "s", 0.0, 10.0,
+                                     "after reactivation the reference ramps from the landing"
+                                     " position to the centre in this time", "A")
 
 
 @dataclass(frozen=True)
@@ -118,13 +139,20 @@ class Support:
     stiffness: float = param(5e7, "N/m", 1e4, 1e11, "housing support stiffness K_s (X and Y)")
     damping: float = param(5000.0, "N s/m", 0.0, 1e7, "housing support damping C_s (X and Y)")
     housing_mass: float = param(5.0, "kg", 1e-3, 1e4, "housing + outer ring mass", "A")
+    # semi-active damper (effects.semi_active_damper, spec §6)
+    damping_min: float = param(2790.0, "N s/m", 0.0, 1e7, "semi-active damper: lowest C_s (C_min)")
+    damping_max: float = param(27900.0, "N s/m", 0.0, 1e7, "semi-active damper: highest C_s (C_max)")
+    damper_time_constant: float = param(0.01, "s", 1e-5, 1.0,
+                                        "semi-active damper: first-order lag of C_s behind its"
+                                        " command", "A")
 
 
 @dataclass(frozen=True)
 class Solver:
     method: str = param("adaptive", "-", doc="adaptive (Dormand-Prince 5(4)) or fixed (same tableau,"
                         " constant step solver.dt)", tag="A", choices=("adaptive", "fixed"))
-    rtol: float = param(1e-6, "-", 1e-12, 1e-1, "relative tolerance (absolute = rtol x state scale)", "A")
+    rtol: float = param(1e-5, "-", 1e-12, 1e-1, "relative tolerance (absolute = rtol x state scale);"
+                        " default chosen by `rotordrop accuracy` (docs/accuracy.md)", "A")
     dt: float = param(2e-6, "s", 1e-9, 1e-2, "step of the fixed-step method", "A")
     max_step: float = param(1e-3, "s", 1e-9, 1.0, "largest adaptive step", "A")
     min_step: float = param(1e-12, "s", 1e-16, 1e-6,
@@ -141,7 +169,8 @@ class Effects:
     gravity: bool = param(True, "-", doc="gravity on all bodies")
     unbalance: bool = param(True, "-", doc="rotating unbalance force (adds the spin angle state)")
     gyroscopic: bool = param(True, "-", doc="gyroscopic coupling I_p Omega of the tilts")
-    amb: str = param("linear", "-", doc="AMB model before the fault", choices=("none", "linear"))
+    amb: str = param("linear", "-", doc="AMB model: linear spring-damper, or actuator (electromagnets,"
+                     " current limit, PID; can be reactivated)", choices=("none", "linear", "actuator"))
     retainer_bearing: str = param("sopanen_mikkola", "-",
                                   doc="sleeve mount: rigid (moves with the housing), linear spring, or"
                                       " Sopanen-Mikkola ball bearing",
@@ -155,6 +184,9 @@ class Effects:
                                      " drag)")
     friction: str = param("paper", "-", doc="rotor-sleeve friction slip definition",
                           choices=("none", "paper", "kinematic"))
+    semi_active_damper: bool = param(False, "-",
+                                     doc="support damping C_s is a controlled state lagging its command"
+                                         " (needs housing; adds one state per housing)")
 
 
 GROUPS: dict[str, type] = {
@@ -371,6 +403,40 @@ def _check_consistency(s: Scene) -> None:
                          f"(got {s.solver.output_rate * s.solver.t_end:.3g})")
     if s.solver.method == "fixed" and s.solver.t_end / s.solver.dt > 1e9:
         raise SceneError("solver.t_end / solver.dt must be <= 1e9 steps for the fixed-step method")
+    if s.effects.amb == "actuator":
+        _check_actuator(s)
+    if s.effects.semi_active_damper:
+        sp = s.support
+        if not s.effects.housing:
+            raise SceneError("effects.semi_active_damper needs effects.housing = true (the damper"
+                             " acts between housing and ground)")
+        if not sp.damping_min < sp.damping_max:
+            raise SceneError(f"support.damping_min ({sp.damping_min:g}) must be < support.damping_max"
+                             f" ({sp.damping_max:g})")
+        if not sp.damping_min <= sp.damping <= sp.damping_max:
+            raise SceneError(f"support.damping = {sp.damping:g} must lie in [support.damping_min,"
+                             f" support.damping_max] = [{sp.damping_min:g}, {sp.damping_max:g}] N s/m"
+                             " with effects.semi_active_damper")
+
+
+def _check_actuator(s: Scene) -> None:
+    """The actuator AMBs must be able to carry the rotor (spec §5)."""
+    from .amb import actuator_constants, weight_shares
+    a = s.amb
+    if a.current_limit > a.bias_current:
+        raise SceneError(f"amb.current_limit ({a.current_limit:g} A) must be <= amb.bias_current"
+                         f" ({a.bias_current:g} A): a coil current cannot reverse")
+    g = s.world.gravity if s.effects.gravity else 0.0
+    shares = weight_shares(s.rotor.mass * g, s.positions.amb1, s.positions.amb2)
+    c = actuator_constants(a, *shares)
+    need = max(abs(f) for f in c.feedforward)
+    if need > a.current_limit:
+        raise SceneError(f"the actuator AMBs cannot carry the rotor: the weight share needs {need:.3g} A"
+                         f" of control current at the centre, above amb.current_limit ="
+                         f" {a.current_limit:g} A (raise amb.bias_current, amb.turns or amb.pole_area)")
+    if a.kp * c.current_gain <= c.negative_stiffness:
+        raise SceneError(f"amb.kp = {a.kp:g} A/m is too low: k_i kp = {a.kp * c.current_gain:.3g} N/m must"
+                         f" exceed the negative stiffness k_s = {c.negative_stiffness:.3g} N/m")
 
 
 def _toml_value(v: Any) -> str:

@@ -7,7 +7,7 @@ import numpy as np
 
 from .equilibrium import levitated_state
 from .integrate import NOT_FINITE, OK, STEP_COLLAPSE, TOO_MANY_STEPS, integrate_segment
-from .model import N_AUX, AMB_LINEAR, F_AMB, Model, build_model, diagnostics
+from .model import N_AUX, AMB_NONE, F_AMB, Model, build_model, diagnostics
 from .results import Result, RunStats
 from .scene import Scene
 
@@ -87,7 +87,7 @@ def warm_up(model: Model) -> float:
 def segments(model: Model, t_end: float) -> list[tuple[float, float, bool]]:
     """(start, end, AMB powered) pieces of the run, split exactly at the fault time."""
     t_off = model.scene.amb.off_time
-    if model.I[F_AMB] != AMB_LINEAR:
+    if model.I[F_AMB] == AMB_NONE:
         return [(0.0, t_end, False)]
     if t_off >= t_end:
         return [(0.0, t_end, True)]

@@ -84,7 +84,8 @@ def test_whirl_raises_forces_spins_sleeves_faster_and_leaves_the_clearance_circl
 
 
 def test_stiffer_support_gives_larger_impact_force_and_smaller_displacement():
-    res = {ks: compute_metrics(simulate(load_scene("paper", {"support.stiffness": ks,
+    # the analytic bounds of spec §7 are for the spec's parameters (the frozen `spec` preset)
+    res = {ks: compute_metrics(simulate(load_scene("spec", {"support.stiffness": ks,
                                                              "contact.friction": 0.1}), t_end=0.13))
            for ks in (5e6, 5e7, 5e8)}
     f = [res[k]["planes"]["RB1"]["peak_contact_force_N"] for k in (5e6, 5e7, 5e8)]

@@ -1,0 +1,216 @@
+"""Environment speed: env steps per second at the 1 ms control step, single and batched.
+
+    python benchmarks/bench_env.py [--repeats 3] [--episodes 2] [--n-envs 16] [--json out.json]
+                                   [--set KEY=VALUE ...]
+
+Paper scene, default environment settings (episode 0.3 s = 300 steps, 5 monitor samples per
+step), whole episodes including resets. Every figure is the median of ``--repeats`` runs after a
+JIT warm-up, timed by the process CPU time (``--clock cpu``, the default: per core and robust on
+a machine shared with other jobs) or by the wall clock (``--clock wall``).
+
+* single env: ``gym.make(id)`` (with Gymnasium's wrappers) and ``env.unwrapped``, for the passive
+  env (no action) and the damping env (uniform random actions, seeded), for the paper scene as
+  it is (mu = 0.25: drop, bounces, no whirl) and at mu = 0.5, which whirls backward (run on
+  through the whirl with ``terminate_on_failure=False``; the physics is costliest there);
+* cost split (passive env, same trajectory): physics alone (``integrate_segment`` over each
+  1 ms step, in one compiled loop), the step kernel (physics + sub-sampled monitors, reward,
+  observation), the Python ``step`` and Gymnasium's wrappers;
+* batched: ``BatchedRotorDropVecEnv`` with N envs of the damping env, with 1 numba thread (the
+  per-core figure) and with all threads.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import time
+
+import gymnasium as gym
+import numba
+import numpy as np
+
+import rotordrop_env
+from physics._jit import njit
+from physics.scene import parse_assignment
+from physics.integrate import integrate_segment
+from rotordrop_env import kernels as K
+
+
+CLOCK = time.process_time
+
+
+def _median(fn, repeats: int) -> float:
+    fn()                                               # warm-up (JIT, caches)
+    return statistics.median(fn() for _ in range(repeats))
+
+
+def single_env_rate(env_id: str, kwargs: dict, episodes: int, unwrapped: bool, seed: int = 0):
+    """Steps per second over whole episodes (random actions except for the passive env)."""
+    env = gym.make(env_id, **kwargs)
+    stepper = env.unwrapped if unwrapped else env
+    space = env.action_space
+    space.seed(seed)
+    acts = [space.sample() for _ in range(4096)]
+
+    def run():
+        steps = 0
+        t0 = CLOCK()
+        for ep in range(episodes):
+            stepper.reset(seed=seed + ep)
+            done = False
+            while not done:
+                _, _, te, tr, _ = stepper.step(acts[steps % len(acts)])
+                done = te or tr
+                steps += 1
+        return steps / (CLOCK() - t0)
+    return run
+
+
+def passive_split(kwargs: dict, episodes: int):
+    """Per-step microseconds of physics, kernel, unwrapped step and wrapped step (passive env)."""
+    env = gym.make("RotorDrop-Passive-v0", **kwargs)
+    u = env.unwrapped
+    a = np.zeros(1, dtype=np.float32)
+
+    def per_step(fn):
+        def run():
+            steps, total = 0, 0.0
+            for _ in range(episodes):
+                env.reset(seed=0)
+                t0 = CLOCK()
+                done = False
+                while not done:
+                    done = fn()
+                    steps += 1
+                total += CLOCK() - t0
+            return total / steps * 1e6
+        return run
+
+    def kernel_step():
+        K.step_one(*u._args)
+        return bool(u._b.out[K.O_TERM] or u._b.out[K.O_TRUNC])
+
+    def unwrapped_step():
+        _, _, te, tr, _ = u.step(a)
+        return te or tr
+
+    def wrapped_step():
+        _, _, te, tr, _ = env.step(a)
+        return te or tr
+
+    env.reset(seed=0)
+    n_steps = 1
+    while not kernel_step():                # episode length (it may end at the stator)
+        n_steps += 1
+
+    def physics():
+        env.reset(seed=0)
+        b = u._b
+        y, U = b.y.copy(), b.U.copy()
+        sv = u.scene.solver
+        work = np.empty((8, y.size))
+        t0 = CLOCK()
+        status = _physics_loop(y, b.M[K.M_T], u.dt, n_steps, b.P, b.I, U, sv.rtol, b.atol,
+                               b.M[K.M_H], sv.max_step, sv.min_step, work)
+        elapsed = CLOCK() - t0
+        assert status == 0
+        return elapsed / n_steps * 1e6
+
+    return dict(physics=physics, kernel=per_step(kernel_step), unwrapped=per_step(unwrapped_step),
+                wrapped=per_step(wrapped_step))
+
+
+@njit
+def _physics_loop(y, t, dt, n, P, I, U, rtol, atol, h, h_max, h_min, work):
+    """The physics alone: n control steps of integrate_segment in one compiled call."""
+    no_t = np.empty(0)
+    no_Y = np.empty((0, y.shape[0]))
+    for _ in range(n):
+        status, _, h, _, _, _, _ = integrate_segment(y, t, t + dt, P, I, U, rtol, atol, h, h_max,
+                                                     h_min, False, 10**9, no_t, no_Y, 0, work)
+        if status != 0:
+            return status
+        t += dt
+    return 0
+
+
+def batched_rate(env_id: str, kwargs: dict, n_envs: int, steps: int, threads: int, seed: int = 0):
+    venv = rotordrop_env.BatchedRotorDropVecEnv(env_id, n_envs, seed=seed, n_threads=threads,
+                                                **kwargs)
+    rng = np.random.default_rng(seed)
+    shape = (n_envs,) + venv.action_space.shape
+    acts = [rng.uniform(-1, 1, shape).astype(np.float32) for _ in range(64)]
+
+    def run():
+        venv.reset()
+        t0 = CLOCK()
+        for k in range(steps):
+            venv.step(acts[k % len(acts)])
+        return steps * n_envs / (CLOCK() - t0)
+    return run
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--repeats", type=int, default=3)
+    p.add_argument("--episodes", type=int, default=2, help="episodes per single-env run")
+    p.add_argument("--n-envs", type=int, default=16)
+    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                   help="scene override for every env, e.g. solver.rtol=1e-4")
+    p.add_argument("--json", default=None, help="write the figures to this JSON file")
+    p.add_argument("--clock", choices=("cpu", "wall"), default="cpu",
+                   help="process CPU time (per core; default) or wall-clock time")
+    args = p.parse_args(argv)
+    global CLOCK
+    CLOCK = time.process_time if args.clock == "cpu" else time.perf_counter
+    kwargs = {"overrides": dict(parse_assignment(a) for a in args.overrides)} if args.overrides else {}
+    R, E = args.repeats, args.episodes
+    res: dict = {"scene": "paper", "overrides": kwargs.get("overrides", {}), "clock": args.clock,
+                 "control_dt_s": 1e-3, "numba_threads": numba.config.NUMBA_NUM_THREADS}
+
+    cases = (("mu = 0.25 (drop and bounces)", {}),
+             ("mu = 0.5 through the backward whirl", {"contact.friction": 0.5}))
+    for label, extra in cases:
+        kw = dict(kwargs, overrides=dict(kwargs.get("overrides", {}), **extra))
+        if extra:
+            kw["terminate_on_failure"] = False
+        print(f"single environment, paper scene {res['overrides'] or ''}, {label}, whole 0.3 s "
+              f"episodes (median of {R}):")
+        for env_id in ("RotorDrop-Passive-v0", "RotorDrop-Damping-v0"):
+            for unwrapped in (False, True):
+                rate = _median(single_env_rate(env_id, kw, E, unwrapped), R)
+                key = f"{label}: {env_id}{' unwrapped' if unwrapped else ''}"
+                res[key + " steps/s"] = rate
+                print(f"  {env_id + (' unwrapped' if unwrapped else ''):36s} {rate:10.0f} steps/s")
+        split = {k: _median(fn, R) for k, fn in passive_split(kw, E).items()}
+        res[f"{label}: passive per-step us"] = split
+        print("  cost split of one passive step [µs] (same trajectory):")
+        print(f"    physics (integrate_segment)        {split['physics']:8.1f}")
+        print(f"    + monitors, reward, obs (kernel)   {split['kernel'] - split['physics']:8.1f}"
+              f"   (kernel call {split['kernel']:.1f})")
+        print(f"    + Python step()                    {split['unwrapped'] - split['kernel']:8.1f}"
+              f"   (env.unwrapped.step {split['unwrapped']:.1f})")
+        print(f"    + Gymnasium wrappers               {split['wrapped'] - split['unwrapped']:8.1f}"
+              f"   (gym.make env.step {split['wrapped']:.1f})")
+        print(f"    physics share of env.step: {100 * split['physics'] / split['wrapped']:.0f} %")
+
+    n, steps = args.n_envs, 600
+    single = res[f"{cases[0][0]}: RotorDrop-Damping-v0 steps/s"]
+    print(f"batched VecEnv, N = {n}, RotorDrop-Damping-v0 (paper scene), random actions, "
+          f"{steps} batch steps:")
+    for threads in sorted({1, numba.config.NUMBA_NUM_THREADS}):
+        rate = _median(batched_rate("RotorDrop-Damping-v0", kwargs, n, steps, threads), R)
+        per_core = rate if args.clock == "cpu" else rate / threads
+        res[f"batched N={n} threads={threads} steps/s per core"] = per_core
+        print(f"  {threads} thread(s): {per_core:10.0f} env steps/s per core "
+              f"({per_core / single:.2f}x the single env)"
+              + ("" if args.clock == "cpu" else f", {rate:.0f} env steps/s in all"))
+    if args.json:
+        with open(args.json, "w") as fh:
+            json.dump(res, fh, indent=2)
+        print(f"wrote {args.json}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

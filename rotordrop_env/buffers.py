@@ -1,0 +1,41 @@
+"""Preallocated arrays of one environment, or stacked (N, ...) for the batched VecEnv.
+
+A batched VecEnv allocates one stack and hands each of its environments a row of views, so the
+single-env step (:func:`~rotordrop_env.kernels.step_one`) and the batched step
+(:func:`~rotordrop_env.kernels.step_batch`) read and write the very same memory.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from physics.model import N_AUX, N_I, N_P, N_U
+
+from .kernels import N_C, N_M, N_O
+
+FIELDS = ("act", "y", "P", "I", "U", "atol", "work", "t_sub", "Y_sub", "aux", "cur", "C", "M",
+          "scale", "obs", "out")
+
+
+class Buffers:
+    """Arrays passed to the step kernels (see :mod:`rotordrop_env.kernels`), in kernel order."""
+
+    def __init__(self, n_state: int, n_obs: int, n_act: int, n_sub: int, n_envs: int | None = None):
+        lead = () if n_envs is None else (n_envs,)
+        shapes = dict(act=(n_act,), y=(n_state,), P=(N_P,), I=(N_I,), U=(N_U,), atol=(n_state,),
+                      work=(8, n_state), t_sub=(n_sub,), Y_sub=(n_sub, n_state), aux=(N_AUX,),
+                      cur=(4,), C=(N_C,), M=(N_M,), scale=(n_obs,), obs=(n_obs,), out=(N_O,))
+        for name in FIELDS:
+            dtype = np.int64 if name == "I" else np.float64
+            setattr(self, name, np.zeros(lead + shapes[name], dtype=dtype))
+        self.dims = (n_state, n_obs, n_act, n_sub)
+
+    def row(self, e: int) -> "Buffers":
+        """Views of environment ``e``'s arrays in a stack."""
+        view = object.__new__(Buffers)
+        for name in FIELDS:
+            setattr(view, name, getattr(self, name)[e])
+        view.dims = self.dims
+        return view
+
+    def args(self) -> tuple:
+        return tuple(getattr(self, name) for name in FIELDS)

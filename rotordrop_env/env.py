@@ -1,0 +1,492 @@
+"""Gymnasium environments of the AMB rotor drop (spec §5-6): passive, semi-active support
+damping, AMB re-levitation, and both together. See docs/environments.md for the full tables."""
+from __future__ import annotations
+
+import math
+
+import gymnasium as gym
+import numpy as np
+
+from physics.model import P_Z_RB1, S_A, S_B, S_X, S_Y
+from physics.scene import Scene, SceneError, load_scene
+from physics.simulate import IntegrationError, _explain
+
+from . import kernels as K
+from .buffers import Buffers
+from .layout import action_layout, observation_layout
+from .scenario import POWER_RETURN, fault_state, resolve_ranges, sample, scenario_scene
+
+REWARD_TERMS = ("whirl", "contact", "displacement", "effort", "success", "failure")
+_O_TERMS = (K.O_R_WHIRL, K.O_R_CONTACT, K.O_R_DISP, K.O_R_EFFORT, K.O_R_SUCCESS, K.O_R_FAILURE)
+DEFAULT_POWER_RETURN = 0.05
+
+
+class RotorDropEnv(gym.Env):
+    """Base class of the rotor-drop environments (one readable class, MuJoCo-v5 style).
+
+    An episode starts at the AMB fault from the cached levitated state of the scene and runs
+    ``episode_time`` seconds in control steps of ``control_dt``. The physics is the full drop
+    model of :mod:`physics` (adaptive Dormand-Prince between control steps).
+
+    Constructor keyword arguments (all pass through ``gym.make(id, **kwargs)``)
+    --------------------------------------------------------------------------
+    ==========================  ==========  ====================================================
+    kwarg                       default     meaning
+    ==========================  ==========  ====================================================
+    scene                       "paper"     preset name, TOML path or :class:`physics.Scene`
+    overrides                   None        dict of dotted scene keys, e.g. {"contact.friction": 0.4}
+    control_dt                  1e-3        control step [s] (``env.dt``)
+    episode_time                0.3         episode length after the fault [s] (time limit)
+    randomize                   False       draw a scenario at every reset (ranges below)
+    randomization               None        {key: (low, high) | (law, low, high) | None}
+    full_state                  False       observe the whole state vector (research)
+    command                     "discrete"  re-levitation envs: "discrete" or "continuous"
+    power_return_time           0.05        re-levitation envs: power returns [s after fault]
+    samples_per_step            5           monitor samples per control step (dense output)
+    relevitation_hold           0.02        re-levitated after this long in the success region [s]
+    terminate_on_failure        True        end at the stator or at a bearing overload
+    w_whirl, w_contact,         10, 0.1,    reward weights (see Reward)
+    w_displacement, w_effort,   0.1, 0.01,
+    w_success, w_failure        10, 1.0
+    render_mode                 None        "rgb_array" or "human"
+    ==========================  ==========  ====================================================
+
+    Reward (sum of named terms, each in ``info["reward_<term>"]``)
+    -------------------------------------------------------------
+    =============  ========================================================================
+    term           value per control step
+    =============  ========================================================================
+    whirl          -w_whirl x backward orbit revolutions in the step (rotor relative to the
+                   sleeve, counted beyond half the clearance; mean of the two planes)
+    contact        -w_contact x peak contact force in the step / static weight share [N/N]
+    displacement   -w_displacement x peak radial displacement at the retainer planes / clearance
+    effort         -w_effort x mean squared normalised command (damper (C-C_min)/(C_max-C_min),
+                   AMB control currents / current limit)
+    success        +w_success once, when re-levitation is achieved (re-levitation envs)
+    failure        -w_failure x remaining control steps, on termination (failing never pays)
+    =============  ========================================================================
+
+    Episode end: ``terminated`` when the rotor reaches the AMB stator (radial displacement
+    ``amb.air_gap`` = 600 µm at an AMB plane) or a contact force exceeds the retainer
+    bearing's static load rating C_0; ``truncated`` only at the time limit.
+    """
+
+    metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 30}
+    _damping = False
+    _relevitate = False
+
+    def __init__(self, scene: str | Scene = "paper", overrides: dict | None = None,
+                 control_dt: float = 1e-3, episode_time: float = 0.3, randomize: bool = False,
+                 randomization: dict | None = None, full_state: bool = False,
+                 command: str | None = None, power_return_time: float | None = None,
+                 samples_per_step: int = 5, relevitation_hold: float = 0.02,
+                 terminate_on_failure: bool = True, w_whirl: float = 10.0,
+                 w_contact: float = 0.1, w_displacement: float = 0.1, w_effort: float = 0.01,
+                 w_success: float = 10.0, w_failure: float = 1.0, render_mode: str | None = None):
+        self._check_options(command, power_return_time, render_mode)
+        _positive("control_dt", control_dt, 1e-6, 0.1)
+        _positive("episode_time", episode_time, control_dt, 100.0)
+        _positive("relevitation_hold", relevitation_hold, 0.0, 100.0)
+        if int(samples_per_step) != samples_per_step or not 1 <= samples_per_step <= 1000:
+            raise ValueError(f"samples_per_step = {samples_per_step!r} must be an integer in [1, 1000]")
+        weights = dict(w_whirl=w_whirl, w_contact=w_contact, w_displacement=w_displacement,
+                       w_effort=w_effort, w_success=w_success, w_failure=w_failure)
+        for k, v in weights.items():
+            _positive(k, v, 0.0, 1e9)
+        self.command = (command or "discrete") if self._relevitate else None
+        self.power_return_time = (DEFAULT_POWER_RETURN if power_return_time is None
+                                  else float(power_return_time)) if self._relevitate else None
+        self.control_dt = self.dt = float(control_dt)
+        self.n_steps = int(math.ceil(episode_time / control_dt - 1e-9))
+        self.episode_time = self.n_steps * self.dt
+        self.randomize = bool(randomize)
+        self.full_state = bool(full_state)
+        self.render_mode = render_mode
+        self.weights = weights
+        self.base_scene = self._make_scene(scene, overrides)
+        self.ranges = resolve_ranges(randomization, self._relevitate, self.base_scene)
+        self.scene = self.base_scene
+        fs = fault_state(self.base_scene)
+        self.model = model = fs.model
+
+        self.obs_names, self.obs_scale = observation_layout(
+            model, self._damping, self._relevitate, self.full_state, self.episode_time)
+        self.action_space, self.action_names = action_layout(self._damping, self._relevitate,
+                                                             self.command)
+        n_obs = len(self.obs_names)
+        self.observation_space = gym.spaces.Box(-np.inf, np.inf, shape=(n_obs,), dtype=np.float32)
+        self._discrete = isinstance(self.action_space, gym.spaces.Discrete)
+        self._act_shape = () if self._discrete else self.action_space.shape
+        n_act = 1 if self._discrete else self.action_space.shape[0]
+        self._bind(Buffers(model.n_state, n_obs, n_act, int(samples_per_step)))
+        self._configure_static(relevitation_hold, terminate_on_failure)
+        self.actuator = None
+        if self._relevitate:
+            from physics.amb import actuator_constants
+            from physics.model import P_AMB_BIAS1, P_AMB_BIAS2
+            self.actuator = actuator_constants(self.base_scene.amb, model.P[P_AMB_BIAS1],
+                                               model.P[P_AMB_BIAS2])
+        self._renderer = None
+        self._scenario: dict = {}
+        self._needs_reset = True
+
+    # ------------------------------------------------------------------------- set-up --
+    def _check_options(self, command, power_return_time, render_mode):
+        name = type(self).__name__
+        if not self._relevitate:
+            if command is not None:
+                raise ValueError(f"command= applies to the re-levitation environments only, not {name}")
+            if power_return_time is not None:
+                raise ValueError(f"power_return_time= applies to the re-levitation environments "
+                                 f"only, not {name}")
+        if command not in (None, "discrete", "continuous"):
+            raise ValueError(f"command = {command!r} must be 'discrete' or 'continuous'")
+        if power_return_time is not None:
+            _positive("power_return_time", power_return_time, 0.0, 100.0)
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(f"render_mode = {render_mode!r} must be None or one of "
+                             f"{self.metadata['render_modes']}")
+
+    def _make_scene(self, scene, overrides) -> Scene:
+        if isinstance(scene, Scene):
+            base = scene.with_overrides(overrides) if overrides else scene
+        else:
+            base = load_scene(scene, overrides)
+        forced = {}
+        if self._damping:
+            forced["effects.semi_active_damper"] = True
+        if self._relevitate:
+            forced["effects.amb"] = "actuator"
+        for key, value in forced.items():
+            given = (overrides or {}).get(key)
+            if given is not None and str(given).lower() != str(value).lower():
+                raise SceneError(f"{type(self).__name__} needs {key} = {value}, got {given!r}")
+        base = base.with_overrides(forced) if forced else base
+        if self._damping and not base.effects.housing:
+            raise SceneError("the damping environments need effects.housing = true")
+        return base
+
+    def _bind(self, buffers: Buffers) -> None:
+        """Use these arrays (own ones, or a row of a batched VecEnv's stack)."""
+        old = getattr(self, "_b", None)
+        if old is not None:
+            for name in ("C", "scale"):
+                getattr(buffers, name)[...] = getattr(old, name)
+        self._b = buffers
+        self._args = buffers.args()
+        self._needs_reset = True
+
+    def _configure_static(self, hold: float, terminate: bool) -> None:
+        b, s = self._b, self.base_scene
+        C = b.C
+        C[K.C_DT] = self.dt
+        C[K.C_DAMP] = 1.0 if self._damping else 0.0
+        C[K.C_LEV] = (K.LEV_NONE if not self._relevitate else
+                      K.LEV_DISCRETE if self.command == "discrete" else K.LEV_CONTINUOUS)
+        C[K.C_A_DAMP] = 0.0
+        C[K.C_A_LEV] = 2.0 if self._damping else 0.0
+        C[K.C_N_ACT] = b.act.shape[-1]
+        C[K.C_N_SUB] = b.t_sub.shape[-1]
+        w = self.weights
+        C[K.C_W_WHIRL], C[K.C_W_CONTACT], C[K.C_W_DISP] = w["w_whirl"], w["w_contact"], w["w_displacement"]
+        C[K.C_W_EFFORT], C[K.C_W_SUCCESS], C[K.C_W_FAILURE] = w["w_effort"], w["w_success"], w["w_failure"]
+        C[K.C_HOLD] = hold
+        C[K.C_TERMINATE] = 1.0 if terminate else 0.0
+        C[K.C_FULL] = 1.0 if self.full_state else 0.0
+        b.scale[:] = self.obs_scale
+
+    def _configure_episode(self, scene: Scene, t_fault: float, power_return: float | None) -> None:
+        C, sv = self._b.C, scene.solver
+        C[K.C_T_FAULT] = t_fault
+        C[K.C_T_END] = t_fault + self.n_steps * self.dt
+        if power_return is None:
+            C[K.C_T_POWER] = math.inf
+        else:                                   # on the control-step grid (documented)
+            C[K.C_T_POWER] = t_fault + math.ceil(power_return / self.dt - 1e-9) * self.dt
+        C[K.C_RTOL], C[K.C_HMAX], C[K.C_HMIN] = sv.rtol, sv.max_step, sv.min_step
+        C[K.C_FIXED] = 1.0 if sv.method == "fixed" else 0.0
+        C[K.C_MAXSTEPS] = sv.max_steps
+        g = scene.world.gravity if scene.effects.gravity else 9.80665
+        z1, z2 = scene.positions.rb1, scene.positions.rb2
+        C[K.C_F_REF] = scene.rotor.mass * g * max(z2, -z1) / (z2 - z1)    # static weight share
+        C[K.C_GAP] = scene.amb.air_gap
+        C[K.C_LOAD_RATING] = scene.bearing.static_load_rating
+        C[K.C_CS_MIN], C[K.C_CS_MAX] = scene.support.damping_min, scene.support.damping_max
+        C[K.C_ILIM] = scene.amb.current_limit
+        C[K.C_RELEV_RADIUS] = 0.5 * scene.contact.clearance
+
+    # ------------------------------------------------------------------------ episode --
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        super().reset(seed=seed)
+        values = sample(self.ranges, self.np_random) if self.randomize else {}
+        fixed = dict((options or {}).get("scenario") or {})
+        unknown = set(options or {}) - {"scenario"}
+        if unknown:
+            raise ValueError(f"unknown reset option(s) {sorted(unknown)}; use options="
+                             "{'scenario': {dotted_key: value, 'power_return_time': s}}")
+        values.update(fixed)
+        if POWER_RETURN in values and not self._relevitate:
+            raise ValueError(f"{POWER_RETURN} applies to the re-levitation environments only")
+        scene = scenario_scene(self.base_scene, values)
+        fs = fault_state(scene)
+        b = self._b
+        if fs.model.n_state != b.y.shape[-1]:
+            raise SceneError(f"scenario {values} changes the state layout ({fs.model.n_state} "
+                             f"states instead of {b.y.shape[-1]}): keep effect-switching values "
+                             "(e.g. unbalance.mass = 0) out of the randomisation ranges")
+        self.scene, self.model = scene, fs.model
+        pr = values.get(POWER_RETURN, self.power_return_time)
+        if pr is not None:
+            _positive(POWER_RETURN, pr, 0.0, 100.0)
+        self._configure_episode(scene, fs.t_fault, pr)
+        b.y[:] = fs.y
+        b.P[:] = fs.model.P
+        b.I[:] = fs.model.I
+        b.U[:] = fs.model.controls(False)
+        b.atol[:] = scene.solver.rtol * fs.model.scale
+        b.M[:] = 0.0
+        b.M[K.M_T] = fs.t_fault
+        b.M[K.M_H] = fs.h
+        b.M[K.M_OK_START] = -1.0
+        b.M[K.M_RELEV_T] = math.nan
+        K.observe_now(b.y, b.P, b.I, b.U, b.C, b.M, b.work, b.aux, b.cur, b.scale, b.obs)
+        self._scenario = values
+        if pr is not None:
+            self._scenario = dict(values, **{POWER_RETURN: b.C[K.C_T_POWER] - fs.t_fault})
+        self._needs_reset = False
+        if self._renderer is not None:
+            self._renderer.reset()
+            self._record()
+        return b.obs.astype(np.float32), {"scenario": dict(self._scenario), "time_s": 0.0}
+
+    def step(self, action):
+        if self._needs_reset:
+            raise gym.error.ResetNeeded("call reset() before step() (and after a batched VecEnv "
+                                        "took over this environment's arrays)")
+        b = self._b
+        self._load_action(action, b.act)
+        K.step_one(*self._args)
+        return self._finish(action)
+
+    def _load_action(self, action, act: np.ndarray) -> None:
+        if self._discrete:
+            a = np.asarray(action)
+            if a.size != 1 or not np.issubdtype(a.dtype, np.number):
+                raise ValueError(f"action {action!r} is not in {self.action_space}: give 0 or 1")
+            act[0] = a.item()
+            return
+        if np.shape(action) != self._act_shape:
+            raise ValueError(f"action {action!r} has shape {np.shape(action)}; "
+                             f"{self.action_space} needs {self._act_shape} ({', '.join(self.action_names)})")
+        act[:] = action
+
+    def _finish(self, action):
+        """Turn the kernel's outputs into Gymnasium's (obs, reward, terminated, truncated, info)."""
+        b = self._b
+        out = b.out
+        if out[K.O_ERR]:
+            what = "non-finite" if out[K.O_ERR] == K.ERR_NAN else "out-of-range"
+            raise ValueError(f"{what} action {action!r}: {self.action_space} entries must be finite "
+                             f"and in [-1, 1] ({', '.join(self.action_names)})"
+                             + (" (0 = stay off, 1 = switch on)" if self._discrete else ""))
+        if out[K.O_STATUS]:
+            raise IntegrationError(_explain(int(out[K.O_STATUS]), b.M[K.M_T], b.M[K.M_H], self.model))
+        terminated = bool(out[K.O_TERM])
+        truncated = bool(out[K.O_TRUNC])
+        info = self._step_info(terminated or truncated)
+        if self._renderer is not None:
+            self._record()
+            if self.render_mode == "human":
+                self.render()
+        return b.obs.astype(np.float32), float(out[K.O_REWARD]), terminated, truncated, info
+
+    def _step_info(self, done: bool) -> dict:
+        b = self._b
+        o = b.out.tolist()
+        m = b.M.tolist()
+        info = dict(zip(_INFO_KEYS, [o[j] for j in _INFO_COLS]),
+                    time_s=m[K.M_T] - b.C[K.C_T_FAULT].item(), backward_whirl=m[K.M_WHIRL] > 0.0)
+        if self._relevitate:
+            info["relevitated"] = m[K.M_RELEV] > 0.0
+        if done:
+            info.update(self.kpis())
+        return info
+
+    def kpis(self) -> dict:
+        """Episode KPIs so far (the final step's ``info`` carries them)."""
+        b = self._b
+        M, out = b.M, b.out
+        relev = bool(M[K.M_RELEV])
+        return {"kpi_backward_whirl": bool(M[K.M_WHIRL]),
+                "kpi_whirl_revolutions": float(max(M[K.M_REV1], M[K.M_REV2])),
+                "kpi_peak_contact_force_N": float(M[K.M_PEAK_F]),
+                "kpi_max_displacement_um": float(M[K.M_MAX_DISP] * 1e6),
+                "kpi_relevitated": relev,
+                "kpi_relevitation_time_s": float(M[K.M_RELEV_T]) if relev else math.nan,
+                "kpi_control_effort": float(M[K.M_EFFORT]),
+                "kpi_stator_contact": bool(out[K.O_STATOR]),
+                "kpi_bearing_overload": bool(out[K.O_OVERLOAD]),
+                "kpi_episode_time_s": float(M[K.M_T] - b.C[K.C_T_FAULT])}
+
+    # ---------------------------------------------------------------------- rendering --
+    def _record(self) -> None:
+        y, I, P = self._b.y, self._b.I, self._b.P
+        orbit = []
+        for k in range(2):
+            z = P[P_Z_RB1 + k]
+            orbit += [y[I[S_X]] + z * y[I[S_A]], y[I[S_Y]] + z * y[I[S_B]]]
+        self._renderer.add(self._b.M[K.M_T] - self._b.C[K.C_T_FAULT], orbit,
+                           float(self._b.out[K.O_FORCE]))
+
+    def render(self):
+        if self.render_mode is None:
+            gym.logger.warn("render() called without a render_mode; pass render_mode='rgb_array' "
+                            "or 'human' to gym.make")
+            return None
+        if self._renderer is None:
+            from .render import Renderer
+            self._renderer = Renderer(self.render_mode, self.scene, self.episode_time)
+            self._record()
+        return self._renderer.draw()
+
+    def close(self):
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
+
+    # ---------------------------------------------------------------------- helpers --
+    @property
+    def time(self) -> float:
+        """Time since the fault [s]."""
+        return float(self._b.M[K.M_T] - self._b.C[K.C_T_FAULT])
+
+    @property
+    def state(self) -> np.ndarray:
+        """A copy of the physical state vector (names: ``env.unwrapped.model.names``)."""
+        return self._b.y.copy()
+
+
+_INFO_KEYS = ("contact_force_N",) + tuple("reward_" + n for n in REWARD_TERMS)
+_INFO_COLS = [K.O_FORCE, *_O_TERMS]
+
+
+def step_infos(out: np.ndarray, M: np.ndarray, C: np.ndarray, relevitate: bool) -> list[dict]:
+    """The per-step ``info`` dicts of N environments from their (N, ...) kernel arrays."""
+    rows = out[:, _INFO_COLS].tolist()
+    t = (M[:, K.M_T] - C[:, K.C_T_FAULT]).tolist()
+    whirl = (M[:, K.M_WHIRL] > 0.0).tolist()
+    infos = [dict(zip(_INFO_KEYS, r), time_s=te, backward_whirl=w)
+             for r, te, w in zip(rows, t, whirl)]
+    if relevitate:
+        for info, rel in zip(infos, (M[:, K.M_RELEV] > 0.0).tolist()):
+            info["relevitated"] = rel
+    return infos
+
+
+def _positive(name: str, value, lo: float, hi: float) -> None:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} = {value!r} must be a number in [{lo:g}, {hi:g}]") from None
+    if not (math.isfinite(v) and lo <= v <= hi):
+        raise ValueError(f"{name} = {value!r} must be in [{lo:g}, {hi:g}]")
+
+
+class PassiveEnv(RotorDropEnv):
+    """``RotorDrop-Passive-v0``: the paper's passive drop (the action does nothing).
+
+    One episode reproduces ``rotordrop drop`` for the same scene from the fault on.
+
+    Action space: ``Box(-1, 1, (1,), float32)``, ignored (checked for finiteness and range).
+
+    Observation (``obs_names``; physical value = obs x ``obs_scale``, SI)
+    --------------------------------------------------------------------
+    =====  =============  =============================================  ==================
+    index  name           meaning                                        scale
+    =====  =============  =============================================  ==================
+    0-3    x1 y1 vx1 vy1  rotor displacement / velocity at sensor 1      clearance, 0.1 m/s
+                          (= AMB1 plane), relative to the stator centre
+    4-7    x2 y2 vx2 vy2  same at sensor 2 (AMB2 plane)                  clearance, 0.1 m/s
+    8      rotor_speed    rotor spin speed Omega [rad/s]                 initial speed
+    9-10   sleeve_speed1  sleeve (inner ring) spin speed of RB1, RB2     initial speed
+           sleeve_speed2
+    11     time           time since the fault [s]                       episode_time
+    =====  =============  =============================================  ==================
+
+    With ``full_state=True`` the observation is the whole state vector (``model.names``, scaled
+    by ``model.scale``) followed by ``time``.
+
+    Version history: v0 (initial release).
+    """
+
+
+class DampingEnv(RotorDropEnv):
+    """``RotorDrop-Damping-v0``: semi-active support damping (spec §6).
+
+    Action space: ``Box(-1, 1, (2,), float32)``: ``damping1``, ``damping2``, the command of each
+    housing's support damping, -1 -> C_min (``support.damping_min``, 2790 N s/m), +1 -> C_max
+    (``support.damping_max``, 27900 N s/m), linear in between. The damping follows its command
+    with a first-order lag (``support.damper_time_constant``, 10 ms); it starts at
+    ``support.damping``.
+
+    Observation: the passive table (indices 0-10), then
+
+    =====  ========  ======================================  =======
+    11-12  damping1  current support damping C_s of housing  C_max
+           damping2  1 and 2 [N s/m] (the damper state)
+    13     time      time since the fault [s]                episode_time
+    =====  ========  ======================================  =======
+
+    Version history: v0 (initial release).
+    """
+    _damping = True
+
+
+class RelevitateEnv(RotorDropEnv):
+    """``RotorDrop-Relevitate-v0``: AMB reactivation (spec §5, ``effects.amb = "actuator"``).
+
+    The AMBs (differential electromagnets, bias current, current limit, force capacity, optional
+    coil lag, PID with filtered derivative) switch off at the fault; power returns
+    ``power_return_time`` after it (rounded up to the control-step grid). From then on the agent
+    commands the AMBs; before, its action has no effect.
+
+    Action space, ``command="discrete"`` (default): ``Discrete(2)``, ``levitate``: 0 = stay off,
+    1 = switch the built-in levitation controller on (reference ramped from the landing position
+    to the centre in ``amb.liftoff_ramp_time``, integrators reset). Once on it stays on.
+
+    Action space, ``command="continuous"``: ``Box(-1, 1, (4,), float32)``: control currents of
+    AMB1 x, AMB1 y, AMB2 x, AMB2 y, normalised by ``amb.current_limit``; the bias current is on
+    whenever power is.
+
+    Observation: the passive table (indices 0-11), then
+
+    =====  ===============  ================================================  =============
+    12     amb_power        1 once power has returned                          1
+    13     controller_on    1 when the AMBs are under control (the built-in    1
+                            controller engaged, or direct currents applied)
+    14-17  i1x i1y i2x i2y  applied control currents of the 4 AMB axes [A]     current limit
+    =====  ===============  ================================================  =============
+
+    Re-levitation succeeds when both contact forces stay zero and the rotor stays within half the
+    clearance of the centre at both retainer planes for ``relevitation_hold`` (reward
+    ``success`` once; ``info["relevitated"]``; KPI time = start of that period after the fault).
+
+    Version history: v0 (initial release).
+    """
+    _relevitate = True
+
+
+class FullEnv(RotorDropEnv):
+    """``RotorDrop-Full-v0``: semi-active damping and AMB reactivation together.
+
+    Action space: ``Box(-1, 1, float32)``: ``damping1``, ``damping2`` (as in Damping), then
+    with ``command="discrete"`` one entry ``levitate`` (> 0 switches the built-in controller on;
+    it stays on), or with ``command="continuous"`` the 4 normalised control currents.
+
+    Observation: passive indices 0-10, ``damping1``, ``damping2``, ``time``, then the
+    re-levitation entries ``amb_power``, ``controller_on``, ``i1x``, ``i1y``, ``i2x``, ``i2y``.
+
+    Version history: v0 (initial release).
+    """
+    _damping = True
+    _relevitate = True

@@ -1,0 +1,294 @@
+"""Numba kernels of the environments: one control step (action -> physics -> monitor -> reward,
+observation) for one rotor, and the same over N rotors in one parallel call.
+
+Everything an episode needs lives in flat arrays so that the single environment and the batched
+VecEnv run the very same code (the batch owns (N, ...) stacks, each environment a row view):
+
+* ``C``  float64 configuration of the episode (indices ``C_*``), set at reset,
+* ``M``  float64 running monitor (time, step size, whirl revolutions, peaks, re-levitation...),
+* ``out`` float64 per-step results (reward and its terms, flags, status; indices ``O_*``).
+
+The physics is :func:`physics.integrate.integrate_segment` on :func:`physics.model.rhs`; the
+control step is sampled ``n_sub`` times (dense output) for the contact force, whirl and
+re-levitation monitors, so short impacts and fast orbits are not missed between control steps.
+"""
+from __future__ import annotations
+
+import math
+
+import numba
+
+from physics._jit import njit, njit_parallel
+from physics.integrate import integrate_segment
+from physics.model import (A_FR, A_WS, I_AMB_FILT, I_AMB_INT, I_CS, I_PLANES, J_HVX, J_HX, J_SVX,
+                           J_SX, N_AUX_PLANE, N_PLANE_IDX, P_CLR, P_Z_AMB1, P_Z_RB1, S_A,
+                           S_B, S_VA, S_VB, S_VX, S_VY, S_W, S_X, S_Y, U_AMB_DIRECT, U_AMB_POWER,
+                           U_CS1, U_ICMD, U_REF0, U_T_ON, amb_currents, rhs)
+from physics.rotor import axis_at
+
+# ------------------------------------------------------------------------ configuration C --
+(C_DT, C_T_FAULT, C_T_END, C_T_POWER, C_DAMP, C_LEV, C_A_DAMP, C_A_LEV, C_N_ACT, C_N_SUB,
+ C_RTOL, C_HMAX, C_HMIN, C_FIXED, C_MAXSTEPS,
+ C_W_WHIRL, C_W_CONTACT, C_W_DISP, C_W_EFFORT, C_W_SUCCESS, C_W_FAILURE,
+ C_F_REF, C_GAP, C_LOAD_RATING, C_HOLD, C_TERMINATE, C_FULL, C_CS_MIN, C_CS_MAX, C_ILIM,
+ C_RELEV_RADIUS, N_C) = range(32)
+LEV_NONE, LEV_DISCRETE, LEV_CONTINUOUS = 0, 1, 2
+
+# ------------------------------------------------------------------------------ monitor M --
+(M_T, M_H, M_STEP, M_REV1, M_REV2, M_WHIRL, M_PEAK_F, M_MAX_DISP, M_OK_START, M_RELEV,
+ M_RELEV_T, M_EFFORT, M_CTRL_ON, M_POWER, M_NRHS, N_M) = range(16)
+
+# ------------------------------------------------------------------------------ outputs --
+(O_REWARD, O_R_WHIRL, O_R_CONTACT, O_R_DISP, O_R_EFFORT, O_R_SUCCESS, O_R_FAILURE, O_FORCE,
+ O_TERM, O_TRUNC, O_STATUS, O_ERR, O_STATOR, O_OVERLOAD, N_O) = range(15)
+ERR_NONE, ERR_NAN, ERR_RANGE = 0, 1, 2
+ACTION_TOL = 1e-6            # actions may exceed [-1, 1] by this much (float32 round-off)
+TWO_PI = 2.0 * math.pi
+
+
+@njit
+def _sleeve(y, I, k):
+    """Sleeve centre and velocity at retainer plane k (housing, or ground, when rigid)."""
+    base = I_PLANES + k * N_PLANE_IDX
+    i = I[base + J_SX]
+    if i >= 0:
+        return y[i], y[i + 1], y[I[base + J_SVX]], y[I[base + J_SVX] + 1]
+    i = I[base + J_HX]
+    if i >= 0:
+        return y[i], y[i + 1], y[I[base + J_HVX]], y[I[base + J_HVX] + 1]
+    return 0.0, 0.0, 0.0, 0.0
+
+
+@njit
+def _plane(y, I, z):
+    """Rotor axis position and velocity at axial station z."""
+    x, yy, a, b = y[I[S_X]], y[I[S_Y]], y[I[S_A]], y[I[S_B]]
+    px, py = axis_at(z, x, yy, a, b)
+    vx, vy = axis_at(z, y[I[S_VX]], y[I[S_VY]], y[I[S_VA]], y[I[S_VB]])
+    return px, py, vx, vy
+
+
+@njit
+def check_action(a, C):
+    """ERR_NONE, ERR_NAN (non-finite entry) or ERR_RANGE (outside [-1, 1] / not 0 or 1)."""
+    n = int(C[C_N_ACT])
+    for j in range(n):
+        if not math.isfinite(a[j]):
+            return ERR_NAN
+        if a[j] < -1.0 - ACTION_TOL or a[j] > 1.0 + ACTION_TOL:
+            return ERR_RANGE
+    if int(C[C_LEV]) == LEV_DISCRETE and int(C[C_N_ACT]) == 1 and a[0] != 0.0 and a[0] != 1.0:
+        return ERR_RANGE
+    return ERR_NONE
+
+
+@njit
+def _switch_on(t, y, P, I, U):
+    """Engage the built-in PID: ramp the reference from the sensed position, reset integrators."""
+    U[U_AMB_POWER] = 1.0
+    U[U_AMB_DIRECT] = 0.0
+    U[U_T_ON] = t
+    for j in range(4):
+        px, py, _, _ = _plane(y, I, P[P_Z_AMB1 + j // 2])
+        U[U_REF0 + j] = px if j % 2 == 0 else py
+        y[I[I_AMB_INT] + j] = 0.0
+        y[I[I_AMB_FILT] + j] = 0.0
+
+
+@njit
+def apply_action(a, y, P, I, U, C, M):
+    """Map a checked action onto the controls U (and the PID reset).
+
+    Returns the sum of squared normalised damper commands and the number of controlled channels
+    (the currents' share of the effort is added after the step, from the applied currents)."""
+    effort = 0.0
+    n_eff = 0
+    if C[C_DAMP] > 0.0:
+        o = int(C[C_A_DAMP])
+        for k in range(2):
+            frac = 0.5 * (min(max(a[o + k], -1.0), 1.0) + 1.0)
+            U[U_CS1 + k] = C[C_CS_MIN] + frac * (C[C_CS_MAX] - C[C_CS_MIN])
+            effort += frac * frac
+            n_eff += 1
+    lev = int(C[C_LEV])
+    if lev != LEV_NONE:
+        t = M[M_T]
+        if M[M_POWER] == 0.0 and t >= C[C_T_POWER] - 1e-9 * C[C_DT]:
+            M[M_POWER] = 1.0
+        o = int(C[C_A_LEV])
+        if M[M_POWER] > 0.0:
+            if lev == LEV_DISCRETE:
+                want = a[o] >= 0.5 if int(C[C_N_ACT]) == 1 else a[o] > 0.0
+                if want and M[M_CTRL_ON] == 0.0:
+                    _switch_on(t, y, P, I, U)
+                    M[M_CTRL_ON] = 1.0
+            else:
+                U[U_AMB_DIRECT] = 1.0
+                for j in range(4):
+                    U[U_ICMD + j] = min(max(a[o + j], -1.0), 1.0) * C[C_ILIM]
+                M[M_CTRL_ON] = 1.0
+        n_eff += 4
+    return effort, n_eff
+
+
+@njit
+def observe(t, y, P, I, U, C, M, aux, cur, scale, obs):
+    """Fill ``obs`` = physical values / scale (layout: see rotordrop_env.layout)."""
+    n = 0
+    if C[C_FULL] > 0.0:
+        for i in range(y.shape[0]):
+            obs[n] = y[i]
+            n += 1
+    else:
+        for k in range(2):
+            px, py, vx, vy = _plane(y, I, P[P_Z_AMB1 + k])
+            obs[n], obs[n + 1], obs[n + 2], obs[n + 3] = px, py, vx, vy
+            n += 4
+        obs[n] = y[I[S_W]]
+        obs[n + 1] = aux[A_WS]
+        obs[n + 2] = aux[N_AUX_PLANE + A_WS]
+        n += 3
+        if C[C_DAMP] > 0.0:
+            obs[n] = y[I[I_CS]]
+            obs[n + 1] = y[I[I_CS] + 1]
+            n += 2
+    obs[n] = t - C[C_T_FAULT]
+    n += 1
+    if int(C[C_LEV]) != LEV_NONE:
+        obs[n] = M[M_POWER]
+        obs[n + 1] = M[M_CTRL_ON]
+        for j in range(4):
+            obs[n + 2 + j] = cur[j]
+        n += 6
+    for i in range(n):
+        obs[i] /= scale[i]
+
+
+@njit
+def observe_now(y, P, I, U, C, M, work, aux, cur, scale, obs):
+    """Observation of the current state (used at reset)."""
+    t = M[M_T]
+    rhs(t, y, P, I, U, work[0], aux)
+    if int(C[C_LEV]) != LEV_NONE:
+        amb_currents(t, y, P, I, U, cur)
+    observe(t, y, P, I, U, C, M, aux, cur, scale, obs)
+
+
+@njit
+def step_one(a, y, P, I, U, atol, work, t_sub, Y_sub, aux, cur, C, M, scale, obs, out):
+    """One control step of one environment. Results go to ``obs`` and ``out``; nothing raises:
+    ``out[O_ERR]`` flags a bad action (nothing is advanced), ``out[O_STATUS]`` an integrator
+    failure (see physics.integrate status codes)."""
+    for i in range(N_O):
+        out[i] = 0.0
+    err = check_action(a, C)
+    if err != ERR_NONE:
+        out[O_ERR] = err
+        return
+    effort, n_eff = apply_action(a, y, P, I, U, C, M)
+
+    dt = C[C_DT]
+    t0 = M[M_T]
+    t1 = t0 + dt
+    n_sub = t_sub.shape[0]
+    for k in range(n_sub):
+        t_sub[k] = t0 + dt * (k + 1) / n_sub
+    t_sub[n_sub - 1] = t1
+    status, _, h, _, n_rhs, _, _ = integrate_segment(
+        y, t0, t1, P, I, U, C[C_RTOL], atol, M[M_H], C[C_HMAX], C[C_HMIN], C[C_FIXED] > 0.0,
+        int(C[C_MAXSTEPS]), t_sub, Y_sub, 0, work)
+    M[M_NRHS] += n_rhs
+    if status != 0:
+        out[O_STATUS] = status
+        return
+    if C[C_FIXED] == 0.0:
+        M[M_H] = h
+    for i in range(y.shape[0]):
+        Y_sub[n_sub - 1, i] = y[i]
+
+    # ---- monitors at the sub-samples ----
+    clr = P[P_CLR]
+    spin = 1.0 if y[I[S_W]] >= 0.0 else -1.0
+    dts = dt / n_sub
+    f_step = 0.0
+    disp_step = 0.0
+    back = 0.0
+    stator = False
+    lev = int(C[C_LEV])
+    for s in range(n_sub):
+        ys = Y_sub[s]
+        ts = t_sub[s]
+        rhs(ts, ys, P, I, U, work[0], aux)
+        ok = M[M_POWER] > 0.0
+        for k in range(2):
+            fr = aux[k * N_AUX_PLANE + A_FR]
+            f_step = max(f_step, fr)
+            px, py, pvx, pvy = _plane(ys, I, P[P_Z_RB1 + k])
+            sx, sy, svx, svy = _sleeve(ys, I, k)
+            r_abs = math.sqrt(px * px + py * py)
+            disp_step = max(disp_step, r_abs)
+            ex, ey = px - sx, py - sy
+            r2 = ex * ex + ey * ey
+            if r2 > (0.5 * clr) ** 2:               # orbit angle, beyond half the clearance
+                dth = (ex * (pvy - svy) - ey * (pvx - svx)) / r2 * dts
+                db = -spin * dth / TWO_PI
+                M[M_REV1 + k] += db
+                back += 0.5 * db
+            if fr > 0.0 or r_abs >= C[C_RELEV_RADIUS]:
+                ok = False
+            ax, ay, _, _ = _plane(ys, I, P[P_Z_AMB1 + k])
+            if ax * ax + ay * ay >= C[C_GAP] * C[C_GAP]:
+                stator = True
+        if lev != LEV_NONE and M[M_RELEV] == 0.0:
+            if ok:
+                if M[M_OK_START] < 0.0:
+                    M[M_OK_START] = ts
+                if ts - M[M_OK_START] >= C[C_HOLD] - 1e-12:
+                    M[M_RELEV] = 1.0
+                    M[M_RELEV_T] = M[M_OK_START] - C[C_T_FAULT]
+                    out[O_R_SUCCESS] = C[C_W_SUCCESS]
+            else:
+                M[M_OK_START] = -1.0
+    # aux now holds the diagnostics at t1 (last sub-sample)
+    if lev != LEV_NONE:
+        amb_currents(t1, y, P, I, U, cur)
+        for j in range(4):
+            c = cur[j] / C[C_ILIM] if C[C_ILIM] > 0.0 else 0.0
+            effort += c * c
+    if n_eff > 0:
+        effort /= n_eff                          # mean squared normalised command
+    M[M_T] = t1
+    M[M_STEP] += 1.0
+    M[M_PEAK_F] = max(M[M_PEAK_F], f_step)
+    M[M_MAX_DISP] = max(M[M_MAX_DISP], disp_step)
+    if max(M[M_REV1], M[M_REV2]) >= 3.0:
+        M[M_WHIRL] = 1.0
+
+    # ---- reward terms ----
+    out[O_FORCE] = f_step
+    out[O_R_WHIRL] = 0.0 - C[C_W_WHIRL] * max(back, 0.0)          # 0.0 - x: no negative zeros
+    out[O_R_CONTACT] = 0.0 - C[C_W_CONTACT] * f_step / C[C_F_REF]
+    out[O_R_DISP] = 0.0 - C[C_W_DISP] * disp_step / clr
+    out[O_R_EFFORT] = 0.0 - C[C_W_EFFORT] * effort
+    M[M_EFFORT] += effort * dt
+    overload = f_step > C[C_LOAD_RATING]
+    out[O_STATOR] = 1.0 if stator else 0.0
+    out[O_OVERLOAD] = 1.0 if overload else 0.0
+    if (stator or overload) and C[C_TERMINATE] > 0.0:
+        out[O_TERM] = 1.0
+        remaining = max(round((C[C_T_END] - t1) / dt), 0.0)
+        out[O_R_FAILURE] = -C[C_W_FAILURE] * remaining
+    elif t1 >= C[C_T_END] - 1e-9 * dt:
+        out[O_TRUNC] = 1.0
+    out[O_REWARD] = (out[O_R_WHIRL] + out[O_R_CONTACT] + out[O_R_DISP] + out[O_R_EFFORT]
+                     + out[O_R_SUCCESS] + out[O_R_FAILURE])
+    observe(t1, y, P, I, U, C, M, aux, cur, scale, obs)
+
+
+@njit_parallel
+def step_batch(A, Y, P, I, U, ATOL, WORK, TSUB, YSUB, AUX, CUR, C, M, SCALE, OBS, OUT):
+    """:func:`step_one` for N environments (rows), in parallel over environments."""
+    for e in numba.prange(Y.shape[0]):
+        step_one(A[e], Y[e], P[e], I[e], U[e], ATOL[e], WORK[e], TSUB[e], YSUB[e], AUX[e], CUR[e],
+                 C[e], M[e], SCALE[e], OBS[e], OUT[e])
+

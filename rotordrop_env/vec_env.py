@@ -1,0 +1,143 @@
+"""A batched Stable-Baselines3 ``VecEnv``: N rotors stepped in one parallel numba call.
+
+SB3 does not take Gymnasium's ``VectorEnv``, so this is an SB3 ``VecEnv`` subclass with SB3's
+semantics: ``step_wait`` returns ``(obs, rewards, dones, infos)``; a finished environment is
+reset at once, its last observation stored in ``infos[i]["terminal_observation"]`` and
+``infos[i]["TimeLimit.truncated"]`` set when it ended at the time limit.
+
+Each of the N environments is an ordinary ``gym.make(env_id, **env_kwargs)`` environment whose
+arrays are rows of one stack; resets (scenario sampling from each env's own ``np_random``) run
+per environment in Python, steps run all rows in :func:`rotordrop_env.kernels.step_batch`,
+parallel over environments with numba's threads (``numba.set_num_threads`` limits them).
+
+Importing this module sets ``OMP_WAIT_POLICY=PASSIVE`` unless it is already set: with numba's
+OpenMP threading layer, threads that spin at the end of each parallel step steal the core of a
+descheduled worker when the machine is shared, which made a 2-thread batch 5-10x slower than one
+thread on a loaded 2-core machine; with passive waiting it is never slower than one thread.
+"""
+from __future__ import annotations
+
+import os
+from typing import Any, Sequence
+
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")       # before numba starts its OpenMP pool
+
+import gymnasium as gym
+import numba
+import numpy as np
+from stable_baselines3.common.vec_env.base_vec_env import VecEnv
+
+from . import kernels as K
+from .buffers import Buffers
+from .env import RotorDropEnv, step_infos
+
+
+class BatchedRotorDropVecEnv(VecEnv):
+    """``n_envs`` copies of ``env_id`` (with ``env_kwargs``) stepped together.
+
+    ``seed``: environment i is seeded ``seed + i`` at the first reset (as SB3's
+    ``make_vec_env``); later resets continue each environment's own random stream.
+    ``n_threads``: numba threads for the batched step (default: numba's setting, i.e. all
+    cores); on a machine shared with other work use the number of free cores, since a thread
+    that loses its core stalls the whole batch at the end of every step.
+    """
+
+    def __init__(self, env_id: str, n_envs: int, seed: int | None = None,
+                 n_threads: int | None = None, **env_kwargs: Any):
+        import rotordrop_env  # noqa: F401  (registers the ids)
+        if int(n_envs) != n_envs or n_envs < 1:
+            raise ValueError(f"n_envs = {n_envs!r} must be a positive integer")
+        self.envs: list[RotorDropEnv] = []
+        for _ in range(int(n_envs)):
+            env = gym.make(env_id, **env_kwargs).unwrapped
+            if not isinstance(env, RotorDropEnv):
+                raise ValueError(f"{env_id!r} is not a rotordrop environment")
+            self.envs.append(env)
+        first = self.envs[0]
+        self.stack = Buffers(*first._b.dims, n_envs=int(n_envs))
+        for e, env in enumerate(self.envs):
+            env._bind(self.stack.row(e))
+        self._args = self.stack.args()
+        self._discrete = first._discrete
+        if n_threads is not None and not 1 <= int(n_threads) <= numba.config.NUMBA_NUM_THREADS:
+            raise ValueError(f"n_threads = {n_threads!r} must be in [1, "
+                             f"{numba.config.NUMBA_NUM_THREADS}] (numba's NUMBA_NUM_THREADS)")
+        self.n_threads = None if n_threads is None else int(n_threads)
+        self.actions: np.ndarray | None = None
+        super().__init__(int(n_envs), first.observation_space, first.action_space)
+        if seed is not None:
+            self.seed(seed)
+
+    # ------------------------------------------------------------------ SB3 VecEnv API --
+    def reset(self):
+        for e, env in enumerate(self.envs):
+            options = {"options": self._options[e]} if self._options[e] else {}
+            _, self.reset_infos[e] = env.reset(seed=self._seeds[e], **options)
+        self._reset_seeds()
+        self._reset_options()
+        return self.stack.obs.astype(np.float32)
+
+    def step_async(self, actions: np.ndarray) -> None:
+        self.actions = actions
+
+    def step_wait(self):
+        if any(env._needs_reset for env in self.envs):
+            raise gym.error.ResetNeeded("call reset() on the VecEnv before step()")
+        act = self.stack.act
+        a = np.asarray(self.actions)
+        try:
+            if self._discrete:
+                act[:, 0] = a.reshape(self.num_envs)
+            else:
+                act[:] = a.reshape(self.num_envs, -1)
+        except ValueError:
+            raise ValueError(f"actions of shape {a.shape} do not fit {self.num_envs} environments "
+                             f"with action space {self.action_space}") from None
+        if self.n_threads is not None:
+            numba.set_num_threads(self.n_threads)
+        K.step_batch(*self._args)
+        out = self.stack.out
+        bad = np.flatnonzero(out[:, K.O_ERR] + out[:, K.O_STATUS])
+        if bad.size:                              # the single env's clear error message
+            e = bad[0]
+            self.envs[e]._finish(a[e])
+        obs = self.stack.obs.astype(np.float32)
+        rewards = out[:, K.O_REWARD].astype(np.float32)
+        terminated = out[:, K.O_TERM] > 0.0
+        truncated = out[:, K.O_TRUNC] > 0.0
+        dones = terminated | truncated
+        infos = step_infos(out, self.stack.M, self.stack.C, self.envs[0]._relevitate)
+        for e in np.flatnonzero(dones):
+            infos[e].update(self.envs[e].kpis())
+            infos[e]["terminal_observation"] = obs[e].copy()
+            infos[e]["TimeLimit.truncated"] = bool(truncated[e] and not terminated[e])
+            new_obs, self.reset_infos[e] = self.envs[e].reset()
+            obs[e] = new_obs
+        return obs, rewards, dones, infos
+
+    def close(self) -> None:
+        for env in self.envs:
+            env.close()
+
+    def get_attr(self, attr_name: str, indices=None) -> list[Any]:
+        return [getattr(self.envs[i], attr_name) for i in self._get_indices(indices)]
+
+    def set_attr(self, attr_name: str, value: Any, indices=None) -> None:
+        for i in self._get_indices(indices):
+            setattr(self.envs[i], attr_name, value)
+
+    def env_method(self, method_name: str, *method_args, indices=None, **method_kwargs) -> list[Any]:
+        return [getattr(self.envs[i], method_name)(*method_args, **method_kwargs)
+                for i in self._get_indices(indices)]
+
+    def env_is_wrapped(self, wrapper_class, indices=None) -> list[bool]:
+        return [False for _ in self._get_indices(indices)]
+
+    def get_images(self) -> Sequence[np.ndarray | None]:
+        return [env.render() for env in self.envs]
+
+
+def make_batched(env_id: str, n_envs: int, seed: int | None = None,
+                 n_threads: int | None = None, **env_kwargs: Any) -> BatchedRotorDropVecEnv:
+    """``make_vec_env``-like factory of :class:`BatchedRotorDropVecEnv`."""
+    return BatchedRotorDropVecEnv(env_id, n_envs, seed=seed, n_threads=n_threads, **env_kwargs)

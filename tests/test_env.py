@@ -1,0 +1,190 @@
+"""Gymnasium environments: checkers, seeding, passive env == simulator, errors, episode end."""
+import math
+import warnings
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env as gym_check_env
+from stable_baselines3.common.env_checker import check_env as sb3_check_env
+
+import rotordrop_env
+from physics import compute_metrics, load_scene, simulate
+from physics.scene import SceneError
+
+VARIANTS = [("RotorDrop-Passive-v0", {}), ("RotorDrop-Damping-v0", {}),
+            ("RotorDrop-Relevitate-v0", {"command": "discrete"}),
+            ("RotorDrop-Relevitate-v0", {"command": "continuous"}),
+            ("RotorDrop-Full-v0", {"command": "discrete"}),
+            ("RotorDrop-Full-v0", {"command": "continuous"})]
+
+
+@pytest.mark.parametrize("env_id,kwargs", VARIANTS, ids=lambda v: v if isinstance(v, str) else
+                         v.get("command", ""))
+def test_gymnasium_and_sb3_checkers_pass(env_id, kwargs):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")               # infinite Box bounds are intended
+        gym_check_env(gym.make(env_id, episode_time=0.004, **kwargs).unwrapped)
+        sb3_check_env(gym.make(env_id, episode_time=0.004, **kwargs).unwrapped)
+
+
+def test_registered_ids_and_public_attributes():
+    assert set(rotordrop_env.ENV_IDS) <= set(gym.registry)
+    env = gym.make("RotorDrop-Full-v0", episode_time=0.002)
+    u = env.unwrapped
+    for name in ("x1", "y1", "vx1", "vy1", "x2", "y2", "vx2", "vy2", "rotor_speed",
+                 "sleeve_speed1", "sleeve_speed2", "damping1", "damping2", "amb_power",
+                 "controller_on", "i1x", "i1y", "i2x", "i2y"):
+        assert name in u.obs_names
+    assert len(u.obs_names) == env.observation_space.shape[0] == u.obs_scale.shape[0]
+    assert u.action_names == ["damping1", "damping2", "levitate"] and u.dt == 1e-3
+    obs, _ = env.reset(seed=0)
+    phys = dict(zip(u.obs_names, obs.astype(float) * u.obs_scale))
+    # at the fault the rotor spins at the scene speed and the damper holds support.damping
+    assert phys["rotor_speed"] == pytest.approx(10000 * math.pi / 30, rel=1e-4)
+    assert phys["damping1"] == pytest.approx(u.scene.support.damping, rel=1e-6)
+    assert phys["amb_power"] == 0.0
+
+
+def test_seeding_makes_scenarios_and_trajectories_reproducible():
+    def run(seed):
+        env = gym.make("RotorDrop-Damping-v0", randomize=True, episode_time=0.005)
+        obs, info = env.reset(seed=seed)
+        env.action_space.seed(seed)
+        traj = [obs]
+        for _ in range(5):
+            traj.append(env.step(env.action_space.sample())[0])
+        return info["scenario"], np.array(traj)
+
+    s1, t1 = run(7)
+    s2, t2 = run(7)
+    s3, _ = run(8)
+    assert s1 == s2 and np.array_equal(t1, t2)
+    assert s1 != s3
+    lo, hi = 0.1, 0.5                                 # documented friction range
+    assert lo <= s1["contact.friction"] <= hi
+
+
+def test_reset_options_fix_the_scenario():
+    env = gym.make("RotorDrop-Relevitate-v0", randomize=True, episode_time=0.003)
+    _, info = env.reset(seed=1, options={"scenario": {"contact.friction": 0.33,
+                                                      "power_return_time": 0.0123}})
+    assert env.unwrapped.scene.contact.friction == 0.33
+    # power return is put on the control-step grid (rounded up)
+    assert info["scenario"]["power_return_time"] == pytest.approx(0.013)
+    with pytest.raises(SceneError, match="contact.frictoin"):
+        env.reset(options={"scenario": {"contact.frictoin": 0.3}})
+    with pytest.raises(ValueError, match="unknown reset option"):
+        env.reset(options={"friction": 0.3})
+
+
+@pytest.mark.parametrize("mu,whirl", [(0.25, False), (0.5, True)])
+def test_passive_env_reproduces_the_simulator(mu, whirl):
+    """Same scene, same physics: states at the control steps and the KPIs of `rotordrop drop`;
+    the paper's whirl threshold (spec §7: between mu 0.25 and 0.5) is seen by both."""
+    env = gym.make("RotorDrop-Passive-v0", overrides={"contact.friction": mu}, samples_per_step=20,
+                   terminate_on_failure=False, episode_time=0.15)
+    u = env.unwrapped
+    env.reset(seed=0)
+    ys, done = [], False
+    while not done:
+        obs, reward, term, trunc, info = env.step(np.zeros(1, np.float32))
+        assert isinstance(reward, float) and type(term) is bool and type(trunc) is bool
+        ys.append(obs.astype(float) * u.obs_scale)
+        done = term or trunc
+    assert trunc and not term and len(ys) == 150
+    res = simulate(load_scene("paper", {"contact.friction": mu}), t_end=0.25)
+    t = 0.1 + np.arange(1, 151) * 1e-3
+    k = np.searchsorted(res.t, t - 1e-12)
+    z = -0.28                                          # sensor 1 = AMB1 plane
+    y1 = res.state("y")[k] + z * res.state("b")[k]
+    err = np.abs(np.array(ys)[:, u.obs_names.index("y1")] - y1)
+    # first 40 ms: agreement at the integrator's tolerance (the two runs split the time
+    # differently: 1 ms control steps against 10 ms chunks)
+    sv = u.scene
+    assert err[:40].max() < 50 * sv.solver.rtol * sv.contact.clearance
+    m = compute_metrics(res)
+    post = res.t > 0.1
+    f_peak = max(res.contact_force(p)[post].max() for p in ("RB1", "RB2"))
+    assert info["kpi_peak_contact_force_N"] == pytest.approx(f_peak, rel=0.02)
+    d_max = max(np.hypot(*res.orbit(p)[post].T).max() for p in ("RB1", "RB2")) * 1e6
+    assert info["kpi_max_displacement_um"] == pytest.approx(d_max, rel=0.01)
+    assert info["kpi_backward_whirl"] is whirl and m["backward_whirl"] is whirl
+    assert info["kpi_whirl_revolutions"] == pytest.approx(
+        max(m["planes"][p]["whirl_revolutions"] for p in ("RB1", "RB2")), abs=0.1)
+
+
+def test_stator_contact_terminates_with_the_failure_penalty():
+    env = gym.make("RotorDrop-Passive-v0", overrides={"contact.friction": 0.5}, episode_time=0.3)
+    env.reset(seed=0)
+    n = 0
+    while True:
+        _, r, term, trunc, info = env.step(np.zeros(1, np.float32))
+        n += 1
+        if term or trunc:
+            break
+    # mu = 0.5: the whirling orbit passes the 600 um stator gap (the drop alone reaches ~450 um)
+    assert term and not trunc and info["kpi_stator_contact"]
+    assert info["kpi_max_displacement_um"] > 600.0 and n < 300
+    assert info["reward_failure"] == pytest.approx(-(300 - n))
+    assert sum(info[f"reward_{k}"] for k in rotordrop_env.env.REWARD_TERMS) == pytest.approx(r)
+
+
+@pytest.mark.parametrize("env_id,action,match", [
+    ("RotorDrop-Damping-v0", [np.nan, 0.0], "non-finite"),
+    ("RotorDrop-Damping-v0", [1.5, 0.0], "out-of-range"),
+    ("RotorDrop-Damping-v0", [0.0, 0.0, 0.0], "shape"),
+    ("RotorDrop-Relevitate-v0", 2, "out-of-range"),
+    ("RotorDrop-Relevitate-v0", float("nan"), "non-finite"),
+])
+def test_bad_actions_raise_clear_errors(env_id, action, match):
+    env = gym.make(env_id, episode_time=0.003).unwrapped
+    env.reset(seed=0)
+    y0 = env.state
+    with pytest.raises(ValueError, match=match):
+        env.step(np.asarray(action))
+    assert env.time == 0.0 and np.array_equal(env.state, y0)     # nothing advanced
+
+
+def test_step_before_reset_raises():
+    env = gym.make("RotorDrop-Damping-v0").unwrapped
+    with pytest.raises(gym.error.ResetNeeded):
+        env.step(np.zeros(2, np.float32))
+
+
+def test_bad_kwargs_raise_clear_errors():
+    with pytest.raises(ValueError, match="control_dt"):
+        gym.make("RotorDrop-Passive-v0", control_dt=0.0)
+    with pytest.raises(ValueError, match="command"):
+        gym.make("RotorDrop-Passive-v0", command="discrete")
+    with pytest.raises(ValueError, match="w_contact"):
+        gym.make("RotorDrop-Damping-v0", w_contact=-1.0)
+    with pytest.raises(SceneError, match="contact.friction"):
+        gym.make("RotorDrop-Damping-v0", overrides={"contact.friction": 2.0})
+    with pytest.raises(ValueError, match="randomization"):
+        gym.make("RotorDrop-Damping-v0", randomization={"contact.friction": (0.5, 0.1)})
+
+
+def test_time_limit_truncates_and_final_info_has_kpis():
+    env = gym.make("RotorDrop-Relevitate-v0", episode_time=0.004)
+    env.reset(seed=0)
+    flags = [env.step(0)[2:4] for _ in range(4)]
+    assert flags[:3] == [(False, False)] * 3 and flags[3] == (False, True)
+    env.reset(seed=0)
+    for _ in range(4):
+        *_, info = env.step(0)
+    for key in ("kpi_backward_whirl", "kpi_peak_contact_force_N", "kpi_max_displacement_um",
+                "kpi_relevitated", "kpi_relevitation_time_s", "kpi_control_effort"):
+        assert key in info
+    assert info["kpi_relevitated"] is False and math.isnan(info["kpi_relevitation_time_s"])
+
+
+def test_rgb_render_shows_the_orbit():
+    env = gym.make("RotorDrop-Passive-v0", episode_time=0.02, render_mode="rgb_array")
+    env.reset(seed=0)
+    for _ in range(20):
+        env.step(np.zeros(1, np.float32))
+    img = env.render()
+    assert img.dtype == np.uint8 and img.ndim == 3 and img.shape[2] == 3
+    assert (img < 200).any() and (img > 250).any()     # drawn lines on a white background
+    env.close()

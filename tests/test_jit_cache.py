@@ -1,0 +1,27 @@
+"""The kernel cache is keyed by every kernel source, so editing a callee recompiles its callers."""
+import shutil
+
+from physics import _jit
+
+
+def test_editing_any_kernel_file_changes_the_cache_directory(tmp_path):
+    root = _jit.Path(_jit.__file__).resolve().parent.parent
+    for pkg in _jit._PACKAGES:
+        shutil.copytree(root / pkg, tmp_path / pkg, ignore=shutil.ignore_patterns("__pycache__"))
+    before = _jit._kernel_sources_hash(tmp_path)
+    assert before == _jit._kernel_sources_hash(root)
+    model = tmp_path / "physics" / "model.py"                 # a callee of integrate_segment
+    model.write_text(model.read_text() + "\n# edited\n")
+    assert _jit._kernel_sources_hash(tmp_path) != before
+    assert _jit.CACHE_DIR.endswith(before)
+
+
+def test_decorating_leaves_numba_global_cache_setting_alone():
+    from numba.core import config
+    previous = config.CACHE_DIR
+
+    @_jit.njit
+    def twice(x):
+        return 2 * x
+
+    assert twice(2) == 4 and config.CACHE_DIR == previous
