@@ -1,0 +1,110 @@
+"""Orchestration of ``rotordrop study paper``: sweep, analysis, claims, figures, report."""
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+
+from ..scene import load_scene
+from ..simulate import simulate
+from ..sweep import default_jobs
+from . import report
+from .claims import claims
+from .paper import DAMPING, SENSITIVITY, STIFFNESS, Plan, StudyInput, analyse, run_study
+
+
+def run_paper_study(source: str, overrides: dict, out_dir, quick: bool = False,
+                    jobs: int | None = None, progress: bool = True) -> str:
+    """Run the study, write ``study.json``, ``report.md`` and the figures; return a summary."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    plan = Plan.make(quick)
+    base = StudyInput(source, dict(overrides))
+    jobs = default_jobs() if jobs is None else jobs
+    t0 = time.perf_counter()
+    outcomes = run_study(plan, base, jobs=jobs, progress=progress)
+    a = analyse(plan, base, outcomes)
+    scene = base.scene
+    a["claims"] = claims(a, scene.contact.clearance * 1e6)
+    a["calibration"] = calibration(source, overrides)
+    runs = figure_runs(base, plan)
+    figures = dict(
+        probability=[report.plot_probability(a, out)],
+        friction=report.plot_friction_runs(runs["friction"], out),
+        response=[report.plot_friction_response(a, out)],
+        stiffness=report.plot_support(runs["stiffness"], "support.stiffness", out),
+        damping=report.plot_support(runs["damping"], "support.damping", out),
+        sensitivity=[report.plot_sensitivity(a, out)])
+    commands = interesting_runs(a, outcomes, base, plan)
+    a["reproduce"] = [dict(label=l, command=c) for l, c in commands]
+    wall = time.perf_counter() - t0
+    a["wall_time_s"] = wall
+    a["jobs"] = jobs
+    a["quick"] = quick
+    (out / "study.json").write_text(json.dumps(a, indent=1, default=_json))
+    meta = dict(wall_s=wall, jobs=jobs, quick=quick, commands=commands,
+                calibration=calibration_text(a["calibration"], source),
+                ranges={f.name: f.why for f in SENSITIVITY})
+    path = report.write_report(a, out, figures, meta)
+    th = a["friction_threshold"]
+    ok = sum(c["reproduced"] for c in a["claims"])
+    return (f"whirl threshold (50 %): paper slip {th['paper']}, kinematic {th['kinematic']}; "
+            f"{ok}/{len(a['claims'])} claims reproduced; {a['runs']['failed']} of "
+            f"{a['runs']['total']} runs failed; {wall:.0f} s\nwrote {path}, {out / 'study.json'}")
+
+
+def figure_runs(base: StudyInput, plan: Plan) -> dict:
+    """The nominal drops drawn in the figures (full time series, simulated here)."""
+    scene = base.scene
+    return dict(
+        friction={mu: simulate(scene.with_overrides({"contact.friction": mu}))
+                  for mu in plan.figure_frictions},
+        stiffness={k: simulate(scene.with_overrides({"support.stiffness": k})) for k in STIFFNESS},
+        damping={c: simulate(scene.with_overrides({"support.damping": c})) for c in DAMPING})
+
+
+def interesting_runs(a: dict, outcomes, base: StudyInput, plan: Plan) -> list[tuple[str, str]]:
+    """Reproduce commands for a few drops worth looking at."""
+    fr = [o for o in outcomes if o.ok and o.run.label["study"] == "friction"
+          and o.run.label["slip"] == "paper" and o.run.label["drag"]]
+    fr.sort(key=lambda o: (o.run.label["friction"], o.run.label["member"]))
+    out = []
+    first = next((o for o in fr if o.metrics["backward_whirl"]), None)
+    if first is not None:
+        out.append((f"the lowest-μ drop that whirls (μ = {first.run.label['friction']:g})",
+                    first.run.to_dict()["command"]))
+    certain = a["friction_onset"]["paper, drag on"].get("certain_from")
+    if certain is not None:
+        calm = [o for o in fr if not o.metrics["backward_whirl"] and o.run.label["friction"] < certain]
+        if calm:
+            o = calm[-1]
+            out.append((f"the highest-μ drop that does not whirl (μ = {o.run.label['friction']:g})",
+                        o.run.to_dict()["command"]))
+    for row in a["support_stiffness"] + a["support_damping"]:
+        if "command" in row:
+            key = "stiffness" if "stiffness" in row else "damping"
+            out.append((f"support {key} {row[key]:g}, nominal drop", row["command"]))
+    return out
+
+
+def calibration(source: str, overrides: dict) -> list[dict]:
+    """Every parameter where the study's scene differs from the frozen ``spec`` preset."""
+    scene = load_scene(source, overrides).flat()
+    spec = load_scene("spec").flat()
+    return [dict(key=k, spec=spec[k], used=v) for k, v in scene.items() if spec[k] != v]
+
+
+def calibration_text(diff: list[dict], source: str) -> str:
+    if not diff:
+        return (f"The `{source}` scene uses the spec's values throughout (no calibration).\n")
+    rows = "\n".join(f"| `{d['key']}` | {d['spec']} | {d['used']} |" for d in diff)
+    return (f"The `{source}` scene differs from the spec's values (`spec` preset) in:\n\n"
+            f"| key | spec | used here |\n|---|---|---|\n{rows}\n\n"
+            "(See Sensitivity for what each does; `physics/presets/paper.toml` documents why.)\n")
+
+
+def _json(x):
+    try:
+        return float(x)
+    except (TypeError, ValueError):
+        return str(x)

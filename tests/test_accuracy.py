@@ -1,0 +1,93 @@
+"""What accuracy costs (issue 3, part 2): the quick accuracy study end to end, and the rule that
+picks the default solver setting."""
+import json
+
+import pytest
+
+from physics.accuracy import TOLERANCE, choose_default
+from physics.cli import main as cli_main
+from physics.scene import Scene
+
+
+@pytest.fixture(scope="module")
+def quick(tmp_path_factory):
+    out = tmp_path_factory.mktemp("accuracy")
+    assert cli_main(["accuracy", "--quick", "--jobs", "2", "--quiet", "--out", str(out)]) == 0
+    return out, json.loads((out / "accuracy.json").read_text())
+
+
+def _rows(a):
+    return {r["setting"]: r for r in a["rows"]}
+
+
+def test_accuracy_json_holds_reference_rows_and_default(quick):
+    out, a = quick
+    assert {"reference", "rows", "default"} <= a.keys()
+    for r in a["rows"]:
+        assert not r["failed"], r["setting"]
+        assert r["wall_time_s"] > 0 and r["rhs_evaluations"] > 0
+        assert {"peak_contact_force_rel", "max_displacement_rel", "first_contact_time_abs_us",
+                "trajectory_um", "whirl_agreement"} <= r["errors"].keys()
+    ref = a["rows"][0]
+    assert ref["kind"] == "reference"
+    assert ref["errors"]["trajectory_um"]["max"] == 0.0 and ref["errors"]["whirl_agreement"] == 1.0
+    kinds = {r["kind"] for r in a["rows"]}
+    assert kinds == {"reference", "adaptive", "fixed", "reduced"}
+    table = (out / "accuracy.md").read_text()
+    assert all(r["setting"] in table for r in a["rows"])
+    assert (out / "pareto.png").stat().st_size > 10000
+
+
+def test_tighter_tolerance_costs_more_and_errs_less(quick):
+    _, a = quick
+    rows = _rows(a)
+    ladder = [rows[f"adaptive rtol {r:g}"] for r in (1e-4, 1e-6, 1e-8)]
+    rhs = [r["rhs_evaluations"] for r in ladder]
+    assert rhs[0] < rhs[1] < rhs[2]
+    for key in ("trajectory_um", "first_contact_time_abs_us"):
+        err = [r["errors"][key]["max"] for r in ladder]
+        assert err[0] > err[1] > err[2], key
+    # a smaller fixed step is more accurate too (4th-5th order method: far more than 2x)
+    f1, f2 = rows["fixed dt 1e-05 s"], rows["fixed dt 2e-05 s"]
+    assert f1["errors"]["trajectory_um"]["max"] < 0.5 * f2["errors"]["trajectory_um"]["max"]
+
+
+def test_default_meets_the_criterion_and_reduced_models_err_more(quick):
+    _, a = quick
+    rows = _rows(a)
+    d = rows[a["default"]]
+    assert d["kind"] in ("adaptive", "fixed")
+    for key in ("peak_contact_force_rel", "max_displacement_rel"):
+        assert d["errors"][key]["max_converged"] <= TOLERANCE
+    cheaper = [r for r in a["rows"] if r["kind"] in ("adaptive", "fixed")
+               and r["rhs_evaluations"] < d["rhs_evaluations"]]
+    for r in cheaper:                       # everything cheaper breaks the 1 % rule somewhere
+        e = r["errors"]
+        assert max(e["peak_contact_force_rel"]["max_converged"], e["max_displacement_rel"]["max_converged"],
+                   e["early_peak_force_rel"]["max"], e["early_max_displacement_rel"]["max"]) > TOLERANCE
+    # model simplifications change the first 20 ms far more than the default's integration error
+    for name in ("rigid retainer bearing", "no housing flexibility"):
+        assert rows[name]["errors"]["trajectory_um"]["max"] > 20 * d["errors"]["trajectory_um"]["max"]
+
+
+def test_the_package_default_tolerance_is_one_the_study_accepts(quick):
+    """The scene default solver.rtol is the accuracy study's choice (or tighter)."""
+    _, a = quick
+    chosen = _rows(a)[a["default"]]["overrides"]
+    if chosen.get("solver.method") == "adaptive":
+        assert Scene().solver.rtol <= chosen["solver.rtol"]
+
+
+def _row(name, kind, rhs, peak, disp, early=0.0):
+    e = {"peak_contact_force_rel": {"max_converged": peak}, "max_displacement_rel": {"max_converged": disp},
+         "early_peak_force_rel": {"max": early}, "early_max_displacement_rel": {"max": early}}
+    return dict(setting=name, kind=kind, rhs_evaluations=rhs, wall_time_s=rhs * 1e-6, errors=e, failed=[])
+
+
+def test_choose_default_takes_the_cheapest_setting_within_one_percent():
+    rows = [_row("ref", "reference", 1000, 0, 0), _row("loose", "adaptive", 10, 0.05, 0.0),
+            _row("ok-expensive", "adaptive", 300, 0.001, 0.001), _row("ok", "fixed", 200, 0.009, 0.002),
+            _row("early-bad", "adaptive", 100, 0.0, 0.0, early=0.02),
+            _row("cheap-model", "reduced", 5, 0.0, 0.0)]
+    assert choose_default(rows)[0] == "ok"
+    assert choose_default(rows[:2])[0] is None
