@@ -254,8 +254,8 @@ class RotorDropEnv(gym.Env):
         if pr is not None:
             self._scenario = dict(values, **{POWER_RETURN: b.C[K.C_T_POWER] - fs.t_fault})
         self._needs_reset = False
-        if self._renderer is not None:
-            self._renderer.reset()
+        if self.render_mode is not None:            # record from the first step of the episode
+            self._ensure_renderer().reset()
             self._record()
         return b.obs.astype(np.float32), {"scenario": dict(self._scenario), "time_s": 0.0}
 
@@ -343,11 +343,13 @@ class RotorDropEnv(gym.Env):
             gym.logger.warn("render() called without a render_mode; pass render_mode='rgb_array' "
                             "or 'human' to gym.make")
             return None
+        return self._ensure_renderer().draw()
+
+    def _ensure_renderer(self):
         if self._renderer is None:
             from .render import Renderer
             self._renderer = Renderer(self.render_mode, self.scene, self.episode_time)
-            self._record()
-        return self._renderer.draw()
+        return self._renderer
 
     def close(self):
         if self._renderer is not None:

@@ -187,4 +187,8 @@ def test_rgb_render_shows_the_orbit():
     img = env.render()
     assert img.dtype == np.uint8 and img.ndim == 3 and img.shape[2] == 3
     assert (img < 200).any() and (img > 250).any()     # drawn lines on a white background
+    # the RB1 orbit (matplotlib's first colour) and the force trace were recorded from the reset
+    # on, although render() was first called only now
+    c0 = np.array([31, 119, 180])
+    assert (np.abs(img.astype(int) - c0).sum(axis=2) < 60).sum() > 50
     env.close()
