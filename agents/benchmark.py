@@ -1,0 +1,337 @@
+"""``rotordrop benchmark``: every baseline and every shipped policy on a fixed, seeded suite.
+
+1. **Passive threshold.** The passive drop (``RotorDrop-Passive-v0``, paper scene) is run on a
+   friction grid (``THRESHOLD_GRID``) for each unbalance phase of the suite; the threshold μ* is
+   the lowest grid friction from which on the passive drop whirls in at least half of the phases
+   at every grid point. Between the first whirl and μ* the outcome depends on the phase
+   (the drop is chaotic there), above μ* the passive drop whirls.
+2. **Scenarios** (:func:`scenario_suite`): frictions μ* + 0.05, + 0.10, + 0.15 (passive whirls),
+   0.10 (passive rests: a controller must do no harm), 0.25 (the paper's base case) and 0.6; at
+   μ* + 0.05: support stiffness 2e6 and 1e9 N/m, spin speed 6000 and 15000 rpm, a 5 g
+   unbalance, the kinematic friction law, and (re-levitation tasks) power back at 0.15 s. A
+   scenario is in-distribution when all its values lie inside the environments' default
+   randomisation ranges (the training distribution of the shipped policies), else out of it.
+   Each scenario runs once per unbalance phase (``PHASES``): the episodes are deterministic.
+3. **Tasks.** ``damping`` (``RotorDrop-Damping-v0``) and ``relevitate``
+   (``RotorDrop-Relevitate-v0``; the passive reference with the AMBs left off, the PID baseline
+   with continuous currents, learned policies with the command they were trained with).
+   Episodes last ``EPISODE_TIME`` and are not cut short at the stator (``terminate_on_failure =
+   False``) so that whirl is measured as ``rotordrop drop`` measures it.
+4. **Score** (:mod:`agents.score`): per task, 100 (1 − Σ J / Σ J_passive) over the suite.
+
+Outputs: ``benchmark.json`` (threshold sweep, scenarios, one row per controller and scenario,
+leaderboard), ``leaderboard.md``, ``score.png``, ``whirl_map.png``, ``peak_force.png``.
+"""
+from __future__ import annotations
+
+import json
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .controllers import BASELINES, Passive
+from .policies import LearnedPolicy, load_shipped, shipped_names
+from .rollout import run_episodes
+from .score import overall_score, row_cost, summarize
+
+EPISODE_TIME = 0.3
+EVAL_KWARGS = dict(episode_time=EPISODE_TIME, terminate_on_failure=False, randomize=False)
+MONITOR_DT = 2e-4            # KPI sampling interval of every benchmark episode [s]
+PHASES = (0.0, 90.0, 180.0, 270.0)
+QUICK_PHASES = (0.0, 180.0)
+THRESHOLD_GRID = tuple(round(0.10 + 0.02 * i, 2) for i in range(21))     # 0.10 ... 0.50
+WHIRL_MARGINS = (0.05, 0.10, 0.15)
+TASKS = {"damping": "RotorDrop-Damping-v0", "relevitate": "RotorDrop-Relevitate-v0",
+         "full": "RotorDrop-Full-v0"}
+#: env kwargs of the baselines (the passive reference keeps the AMBs off)
+BASELINE_KWARGS = {"pid-relevitate": {"command": "continuous"},
+                   "builtin-relevitate": {"command": "discrete"}}
+
+
+@dataclass(frozen=True)
+class Scenario:
+    name: str
+    friction: float
+    overrides: dict = field(default_factory=dict)
+    group: str = "in-distribution"
+    env_kwargs: dict = field(default_factory=dict)      # relevitation envs only
+    tasks: tuple[str, ...] = tuple(TASKS)
+
+    def scene_overrides(self, phase: float) -> dict:
+        return {"contact.friction": self.friction, "unbalance.angle_deg": phase, **self.overrides}
+
+
+def passive_threshold(phases=PHASES, grid=THRESHOLD_GRID, progress=None) -> dict:
+    """Whirl fraction of the passive drop on the friction grid and the threshold μ* (module doc)."""
+    fractions = []
+    for mu in grid:
+        whirls = []
+        for ph in phases:
+            ep = run_episodes("RotorDrop-Passive-v0", Passive, [0], dict(
+                EVAL_KWARGS, overrides={"contact.friction": mu, "unbalance.angle_deg": ph},
+                **monitor_kwargs({})))[0]
+            whirls.append(bool(ep.kpis["backward_whirl"]))
+            if progress is not None:
+                progress.update(1)
+        fractions.append(float(np.mean(whirls)))
+    threshold = None
+    for i in range(len(grid)):
+        if all(f >= 0.5 for f in fractions[i:]):
+            threshold = grid[i]
+            break
+    return dict(grid=list(grid), phases=list(phases), whirl_fraction=fractions, threshold=threshold,
+                rule="lowest grid friction from which the passive drop whirls in >= half of the "
+                     "phases at every grid point")
+
+
+def scenario_suite(threshold: float | None, quick: bool = False) -> list[Scenario]:
+    ref = threshold if threshold is not None else THRESHOLD_GRID[-1]
+    whirl = [round(ref + m, 2) for m in WHIRL_MARGINS]
+    mu = round(ref + WHIRL_MARGINS[0], 2)
+    relev = ("relevitate", "full")
+    suite = [Scenario(f"mu={m:g} (mu*+{d:g})", m) for m, d in zip(whirl, WHIRL_MARGINS)]
+    suite += [Scenario("mu=0.1 (passive rests)", 0.10), Scenario("mu=0.25 (paper base case)", 0.25),
+              Scenario("mu=0.6", 0.6),
+              Scenario("K_s=2e6 N/m", mu, {"support.stiffness": 2e6}),
+              Scenario("K_s=1e9 N/m", mu, {"support.stiffness": 1e9}),
+              Scenario("6000 rpm", mu, {"rotor.speed_rpm": 6000.0}),
+              Scenario("15000 rpm", mu, {"rotor.speed_rpm": 15000.0}),
+              Scenario("unbalance 5 g", mu, {"unbalance.mass": 5e-3}),
+              Scenario("kinematic friction", mu, {"effects.friction": "kinematic"}),
+              Scenario("power back at 0.15 s", mu, env_kwargs={"power_return_time": 0.15},
+                       tasks=relev)]
+    suite = [Scenario(s.name, s.friction, s.overrides, _group(s), s.env_kwargs, s.tasks) for s in suite]
+    if quick:
+        keep = (0, 2, 3, 5, 9)
+        return [suite[i] for i in keep]
+    return suite
+
+
+def _group(sc: Scenario) -> str:
+    """``in-distribution`` when every value lies inside the environments' default
+    randomisation ranges (what the shipped policies were trained on), else out of it."""
+    from rotordrop_env.scenario import DEFAULT_RANGES
+    values = {"contact.friction": sc.friction, **sc.overrides, **sc.env_kwargs}
+    for key, v in values.items():
+        if key in DEFAULT_RANGES:
+            _, lo, hi = DEFAULT_RANGES[key]
+            if not lo <= float(v) <= hi:
+                return "out-of-distribution"
+        elif key != "unbalance.angle_deg":
+            return "out-of-distribution"
+    return "in-distribution"
+
+
+@dataclass
+class Entry:
+    """A controller in the benchmark: display name, task, how to build it, env kwargs."""
+    name: str
+    task: str
+    make: object
+    env_kwargs: dict
+
+
+def _entries(policies: list[LearnedPolicy]) -> list[Entry]:
+    from .plant import Plant, make_env
+    out = []
+    for task, env_id in TASKS.items():
+        task_policies = [p for p in policies if p.env_id == env_id]
+        if task == "full" and not task_policies:
+            continue
+        for name, cls in BASELINES.items():
+            kw = dict(BASELINE_KWARGS.get(name, {})) if task != "damping" else {}
+            env = make_env(env_id, **kw)
+            supported = cls.supports(Plant.from_env(env))
+            env.close()
+            if supported:
+                out.append(Entry(name, task, cls, kw))
+        for p in task_policies:
+            out.append(Entry(p.name, task, p.bound, dict(p.env_kwargs)))
+    return out
+
+
+def monitor_kwargs(kw: dict) -> dict:
+    """``samples_per_step`` so that the KPI monitor samples every 0.2 ms whatever the control
+    step (the environments' default: 5 samples per 1 ms step). Peak forces of impacts lasting
+    about a millisecond are under-read at coarser sampling, which would favour controllers
+    with longer control steps."""
+    dt = float(kw.get("control_dt", 1e-3))
+    return {"samples_per_step": max(5, int(round(dt / MONITOR_DT)))}
+
+
+def _env_kwargs(entry: Entry, scenario: Scenario, phase: float) -> dict:
+    kw = {k: v for k, v in entry.env_kwargs.items()
+          if k not in ("randomize", "randomization", "overrides", "terminate_on_failure",
+                       "episode_time", "samples_per_step")}
+    kw.update(EVAL_KWARGS)
+    kw.update(monitor_kwargs(kw))
+    kw["overrides"] = {**(entry.env_kwargs.get("overrides") or {}), **scenario.scene_overrides(phase)}
+    if entry.task != "damping":
+        kw.update(scenario.env_kwargs)
+    return kw
+
+
+def benchmark(out: str | Path, quick: bool = False, policies: list[str] | None = None,
+              max_scenarios: int | None = None, episodes: int | None = None,
+              progress: bool = True, plots: bool = True) -> dict:
+    """Run the suite and write benchmark.json, leaderboard.md and the plots into ``out``."""
+    from tqdm.auto import tqdm
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    t0 = time.perf_counter()
+    phases = QUICK_PHASES if quick else PHASES
+    if episodes is not None:
+        phases = PHASES[:max(1, min(episodes, len(PHASES)))]
+    loaded = [load_shipped(n) for n in shipped_names()]
+    for spec in policies or []:
+        if spec in shipped_names():
+            continue                                   # already in
+        pol = LearnedPolicy.load(spec)
+        if any(pol.name == p.name for p in loaded):     # e.g. a new run of a shipped policy
+            pol.name = f"{pol.name}@{Path(spec).name}"
+        loaded.append(pol)
+    entries = _entries(loaded)
+
+    sweep_phases = PHASES if episodes is None else phases     # --quick: the full threshold sweep
+    bar = tqdm(total=len(THRESHOLD_GRID) * len(sweep_phases), desc="passive threshold", unit="ep",
+               disable=not progress)
+    sweep = passive_threshold(sweep_phases, THRESHOLD_GRID, bar)
+    bar.close()
+    scenarios = scenario_suite(sweep["threshold"], quick)
+    if max_scenarios is not None:
+        scenarios = scenarios[:max(1, max_scenarios)]
+
+    rows = []
+    bar = tqdm(total=sum(e.task in s.tasks for e in entries for s in scenarios) * len(phases),
+               desc="benchmark", unit="ep", disable=not progress)
+    for entry in entries:
+        for sc in [s for s in scenarios if entry.task in s.tasks]:
+            eps = []
+            for ph in phases:
+                eps += run_episodes(TASKS[entry.task], entry.make, [0], _env_kwargs(entry, sc, ph))
+                bar.update(1)
+            rows.append(_row(entry, sc, eps))
+    bar.close()
+    board = leaderboard(rows, scenarios, sweep["threshold"])
+    report = dict(quick=quick, episode_time_s=EPISODE_TIME, phases_deg=list(phases),
+                  threshold_sweep=sweep, passive_threshold=sweep["threshold"],
+                  scenarios=[dict(name=s.name, friction=s.friction, overrides=s.overrides,
+                                  group=s.group, env_kwargs=s.env_kwargs, tasks=list(s.tasks))
+                             for s in scenarios],
+                  rows=rows, leaderboard=board, wall_time_s=time.perf_counter() - t0)
+    (out / "benchmark.json").write_text(json.dumps(report, indent=2, default=_json))
+    (out / "leaderboard.md").write_text(leaderboard_markdown(report))
+    if plots:
+        from .plots import plot_benchmark
+        report["figures"] = [p.name for p in plot_benchmark(report, out)]
+    print(leaderboard_markdown(report))
+    print(f"wrote {out / 'benchmark.json'}, {out / 'leaderboard.md'}"
+          + "".join(f", {f}" for f in report.get("figures", []))
+          + f" in {report['wall_time_s']:.0f} s")
+    return report
+
+
+def _row(entry: Entry, sc: Scenario, eps) -> dict:
+    s = summarize(eps)
+    k = [e.kpis for e in eps]
+    return dict(controller=entry.name, task=entry.task, env_id=TASKS[entry.task], scenario=sc.name,
+                group=sc.group, friction=sc.friction,
+                backward_whirl=s["backward_whirl_rate"],
+                whirl_revolutions=float(np.mean([d["whirl_revolutions"] for d in k])),
+                peak_contact_force_N=s["peak_contact_force_N"],
+                max_displacement_um=s["max_displacement_um"],
+                relevitated=s["relevitation_success_rate"],
+                relevitation_time_s=s["relevitation_time_s"],
+                control_effort=s["control_effort"],
+                stator_contact=float(np.mean([bool(d.get("stator_contact")) for d in k])),
+                episodes=len(eps))
+
+
+def leaderboard(rows: list[dict], scenarios: list[Scenario], threshold) -> list[dict]:
+    """Per task and controller: overall score, whirl and force criteria (see agents.score)."""
+    board = []
+    for task in dict.fromkeys(r["task"] for r in rows):
+        passive = {r["scenario"]: r for r in rows if r["task"] == task and r["controller"] == "passive"}
+        relev = task != "damping"
+        p_costs = {n: row_cost(r, r, EPISODE_TIME, relev) for n, r in passive.items()}
+        for name in dict.fromkeys(r["controller"] for r in rows if r["task"] == task):
+            mine = [r for r in rows if r["task"] == task and r["controller"] == name]
+            costs = {r["scenario"]: row_cost(r, passive[r["scenario"]], EPISODE_TIME, relev)
+                     for r in mine}
+            for r in mine:
+                r["cost"] = costs[r["scenario"]]
+            whirl_sc = [r for r in mine if passive[r["scenario"]]["backward_whirl"] >= 0.5
+                        and threshold is not None and r["friction"] >= threshold + 0.05 - 1e-9]
+            entry = dict(task=task, controller=name,
+                         score=overall_score(list(costs.values()), [p_costs[n] for n in costs]),
+                         in_distribution_score=_group_score(mine, costs, p_costs, "in-distribution"),
+                         out_of_distribution_score=_group_score(mine, costs, p_costs,
+                                                                "out-of-distribution"),
+                         whirl_rate=float(np.mean([r["backward_whirl"] for r in mine])),
+                         whirl_rate_where_passive_whirls=(float(np.mean([r["backward_whirl"]
+                                                                         for r in whirl_sc]))
+                                                          if whirl_sc else None),
+                         force_ratio=float(np.mean([r["peak_contact_force_N"] /
+                                                    passive[r["scenario"]]["peak_contact_force_N"]
+                                                    for r in mine])),
+                         max_force_ratio=float(max(r["peak_contact_force_N"] /
+                                                   passive[r["scenario"]]["peak_contact_force_N"]
+                                                   for r in mine)),
+                         displacement_ratio=float(np.mean([r["max_displacement_um"] /
+                                                           passive[r["scenario"]]["max_displacement_um"]
+                                                           for r in mine])),
+                         relevitation_rate=(float(np.mean([r["relevitated"] or 0.0 for r in mine]))
+                                            if relev else None))
+            board.append(entry)
+    board.sort(key=lambda e: (list(TASKS).index(e["task"]), -e["score"]))
+    return board
+
+
+def _group_score(mine, costs, p_costs, group):
+    names = [r["scenario"] for r in mine if r["group"] == group]
+    if not names:
+        return None
+    return overall_score([costs[n] for n in names], [p_costs[n] for n in names])
+
+
+def _fmt(v, f):
+    return "-" if v is None else format(v, f)
+
+
+def leaderboard_markdown(report: dict) -> str:
+    thr = report["passive_threshold"]
+    lines = [f"# rotordrop benchmark{' (quick)' if report['quick'] else ''}", "",
+             f"Passive whirl threshold mu* = {_fmt(thr, 'g')} (paper scene, {len(report['phases_deg'])} "
+             f"unbalance phases, {report['episode_time_s']:g} s after the fault). "
+             f"Score: 100 (1 - sum J / sum J_passive), see docs/agents.md.", ""]
+    for task in dict.fromkeys(e["task"] for e in report["leaderboard"]):
+        lines += [f"## {task}", "",
+                  "| rank | controller | score | in-dist. | out-of-dist. | whirl rate | whirl where "
+                  "passive whirls | peak F / passive (mean, max) | disp. / passive | relevitated |",
+                  "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+        for i, e in enumerate([e for e in report["leaderboard"] if e["task"] == task], 1):
+            lines.append(f"| {i} | {e['controller']} | {e['score']:.1f} | "
+                         f"{_fmt(e['in_distribution_score'], '.1f')} | "
+                         f"{_fmt(e['out_of_distribution_score'], '.1f')} | {e['whirl_rate']:.2f} | "
+                         f"{_fmt(e['whirl_rate_where_passive_whirls'], '.2f')} | "
+                         f"{e['force_ratio']:.2f}, {e['max_force_ratio']:.2f} | "
+                         f"{e['displacement_ratio']:.2f} | {_fmt(e['relevitation_rate'], '.2f')} |")
+        lines += ["", "| controller | scenario | mu | whirl | revs | peak F [N] | max disp [µm] | "
+                      "relevitated | t_relev [ms] | J |", "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+        for r in [r for r in report["rows"] if r["task"] == task]:
+            t = r["relevitation_time_s"]
+            lines.append(f"| {r['controller']} | {r['scenario']} | {r['friction']:g} | "
+                         f"{r['backward_whirl']:.2f} | {r['whirl_revolutions']:.1f} | "
+                         f"{r['peak_contact_force_N']:.0f} | {r['max_displacement_um']:.0f} | "
+                         f"{_fmt(r['relevitated'], '.2f')} | {_fmt(t * 1e3 if t is not None else None, '.0f')} | "
+                         f"{r.get('cost', float('nan')):.2f} |")
+        lines.append("")
+    return "\n".join(lines)
+
+
+def _json(o):
+    if isinstance(o, np.generic):
+        return o.item()
+    return str(o)

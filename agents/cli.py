@@ -1,0 +1,111 @@
+"""``rotordrop train | evaluate | benchmark`` (registered into ``physics.cli``).
+
+Registration is light: SB3, torch and the environments are imported inside the handlers.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+
+
+def _env_kwargs(args) -> dict:
+    from physics.scene import parse_assignment
+    kw = {}
+    if getattr(args, "scene", None):
+        kw["scene"] = args.scene
+    if getattr(args, "overrides", None):
+        kw["overrides"] = {k: _number(v) for k, v in map(parse_assignment, args.overrides)}
+    return kw
+
+
+def _number(text: str):
+    """'0.4' -> 0.4 (so that reports show numbers); other values stay strings for the scene."""
+    try:
+        return float(text)
+    except ValueError:
+        return text
+
+
+def cmd_train(args) -> int:
+    from .hyperparams import ConfigError
+    from .train import command_line, train
+    try:
+        res = train(args.env, args.algo, args.out, timesteps=args.timesteps, n_envs=args.n_envs,
+                    config=args.config, seed=args.seed, resume=args.resume, threads=args.threads,
+                    progress=not args.quiet, verbose=args.verbose, command=command_line())
+    except (ConfigError, FileNotFoundError) as exc:
+        print(f"rotordrop train: error: {exc}", file=sys.stderr)
+        return 2
+    print(f"trained {res.timesteps} steps in {res.wall_time_s:.0f} s; wrote {res.model_path}, "
+          f"{res.vecnormalize_path}, {res.out / 'config.yaml'}, {res.out / 'training.json'}")
+    return 0
+
+
+def cmd_evaluate(args) -> int:
+    from .evaluate import evaluate, print_summary
+    try:
+        report = evaluate(args.policy, args.env, args.episodes, args.out, env_kwargs=_env_kwargs(args),
+                          seed=args.seed, plots=not args.no_plots, compare_passive=not args.no_passive,
+                          randomize=not args.fixed)
+    except (KeyError, ValueError, FileNotFoundError) as exc:
+        print(f"rotordrop evaluate: error: {exc.args[0] if exc.args else exc}", file=sys.stderr)
+        return 2
+    print_summary(report)
+    return 0
+
+
+def cmd_benchmark(args) -> int:
+    from .benchmark import benchmark
+    benchmark(args.out, quick=args.quick, policies=args.policy, max_scenarios=args.scenarios,
+              episodes=args.episodes, progress=not args.quiet, plots=not args.no_plots)
+    return 0
+
+
+def register(sub) -> None:
+    p = sub.add_parser("train", help="train an SB3 agent on a rotor-drop environment")
+    p.add_argument("--env", required=True, help="environment id, e.g. RotorDrop-Damping-v0")
+    p.add_argument("--algo", required=True, choices=("ppo", "sac", "td3"))
+    p.add_argument("--timesteps", type=int, default=None, help="override n_timesteps of the config")
+    p.add_argument("--n-envs", type=int, default=None, help="override n_envs of the config")
+    p.add_argument("--config", default=None,
+                   help="YAML with hyperparameters keyed by env id (rl-zoo3 style), applied over "
+                        "the shipped agents/configs/<algo>.yaml")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--resume", default=None, metavar="DIR|CHECKPOINT.zip",
+                   help="continue from a checkpoint (or the newest one in a run directory)")
+    p.add_argument("--threads", type=int, default=1,
+                   help="torch and numba threads (default 1: several times faster for these small "
+                        "networks and the batched physics on a few shared cores)")
+    p.add_argument("--out", required=True, help="output directory")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--verbose", type=int, default=0, help="SB3 verbosity (0, 1, 2)")
+    p.set_defaults(func=cmd_train)
+
+    p = sub.add_parser("evaluate", help="KPIs and plots of a policy or baseline controller")
+    p.add_argument("--policy", required=True,
+                   help="baseline name (passive, max-damping, whirl-switch, pid-relevitate), shipped "
+                        "policy name (e.g. ppo-damping) or path to a training directory / model zip")
+    p.add_argument("--env", default=None, help="environment id (default: the one the policy was "
+                                               "trained on; required for baselines)")
+    p.add_argument("--episodes", type=int, default=10)
+    p.add_argument("--seed", type=int, default=0, help="episode i uses seed + i")
+    p.add_argument("--scene", default=None, help="scene preset or TOML (default: the env's)")
+    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                   help="scene override (repeatable), e.g. contact.friction=0.4")
+    p.add_argument("--out", default="out/evaluate", help="output directory")
+    p.add_argument("--no-plots", action="store_true")
+    p.add_argument("--no-passive", action="store_true", help="skip the passive reference runs")
+    p.add_argument("--fixed", action="store_true",
+                   help="no scenario randomisation: every episode runs the given scene")
+    p.set_defaults(func=cmd_evaluate)
+
+    p = sub.add_parser("benchmark", help="every baseline and shipped policy on a fixed scenario suite")
+    p.add_argument("--quick", action="store_true", help="a reduced suite that runs in a few minutes")
+    p.add_argument("--policy", action="append", default=None,
+                   help="extra policies to include (path or shipped name; repeatable)")
+    p.add_argument("--out", default="out/benchmark", help="output directory")
+    p.add_argument("--no-plots", action="store_true")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--scenarios", type=int, default=None, help=argparse.SUPPRESS)
+    p.add_argument("--episodes", type=int, default=None, help=argparse.SUPPRESS)
+    p.set_defaults(func=cmd_benchmark)

@@ -1,0 +1,236 @@
+"""Baseline controllers with the interface of a trained SB3 policy.
+
+Every controller is built from a :class:`~agents.plant.Plant` (what the environment tells about
+its observations and actions) and answers ``predict(obs, state, episode_start, deterministic)``
+with ``(actions, state)`` exactly like ``model.predict`` of Stable-Baselines3, for a single
+observation or a batch. Controllers read observations by *name* (``env.unwrapped.obs_names``)
+and convert them to SI with ``obs_scale``, so they do not depend on the observation layout.
+
+Baselines (spec §5-6):
+
+``passive``
+    No control: the support damping stays at the scene's C_s and the AMBs stay off.
+``max-damping``
+    Constant maximum support damping C_max in both housings.
+``whirl-switch``
+    Switching damper: C_max in a housing while the orbit at that plane turns against the spin
+    (orbit angular momentum x ẏ − y ẋ opposite to Ω) beyond ``r_on`` × clearance (the signature
+    of backward whirl, spec §7), held for ``hold_time`` seconds; otherwise the passive C_s.
+``pid-relevitate``
+    Re-levitation once power is back (spec §5), ``command="continuous"``: its own PID per AMB
+    axis at the control rate (the scene's gains ``amb.kp/ki/kd``, gravity feed-forward,
+    anti-windup), with a reference ramped from the landing position to the centre over
+    ``amb.liftoff_ramp_time``, currents limited to ±1 (the normalised current limit).
+``builtin-relevitate``
+    ``command="discrete"``: switches the environment's built-in PID (the same law, evaluated
+    continuously inside the integrator, same ramp) on as soon as power is back.
+
+The PID starts when the ``amb_power`` observation shows the power, one control step after it
+returned (the environment's observation lags its power flag by one step); the built-in switch
+needs no observation and engages in the very step the power returns.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .plant import Plant
+
+
+class Controller:
+    """Base class: ``act(obs)`` maps a batch of raw observations to a batch of actions."""
+
+    name = "controller"
+    #: channels the controller sets (a subset of Plant.channels); the rest stay passive
+    needs: tuple[str, ...] = ()
+
+    def __init__(self, plant: Plant):
+        self.plant = plant
+        self.n = 0
+        self.t = np.zeros(0)
+        self.fresh = np.zeros(0, dtype=bool)
+        self.hold = np.zeros((0, 2))
+
+    @classmethod
+    def supports(cls, plant: Plant) -> bool:
+        return all(c in plant.channels for c in cls.needs)
+
+    def reset(self, n: int, which: np.ndarray | None = None) -> None:
+        """Start new episodes (all of them, or those flagged in ``which``)."""
+        if which is None or self.n != n:
+            self.n = n
+            self.t = np.zeros(n)
+            self.fresh = np.ones(n, dtype=bool)
+            self.hold = np.zeros((n, 2))
+        else:
+            self.t[which] = 0.0
+            self.fresh[which] = True
+
+    def commands(self, obs: np.ndarray) -> dict[str, np.ndarray]:
+        """Channel name -> value per environment (see :mod:`agents.plant`)."""
+        return {}
+
+    def act(self, obs: np.ndarray) -> np.ndarray:
+        if "damping" in self.plant.channels and self.fresh.any():
+            self.hold[self.fresh] = self.plant.damping_level(obs[self.fresh])
+        self.fresh[:] = False
+        action = self.plant.compose(len(obs), self.commands(obs), self.hold)
+        self.t += self.plant.control_dt
+        return action
+
+    def predict(self, observation, state=None, episode_start=None, deterministic: bool = True):
+        """SB3-compatible: ``(actions, state)`` for one observation or a batch."""
+        obs = np.asarray(observation, dtype=np.float64)
+        single = obs.ndim == 1
+        obs = np.atleast_2d(obs)
+        if self.n != len(obs):
+            self.reset(len(obs))
+        elif episode_start is not None and np.any(episode_start):
+            self.reset(len(obs), np.asarray(episode_start, dtype=bool).reshape(-1))
+        action = self.act(obs)
+        return (action[0] if single else action), state
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}({self.name!r})"
+
+
+class Passive(Controller):
+    """No control action: the scene's own support damping, AMBs never switched back on."""
+
+    name = "passive"
+
+
+class MaxDamping(Controller):
+    """Constant C_max in both housings."""
+
+    name = "max-damping"
+    needs = ("damping",)
+
+    def commands(self, obs):
+        return {"damping": np.ones((len(obs), 2))}
+
+
+class WhirlSwitch(Controller):
+    """High damping while the orbit at a plane looks like backward whirl (see module doc).
+
+    Per plane the backward orbit angle (against the spin) travelled beyond ``r_on`` x clearance
+    is accumulated with exponential forgetting (time constant ``window``); the damping goes to
+    C_max when it exceeds ``angle`` and stays there ``hold_time`` after the last detection.
+    Impacts and bounces (radial motion) do not trigger it; an orbit turning backwards does.
+    """
+
+    name = "whirl-switch"
+    needs = ("damping",)
+
+    def __init__(self, plant: Plant, r_on: float = 0.6, angle: float = np.pi / 4,
+                 window: float = 0.01, hold_time: float = 0.02):
+        super().__init__(plant)
+        self.r_on, self.angle, self.window, self.hold_time = r_on, angle, window, hold_time
+        self.last = np.zeros((0, 2))
+        self.theta = np.zeros((0, 2))
+        self.backward = np.zeros((0, 2))
+
+    def reset(self, n, which=None):
+        super().reset(n, which)
+        if which is None or len(self.last) != n:
+            which = np.ones(n, dtype=bool)
+            self.last = np.zeros((n, 2))
+            self.theta = np.zeros((n, 2))
+            self.backward = np.zeros((n, 2))
+        self.last[which] = -np.inf
+        self.theta[which] = np.nan
+        self.backward[which] = 0.0
+
+    def commands(self, obs):
+        p = self.plant
+        spin = np.sign(p.get(obs, "rotor_speed"))
+        spin[spin == 0] = 1.0
+        decay = np.exp(-p.control_dt / self.window)
+        for k in range(2):
+            x, y = p.get(obs, f"x{k + 1}"), p.get(obs, f"y{k + 1}")
+            theta = np.arctan2(y, x)
+            dtheta = np.nan_to_num((theta - self.theta[:, k] + np.pi) % (2 * np.pi) - np.pi)
+            far = np.hypot(x, y) > self.r_on * p.clearance
+            self.backward[:, k] = decay * self.backward[:, k] + np.where(far, -spin * dtheta, 0.0)
+            self.theta[:, k] = theta
+            detected = self.backward[:, k] > self.angle
+            self.last[detected, k] = self.t[detected]
+        high = self.t[:, None] - self.last <= self.hold_time
+        return {"damping": np.where(high, 1.0, self.hold)}
+
+
+class BuiltinRelevitate(Controller):
+    """Switches the environment's built-in PID (ramped lift-off) on as soon as power is back.
+
+    It commands "on" at every step: the environment ignores the command until power returns
+    and then engages the controller at once (waiting for the ``amb_power`` observation would
+    lose one control step, since the observation shows the power one step after it is back).
+    """
+
+    name = "builtin-relevitate"
+    needs = ("levitate",)
+
+    def commands(self, obs):
+        return {"levitate": np.ones(len(obs))}
+
+
+class PidRelevitate(Controller):
+    """An own PID per AMB axis on the control currents, with a lift-off reference ramped from
+    the landing position to the centre, switched on as soon as power is back (spec §5)."""
+
+    name = "pid-relevitate"
+    needs = ("currents",)
+
+    def __init__(self, plant: Plant, ramp: float | None = None):
+        super().__init__(plant)
+        self.ramp = plant.liftoff_ramp if ramp is None else ramp
+        lim = plant.current_limit
+        kp, ki, kd = plant.pid               # the scene's AMB PID gains, per A -> normalised
+        self.kp, self.ki, self.kd = kp / lim, ki / lim, kd / lim
+        self.ff = np.array([0.0, plant.feedforward[0], 0.0, plant.feedforward[1]]) / lim
+        self.on_t = np.zeros(0)
+        self.start = np.zeros((0, 4))
+        self.integral = np.zeros((0, 4))
+
+    def reset(self, n, which=None):
+        super().reset(n, which)
+        if which is None or len(self.on_t) != n:
+            self.on_t = np.full(n, np.nan)
+            self.start = np.zeros((n, 4))
+            self.integral = np.zeros((n, 4))
+        else:
+            self.on_t[which] = np.nan
+            self.integral[which] = 0.0
+
+    def commands(self, obs):
+        p = self.plant
+        powered = p.power_available(obs)
+        pos = np.stack([p.get(obs, k) for k in ("x1", "y1", "x2", "y2")], axis=1)
+        vel = np.stack([p.get(obs, k) for k in ("vx1", "vy1", "vx2", "vy2")], axis=1)
+        new = powered & np.isnan(self.on_t)
+        self.on_t[new] = self.t[new]
+        self.start[new] = pos[new]
+        self.integral[new] = 0.0
+        s = np.nan_to_num((self.t - self.on_t) / max(self.ramp, 1e-12), nan=0.0)
+        ramping = ((s > 0.0) & (s < 1.0))[:, None]
+        s = np.clip(s, 0.0, 1.0)[:, None]
+        err = pos - self.start * (1.0 - s)                       # e = d - reference
+        derr = vel + np.where(ramping, self.start / max(self.ramp, 1e-12), 0.0)
+        raw = self.ff - (self.kp * err + self.ki * self.integral + self.kd * derr)
+        windup = ((raw > 1.0) & (err < 0.0)) | ((raw < -1.0) & (err > 0.0))
+        self.integral += np.where(powered[:, None] & ~windup, err * p.control_dt, 0.0)
+        current = np.where(powered[:, None], np.clip(raw, -1.0, 1.0), 0.0)
+        return {"currents": current}
+
+
+BASELINES: dict[str, type[Controller]] = {c.name: c for c in (
+    Passive, MaxDamping, WhirlSwitch, PidRelevitate, BuiltinRelevitate)}
+
+
+def make_baseline(name: str, plant: Plant) -> Controller:
+    if name not in BASELINES:
+        raise KeyError(f"unknown baseline controller {name!r}; known: {', '.join(BASELINES)}")
+    cls = BASELINES[name]
+    if not cls.supports(plant):
+        raise ValueError(f"controller {name!r} needs action channels {cls.needs}, which "
+                         f"{plant.env_id} does not have (it has {', '.join(plant.channels)})")
+    return cls(plant)

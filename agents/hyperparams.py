@@ -1,0 +1,180 @@
+"""Hyperparameters: rl-zoo3-style YAML files keyed by environment id.
+
+``agents/configs/<algo>.yaml`` holds the shipped defaults; ``--config FILE`` overrides them with a
+file of the same format (a block for the env id, or a flat mapping applied to it). Besides the
+algorithm's constructor arguments a block may hold:
+
+=================  ===========================================================================
+``n_timesteps``    training steps (``--timesteps`` overrides)
+``n_envs``         parallel environments in the batched VecEnv (``--n-envs`` overrides)
+``policy``         SB3 policy name (``MlpPolicy``)
+``policy_kwargs``  a Python dict literal as a string, e.g. ``"dict(net_arch=[64, 64])"``
+``normalize``      ``true``/``false`` or a dict literal of ``VecNormalize`` arguments
+``env_kwargs``     keyword arguments of ``gym.make`` (``randomize``, ``overrides``...)
+``eval_freq``      environment steps between evaluations (``EvalCallback``)
+``n_eval_episodes`` episodes per evaluation
+``checkpoint_freq`` environment steps between checkpoints
+``noise_type``     TD3 action noise (``normal`` | ``ornstein-uhlenbeck``), with ``noise_std``
+``reward``         ``env`` (the environment's reward, default) or ``kpi`` (the KPI-aligned
+                   reward of :mod:`agents.reward`), with optional ``reward_kwargs``
+``residual``       a baseline controller name: the agent's action corrects that controller's
+                   (:mod:`agents.residual`; the saved policy applies it too)
+=================  ===========================================================================
+
+``learning_rate``, ``clip_range`` accept ``lin_<value>`` (linear decay to zero, as in rl-zoo3).
+"""
+from __future__ import annotations
+
+import ast
+import copy
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+ALGOS = ("ppo", "sac", "td3")
+META_KEYS = ("n_timesteps", "n_envs", "policy", "policy_kwargs", "normalize", "env_kwargs",
+             "eval_freq", "n_eval_episodes", "checkpoint_freq", "noise_type", "noise_std",
+             "reward", "reward_kwargs", "residual")
+REWARDS = ("env", "kpi")
+SCHEDULE_KEYS = ("learning_rate", "clip_range")
+
+
+class ConfigError(ValueError):
+    """A hyperparameter file or value is invalid; the message names the key."""
+
+
+def _yaml():
+    try:
+        import yaml
+    except ImportError as exc:   # pragma: no cover - the rl extra installs it
+        raise ConfigError("reading hyperparameter files needs PyYAML: pip install 'rotordrop[rl]'") from exc
+    return yaml
+
+
+def default_config_path(algo: str) -> Path:
+    if algo not in ALGOS:
+        raise ConfigError(f"algo must be one of {', '.join(ALGOS)}, got {algo!r}")
+    return Path(str(resources.files("agents") / "configs" / f"{algo}.yaml"))
+
+
+def read_yaml(path: str | Path) -> dict:
+    path = Path(path)
+    if not path.is_file():
+        raise ConfigError(f"config file {path} does not exist")
+    try:
+        data = _yaml().safe_load(path.read_text())
+    except Exception as exc:
+        raise ConfigError(f"config file {path} is not valid YAML: {exc}") from exc
+    if not isinstance(data, dict):
+        raise ConfigError(f"config file {path} must be a mapping (env id -> hyperparameters)")
+    return data
+
+
+def load_hyperparams(algo: str, env_id: str, config: str | Path | None = None) -> dict:
+    """The hyperparameters for (algo, env id): shipped defaults, then ``config`` on top."""
+    shipped = read_yaml(default_config_path(algo))
+    if env_id not in shipped:
+        raise ConfigError(f"no {algo} hyperparameters for {env_id} in {default_config_path(algo)}; "
+                          f"known ids: {', '.join(shipped)}")
+    hp = copy.deepcopy(shipped[env_id])
+    if config is not None:
+        user = read_yaml(config)
+        block = user.get(env_id, user if not any(k.startswith("RotorDrop-") for k in user) else None)
+        if block is None:
+            raise ConfigError(f"config file {config} has no block for {env_id} (has {', '.join(user)})")
+        for key, value in block.items():
+            if key == "env_kwargs" and isinstance(value, dict):
+                hp.setdefault("env_kwargs", {}).update(value)
+            else:
+                hp[key] = value
+    return hp
+
+
+def parse_literal(text: Any, key: str) -> Any:
+    """Evaluate a restricted Python literal: constants, lists, tuples, dicts, ``dict(...)``,
+    and ``nn.<Module>`` names (torch activation functions), as rl-zoo3 configs write them."""
+    if not isinstance(text, str):
+        return text
+    try:
+        tree = ast.parse(text, mode="eval").body
+    except SyntaxError as exc:
+        raise ConfigError(f"{key}: cannot parse {text!r}: {exc.msg}") from exc
+
+    def ev(node):
+        if isinstance(node, ast.Constant):
+            return node.value
+        if isinstance(node, (ast.List, ast.Tuple)):
+            items = [ev(e) for e in node.elts]
+            return items if isinstance(node, ast.List) else tuple(items)
+        if isinstance(node, ast.Dict):
+            return {ev(k): ev(v) for k, v in zip(node.keys, node.values)}
+        if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub):
+            return -ev(node.operand)
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id == "dict" \
+                and not node.args:
+            return {kw.arg: ev(kw.value) for kw in node.keywords}
+        if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name) and node.value.id == "nn":
+            import torch.nn as nn
+            if not hasattr(nn, node.attr):
+                raise ConfigError(f"{key}: torch.nn has no {node.attr}")
+            return getattr(nn, node.attr)
+        raise ConfigError(f"{key}: only literals, dict(...) and nn.<Name> are allowed, got "
+                          f"{ast.unparse(node)!r}")
+
+    return ev(tree)
+
+
+def schedule(value: Any, key: str):
+    """A float, or ``lin_<v>``: a linear schedule from v to 0 over training."""
+    if isinstance(value, str) and value.startswith("lin_"):
+        try:
+            start = float(value[4:])
+        except ValueError as exc:
+            raise ConfigError(f"{key}: bad linear schedule {value!r} (write lin_3e-4)") from exc
+        return lambda progress_remaining: progress_remaining * start
+    try:
+        return float(value)
+    except (TypeError, ValueError) as exc:
+        raise ConfigError(f"{key}: expected a number or lin_<value>, got {value!r}") from exc
+
+
+def split(hp: dict) -> tuple[dict, dict]:
+    """(meta settings, algorithm constructor kwargs) with literals and schedules resolved."""
+    meta = {k: hp[k] for k in META_KEYS if k in hp}
+    algo_kwargs = {k: v for k, v in hp.items() if k not in META_KEYS}
+    for k in SCHEDULE_KEYS:
+        if k in algo_kwargs:
+            algo_kwargs[k] = schedule(algo_kwargs[k], k)
+    if "policy_kwargs" in meta:
+        pk = parse_literal(meta["policy_kwargs"], "policy_kwargs")
+        if not isinstance(pk, dict):
+            raise ConfigError(f"policy_kwargs must be a dict, got {pk!r}")
+        algo_kwargs["policy_kwargs"] = pk
+    norm = parse_literal(meta.get("normalize", False), "normalize")
+    if not isinstance(norm, (bool, dict)):
+        raise ConfigError(f"normalize must be true/false or a dict, got {norm!r}")
+    meta["normalize"] = norm
+    meta.setdefault("reward", "env")
+    if meta["reward"] not in REWARDS:
+        raise ConfigError(f"reward must be one of {', '.join(REWARDS)}, got {meta['reward']!r}")
+    if meta.get("residual") is not None:
+        from .controllers import BASELINES
+        if meta["residual"] not in BASELINES:
+            raise ConfigError(f"residual must be a baseline controller ({', '.join(BASELINES)}), "
+                              f"got {meta['residual']!r}")
+    if not isinstance(meta.setdefault("reward_kwargs", {}) or {}, dict):
+        raise ConfigError(f"reward_kwargs must be a mapping, got {meta['reward_kwargs']!r}")
+    for k, lo in (("n_timesteps", 1), ("n_envs", 1), ("eval_freq", 0), ("n_eval_episodes", 1),
+                  ("checkpoint_freq", 0)):
+        if k in meta:
+            try:
+                meta[k] = int(float(meta[k]))
+            except (TypeError, ValueError) as exc:
+                raise ConfigError(f"{k} must be an integer, got {meta[k]!r}") from exc
+            if meta[k] < lo:
+                raise ConfigError(f"{k} must be >= {lo}, got {meta[k]}")
+    return meta, algo_kwargs
+
+
+def dump_yaml(data: dict, path: str | Path) -> None:
+    Path(path).write_text(_yaml().safe_dump(data, sort_keys=False))

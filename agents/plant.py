@@ -1,0 +1,155 @@
+"""What a controller needs to know about the environment it drives, read from the env itself.
+
+``Plant.from_env(env)`` reads ``obs_names`` / ``obs_scale`` / ``action_names`` / the action space
+and the scene of a rotor-drop environment (a ``gym.make`` env, its unwrapped env or a batched
+VecEnv). Controllers address observations by name and build actions by *channel*:
+
+============  =========================================================================
+channel       meaning of the value a controller gives (per environment)
+============  =========================================================================
+``damping``   (n, 2) damper commands in [-1, 1] (-1 = C_min, +1 = C_max) of housing 1, 2
+``levitate``  (n,) 1 = switch the built-in levitation controller on, 0 = stay off
+              (``command="discrete"``)
+``currents``  (n, 4) control currents / current limit, AMB1 x, AMB1 y, AMB2 x, AMB2 y
+              (``command="continuous"``)
+============  =========================================================================
+
+Channels a controller does not set stay passive (damping held at its value at the episode
+start, AMBs off).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+SENSORS = ("x1", "y1", "vx1", "vy1", "x2", "y2", "vx2", "vy2", "rotor_speed")
+CURRENT_NAMES = ("current_amb1_x", "current_amb1_y", "current_amb2_x", "current_amb2_y")
+
+
+def make_env(env_id: str, **kwargs):
+    """``gym.make`` of a rotor-drop environment (registers the ids first)."""
+    import gymnasium as gym
+    import rotordrop_env  # noqa: F401
+    return gym.make(env_id, **kwargs)
+
+
+def make_vec_env(env_id: str, n_envs: int, seed: int, env_kwargs: dict, monitor_file=None,
+                 reward: str = "env", reward_kwargs: dict | None = None,
+                 residual: str | None = None):
+    """The batched SB3 VecEnv of ``rotordrop_env`` with episode statistics (``VecMonitor``);
+    ``reward="kpi"`` replaces the reward by :mod:`agents.reward`'s KPI-aligned one, ``residual``
+    makes the agent's action a correction of that baseline controller's."""
+    from stable_baselines3.common.vec_env import VecMonitor
+    from rotordrop_env import BatchedRotorDropVecEnv
+    venv = BatchedRotorDropVecEnv(env_id, n_envs, seed=seed, **env_kwargs)
+    if residual:
+        from .residual import make_residual
+        venv = make_residual(venv, residual)
+    if reward == "kpi":
+        from .reward import make_kpi_reward
+        venv = make_kpi_reward(venv, **(reward_kwargs or {}))
+    return VecMonitor(venv, filename=str(monitor_file) if monitor_file else None,
+                      info_keywords=("kpi_backward_whirl", "kpi_peak_contact_force_N"))
+
+
+@dataclass(frozen=True)
+class Plant:
+    env_id: str
+    obs_names: tuple[str, ...]
+    obs_scale: np.ndarray
+    action_names: tuple[str, ...]
+    discrete: bool
+    control_dt: float
+    clearance: float
+    damping_range: tuple[float, float]     # C_min, C_max [N s/m]
+    current_limit: float                   # [A]
+    pid: tuple[float, float, float]        # built-in PID gains kp [A/m], ki [A/(m s)], kd [A s/m]
+    feedforward: tuple[float, float]       # gravity currents of AMB1, AMB2 (y axes) [A]
+    liftoff_ramp: float                    # [s]
+
+    @classmethod
+    def from_env(cls, env) -> "Plant":
+        u = env.unwrapped if hasattr(env, "unwrapped") else env
+        while hasattr(u, "venv") and not hasattr(u, "envs"):      # SB3 VecEnv wrappers
+            u = u.venv
+        if hasattr(u, "envs") and not hasattr(u, "obs_names"):     # batched VecEnv
+            u = u.envs[0]
+        missing = [n for n in SENSORS if n not in u.obs_names]
+        if missing:
+            raise ValueError(f"controllers need the sensor observations {', '.join(missing)}; "
+                             f"create the environment without full_state=True")
+        s = u.base_scene
+        act = u.actuator
+        return cls(env_id=u.spec.id if u.spec is not None else type(u).__name__,
+                   obs_names=tuple(u.obs_names), obs_scale=np.asarray(u.obs_scale, dtype=np.float64),
+                   action_names=tuple(u.action_names), discrete=bool(u._discrete),
+                   control_dt=float(u.dt), clearance=s.contact.clearance,
+                   damping_range=(s.support.damping_min, s.support.damping_max),
+                   current_limit=s.amb.current_limit, pid=(s.amb.kp, s.amb.ki, s.amb.kd),
+                   feedforward=tuple(act.feedforward) if act is not None else (0.0, 0.0),
+                   liftoff_ramp=s.amb.liftoff_ramp_time)
+
+    # ------------------------------------------------------------------ observations --
+    def index(self, name: str) -> int:
+        try:
+            return self.obs_names.index(name)
+        except ValueError:
+            raise KeyError(f"{self.env_id} has no observation {name!r} "
+                           f"(it has {', '.join(self.obs_names)})") from None
+
+    def get(self, obs: np.ndarray, name: str) -> np.ndarray:
+        """Physical (SI) value of observation ``name`` for each row of ``obs``."""
+        j = self.index(name)
+        return obs[:, j] * self.obs_scale[j]
+
+    def damping_level(self, obs: np.ndarray) -> np.ndarray:
+        """(n, 2) current damper values as commands in [-1, 1]."""
+        lo, hi = self.damping_range
+        c = np.stack([self.get(obs, "damping1"), self.get(obs, "damping2")], axis=1)
+        return np.clip(2.0 * (c - lo) / (hi - lo) - 1.0, -1.0, 1.0)
+
+    def power_available(self, obs: np.ndarray) -> np.ndarray:
+        if "amb_power" not in self.obs_names:
+            return np.zeros(len(obs), dtype=bool)
+        return self.get(obs, "amb_power") > 0.5
+
+    # --------------------------------------------------------------------- actions --
+    @property
+    def channels(self) -> tuple[str, ...]:
+        ch = []
+        if "damping1" in self.action_names:
+            ch.append("damping")
+        if "levitate" in self.action_names:
+            ch.append("levitate")
+        if CURRENT_NAMES[0] in self.action_names:
+            ch.append("currents")
+        return tuple(ch)
+
+    @property
+    def continuous_currents(self) -> bool:
+        return CURRENT_NAMES[0] in self.action_names
+
+    def compose(self, n: int, commands: dict, hold_damping: np.ndarray | None = None) -> np.ndarray:
+        """The env action for each of n environments from channel commands (module docstring).
+
+        ``hold_damping`` (n, 2) is the passive damper command used when ``damping`` is not given.
+        """
+        if self.discrete:
+            lev = commands.get("levitate")
+            return (np.zeros(n, dtype=np.int64) if lev is None
+                    else (np.asarray(lev) > 0.5).astype(np.int64))
+        a = np.zeros((n, len(self.action_names)), dtype=np.float32)
+        names = self.action_names
+        if "damping1" in names:
+            d = commands.get("damping", hold_damping)
+            if d is not None:
+                a[:, names.index("damping1")] = d[:, 0]
+                a[:, names.index("damping2")] = d[:, 1]
+        if "levitate" in names:
+            lev = commands.get("levitate")
+            a[:, names.index("levitate")] = -1.0 if lev is None else np.where(np.asarray(lev) > 0.5, 1.0, -1.0)
+        if CURRENT_NAMES[0] in names and commands.get("currents") is not None:
+            for j, name in enumerate(CURRENT_NAMES):
+                a[:, names.index(name)] = commands["currents"][:, j]
+        return np.clip(a, -1.0, 1.0)

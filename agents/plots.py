@@ -1,0 +1,154 @@
+"""Figures of the agents layer: learning curves, policy-vs-passive episodes, benchmark charts."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+
+def _plt():
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    return plt
+
+
+def plot_learning_curve(history: list[dict], path: Path, title: str) -> Path | None:
+    """Evaluation return (± std) and failure rate (whirl, stator contact) against steps."""
+    if not history:
+        return None
+    plt = _plt()
+    steps = np.array([h["timesteps"] for h in history])
+    mean = np.array([h["mean_reward"] for h in history])
+    std = np.array([h["std_reward"] for h in history])
+    fig, ax = plt.subplots(figsize=(7, 4))
+    ax.plot(steps, mean, "o-", label="evaluation return")
+    ax.fill_between(steps, mean - std, mean + std, alpha=0.2)
+    ax.set_xlabel("environment steps")
+    ax.set_ylabel("return")
+    if any("mean_failure" in h for h in history):
+        ax2 = ax.twinx()
+        ax2.plot(steps, [h.get("mean_failure", np.nan) for h in history], "s--", color="C3",
+                 label="failure rate")
+        ax2.set_ylabel("failure rate (whirl, stator contact, overload)", color="C3")
+        ax2.set_ylim(-0.05, 1.05)
+    ax.set_title(title)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return Path(path)
+
+
+def _plane_xy(ep, k: int):
+    names = list(ep.obs_names)
+    return ep.obs[:, names.index(f"x{k}")], ep.obs[:, names.index(f"y{k}")]
+
+
+def plot_episode_comparison(ep, passive, name: str, out: Path) -> list[Path]:
+    """Orbits at both sensor planes, contact force and actions: ``name`` against passive."""
+    plt = _plt()
+    out = Path(out)
+    runs = [(name, ep, "C0")] + ([("passive", passive, "C7")] if passive is not None else [])
+    paths = []
+
+    fig, axes = plt.subplots(1, 2, figsize=(10, 5))
+    for k, ax in enumerate(axes, start=1):
+        for label, e, color in runs[::-1]:
+            x, y = _plane_xy(e, k)
+            ax.plot(x * 1e6, y * 1e6, color=color, lw=0.7, label=label)
+        ax.set_aspect("equal")
+        ax.set_xlabel("x [µm]")
+        ax.set_ylabel("y [µm]")
+        ax.set_title(f"orbit at sensor plane {k}")
+        ax.grid(alpha=0.3)
+        ax.legend(loc="upper right", fontsize=8)
+    fig.suptitle(f"{name} vs passive (seed {ep.seed})")
+    fig.tight_layout()
+    paths.append(out / "orbits.png")
+    fig.savefig(paths[-1], dpi=110)
+    plt.close(fig)
+
+    fig, ax = plt.subplots(figsize=(9, 4))
+    for label, e, color in runs[::-1]:
+        f = e.contact_force
+        for j in range(f.shape[1]):
+            ax.plot(e.t * 1e3, f[:, j], color=color, lw=0.8, ls="-" if j == 0 else "--",
+                    label=label if f.shape[1] == 1 else f"{label} RB{j + 1}")
+    ax.set_xlabel("time since the episode start [ms]")
+    ax.set_ylabel("contact force [N]")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    ax.set_title(f"contact force: {name} vs passive (seed {ep.seed})")
+    fig.tight_layout()
+    paths.append(out / "contact_force.png")
+    fig.savefig(paths[-1], dpi=110)
+    plt.close(fig)
+
+    if ep.actions is not None and ep.actions.size:
+        fig, ax = plt.subplots(figsize=(9, 3.5))
+        for j in range(ep.actions.shape[1]):
+            ax.step(ep.t * 1e3, ep.actions[:, j], where="post", lw=0.8, label=f"action[{j}]")
+        ax.set_xlabel("time since the episode start [ms]")
+        ax.set_ylabel("action")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+        ax.set_title(f"actions of {name}")
+        fig.tight_layout()
+        paths.append(out / "actions.png")
+        fig.savefig(paths[-1], dpi=110)
+        plt.close(fig)
+    return paths
+
+
+def plot_benchmark(report: dict, out: Path) -> list[Path]:
+    """Score per controller and task, whirl map (controller x scenario), peak contact force."""
+    plt = _plt()
+    out = Path(out)
+    paths = []
+    board = report["leaderboard"]
+    tasks = list(dict.fromkeys(e["task"] for e in board))
+
+    fig, axes = plt.subplots(1, len(tasks), figsize=(5 * len(tasks), 4), squeeze=False)
+    for ax, task in zip(axes[0], tasks):
+        es = [e for e in board if e["task"] == task]
+        ax.barh([e["controller"] for e in es][::-1], [e["score"] for e in es][::-1],
+                color=["C2" if e["controller"].split("-")[0] in ("ppo", "sac", "td3") else "C0"
+                       for e in es][::-1])
+        ax.axvline(0.0, color="k", lw=0.8)
+        ax.set_xlabel("overall score (passive = 0, higher is better)")
+        ax.set_title(task)
+        ax.grid(axis="x", alpha=0.3)
+    fig.tight_layout()
+    paths.append(out / "score.png")
+    fig.savefig(paths[-1], dpi=110)
+    plt.close(fig)
+
+    rows = report["rows"]
+    for key, fname, label, fmt in (("backward_whirl", "whirl_map.png", "backward-whirl rate", ".2f"),
+                                   ("peak_contact_force_N", "peak_force.png",
+                                    "peak contact force [kN]", ".1f")):
+        fig, axes = plt.subplots(len(tasks), 1, figsize=(12, 2.2 + 0.5 * len(board)), squeeze=False)
+        for ax, task in zip(axes[:, 0], tasks):
+            ctrls = [e["controller"] for e in board if e["task"] == task]
+            scen = list(dict.fromkeys(r["scenario"] for r in rows if r["task"] == task))
+            M = np.full((len(ctrls), len(scen)), np.nan)
+            for r in rows:
+                if r["task"] == task:
+                    v = r[key] / (1e3 if key == "peak_contact_force_N" else 1.0)
+                    M[ctrls.index(r["controller"]), scen.index(r["scenario"])] = v
+            vmax = 1.0 if key == "backward_whirl" else np.nanmax(M)
+            im = ax.imshow(M, aspect="auto", cmap="Reds", vmin=0.0, vmax=vmax)
+            for i in range(M.shape[0]):
+                for j in range(M.shape[1]):
+                    ax.text(j, i, format(M[i, j], fmt), ha="center", va="center", fontsize=7,
+                            color="white" if M[i, j] > 0.6 * vmax else "black")
+            ax.set_yticks(range(len(ctrls)), ctrls)
+            ax.set_xticks(range(len(scen)), scen, rotation=30, ha="right", fontsize=7)
+            ax.set_title(f"{task}: {label}")
+            fig.colorbar(im, ax=ax, fraction=0.02)
+        fig.tight_layout()
+        paths.append(out / fname)
+        fig.savefig(paths[-1], dpi=110)
+        plt.close(fig)
+    return paths

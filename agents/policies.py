@@ -1,0 +1,184 @@
+"""Learned policies (SB3 model + VecNormalize statistics) and name resolution for the CLI.
+
+A learned policy is a directory written by ``rotordrop train`` (``model.zip``,
+``vecnormalize.pkl``, ``config.yaml``), a model zip with those files next to it, or a policy
+shipped in ``agents/policies/`` (``<name>.zip``, ``<name>.pkl``, ``<name>.json``; the name
+starts with the algorithm: ``ppo-damping``). It answers ``predict`` like a controller.
+"""
+from __future__ import annotations
+
+import json
+import pickle
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+
+from .controllers import BASELINES, make_baseline
+from .plant import Plant
+from .residual import RESIDUAL_SCALE
+
+ALGO_NAMES = ("ppo", "sac", "td3")
+
+
+def shipped_dir() -> Path:
+    return Path(str(resources.files("agents") / "policies"))
+
+
+def shipped_names() -> list[str]:
+    return sorted(p.stem for p in shipped_dir().glob("*.json")
+                  if p.with_suffix(".zip").is_file())
+
+
+@dataclass
+class LearnedPolicy:
+    """A trained model with its observation normalisation; ``predict`` as in SB3."""
+    name: str
+    algo: str
+    env_id: str
+    env_kwargs: dict
+    model: object
+    vecnormalize: object | None
+    meta: dict = field(default_factory=dict)
+    residual: str | None = None          # baseline whose action the policy corrects
+    base: object | None = None
+
+    def bound(self, plant: Plant) -> "LearnedPolicy":
+        """Ready to drive the environment described by ``plant`` (builds the residual's base)."""
+        if self.residual is not None:
+            self.base = make_baseline(self.residual, plant)
+        return self
+
+    def predict(self, observation, state=None, episode_start=None, deterministic: bool = True):
+        raw = np.asarray(observation, dtype=np.float32)
+        obs = self.vecnormalize.normalize_obs(raw) if self.vecnormalize is not None else raw
+        action, state = self.model.predict(obs, state=state, episode_start=episode_start,
+                                           deterministic=deterministic)
+        if self.residual is not None:
+            if self.base is None:
+                raise RuntimeError(f"{self.name} corrects the {self.residual} controller: call "
+                                   f".bound(Plant.from_env(env)) before predict")
+            b, _ = self.base.predict(raw, episode_start=episode_start)
+            action = np.clip(b + RESIDUAL_SCALE * action, -1.0, 1.0).astype(np.float32)
+        return action, state
+
+    def reset(self, n: int, which=None) -> None:
+        """MLP policies are stateless; a residual's base controller starts new episodes."""
+        if self.base is not None:
+            self.base.reset(n, which)
+
+    @classmethod
+    def load(cls, path: str | Path, name: str | None = None) -> "LearnedPolicy":
+        path = Path(path)
+        if path.is_dir():
+            model_path = path / "model.zip"
+            vn_path = path / "vecnormalize.pkl"
+            meta = _read_meta(path / "config.yaml")
+        elif path.suffix == ".zip":
+            model_path = path
+            vn_path = next((p for p in (path.with_suffix(".pkl"), path.parent / "vecnormalize.pkl")
+                            if p.is_file()), path.with_suffix(".pkl"))
+            meta = _read_meta(path.with_suffix(".json")) or _read_meta(path.parent / "config.yaml")
+        else:
+            raise FileNotFoundError(f"{path} is neither a training directory nor a model .zip")
+        if not model_path.is_file():
+            raise FileNotFoundError(f"no model at {model_path}")
+        algo = meta.get("algo") or _algo_from_zip(model_path)
+        env_id = meta.get("env_id")
+        if env_id is None:
+            raise FileNotFoundError(f"cannot tell which environment {model_path} was trained on: "
+                                    f"no config.yaml or .json next to it")
+        env_kwargs = dict(meta.get("env_kwargs") or meta.get("hyperparams", {}).get("env_kwargs") or {})
+        from .train import _algo_class
+        model = _algo_class(algo).load(str(model_path), device="cpu")
+        vn = None
+        if vn_path.is_file():
+            with open(vn_path, "rb") as fh:
+                vn = pickle.load(fh)
+            vn.training = False
+        task = env_id.split("-")[1].lower() if env_id.count("-") >= 2 else "policy"
+        residual = meta.get("residual") or meta.get("hyperparams", {}).get("residual")
+        return cls(name or meta.get("name") or f"{algo}-{task}", algo, env_id, env_kwargs, model,
+                   vn, meta, residual)
+
+
+def _read_meta(path: Path) -> dict:
+    if not path.is_file():
+        return {}
+    if path.suffix == ".json":
+        return json.loads(path.read_text())
+    from .hyperparams import _yaml
+    return _yaml().safe_load(path.read_text()) or {}
+
+
+def _algo_from_zip(path: Path) -> str:
+    for a in ALGO_NAMES:
+        if a in path.stem.lower():
+            return a
+    raise ValueError(f"cannot tell the algorithm of {path}: name it <algo>-..., or keep the "
+                     f"config.yaml written by rotordrop train next to it")
+
+
+def load_shipped(name: str) -> LearnedPolicy:
+    path = shipped_dir() / f"{name}.zip"
+    if not path.is_file():
+        raise KeyError(f"no shipped policy {name!r}; shipped: {', '.join(shipped_names()) or 'none'}")
+    return LearnedPolicy.load(path, name=name)
+
+
+def resolve(spec: str, plant: Plant | None = None):
+    """A baseline name, a shipped policy name or a path -> (controller-or-policy, env_id | None).
+
+    Baselines need the ``plant`` of the environment they will drive.
+    """
+    if spec in BASELINES:
+        if plant is None:
+            return None, None
+        return make_baseline(spec, plant), None
+    if spec in shipped_names():
+        pol = load_shipped(spec)
+        return (pol.bound(plant) if plant is not None else pol), pol.env_id
+    if Path(spec).exists():
+        pol = LearnedPolicy.load(spec)
+        return (pol.bound(plant) if plant is not None else pol), pol.env_id
+    raise KeyError(f"--policy {spec!r} is not a baseline ({', '.join(BASELINES)}), a shipped "
+                   f"policy ({', '.join(shipped_names()) or 'none shipped'}) or an existing path")
+
+
+def ship_policy(run_dir: str | Path, name: str, which: str = "final", dest: Path | None = None,
+                notes: str = "", command: str | None = None) -> Path:
+    """Copy a training run's model and statistics into ``agents/policies/<name>.*``.
+
+    ``which`` = ``final`` (``model.zip``) or ``best`` (``best/best_model.zip``). The JSON records
+    the command and seed that reproduce the run (``command`` overrides the recorded one, e.g.
+    when the run's ``--config`` has become the shipped default), its training time and a
+    learning-curve summary.
+    """
+    import shutil
+    run = Path(run_dir)
+    dest = Path(dest) if dest is not None else shipped_dir()
+    algo = name.split("-")[0]
+    if algo not in ALGO_NAMES:
+        raise ValueError(f"a shipped policy's name starts with its algorithm ({', '.join(ALGO_NAMES)}), "
+                         f"got {name!r}")
+    model, vn = ((run / "model.zip", run / "vecnormalize.pkl") if which == "final"
+                 else (run / "best" / "best_model.zip", run / "best" / "vecnormalize.pkl"))
+    info = json.loads((run / "training.json").read_text())
+    shutil.copyfile(model, dest / f"{name}.zip")
+    shutil.copyfile(vn, dest / f"{name}.pkl")
+    curve = info.get("learning_curve", [])
+    summary = [{k: (round(v, 4) if isinstance(v, float) else v) for k, v in h.items()
+                if k in ("timesteps", "mean_reward", "mean_failure", "mean_backward_whirl",
+                         "mean_peak_contact_force_N", "mean_relevitated")} for h in curve]
+    import re
+    command = command or re.sub(r"--out \S+", f"--out runs/{name}", info["command"])
+    meta = dict(name=name, algo=info["algo"], env_id=info["env_id"],
+                env_kwargs=info["hyperparams"].get("env_kwargs", {}), model=which,
+                command=command, seed=info["seed"], timesteps=info["timesteps"],
+                training_wall_time_s=round(info["wall_time_s"], 1),
+                steps_per_s=round(info["steps_per_s"], 1) if info.get("steps_per_s") else None,
+                threads=info.get("threads"), versions=info.get("versions"),
+                hyperparams=info["hyperparams"], learning_curve=summary, notes=notes)
+    (dest / f"{name}.json").write_text(json.dumps(meta, indent=1))
+    return dest / f"{name}.zip"

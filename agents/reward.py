@@ -1,0 +1,73 @@
+"""A training reward aligned with the benchmark's KPIs (config key ``reward: kpi``).
+
+The environments' own reward sums per-step penalties (whirl revolutions, contact force,
+displacement, effort). The benchmark scores episode *maxima* instead: the whirl verdict, the peak
+contact force and the maximum displacement (:mod:`agents.score`). Agents trained on the per-step
+reward found that lowering the support damping once a whirl had started lowered the summed
+penalties while it raised the peak force. :class:`KpiReward` replaces the reward by the
+decrease of a potential built from the running episode KPIs (``env.kpis()``),
+
+    Φ_t = w_whirl · min(max_{τ≤t} n_back(τ), 3) / 3 + w_force · F*_t / F_0 + w_disp · D*_t / D_0,
+    r_t = −(Φ_t − Φ_{t−1}),
+
+with n_back the net backward orbit revolutions (3 make a backward whirl), F* the peak contact
+force and D* the maximum displacement so far. The return of an episode is −Φ_T: minus the
+benchmark cost of the episode's KPIs (with fixed references F_0, D_0 instead of the passive
+drop's), so maximising it is what the benchmark rewards, and the reward is dense: it arrives in
+the step in which a new peak or a backward revolution happens. Re-levitation tasks add
+``w_relevitate`` once at re-levitation.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+REVS_FOR_WHIRL = 3.0
+
+
+def kpi_potential(k: dict, revs_max: float, w_whirl: float, w_force: float, w_disp: float,
+                  force_ref: float, disp_ref_um: float) -> float:
+    return (w_whirl * min(revs_max, REVS_FOR_WHIRL) / REVS_FOR_WHIRL
+            + w_force * k["kpi_peak_contact_force_N"] / force_ref
+            + w_disp * k["kpi_max_displacement_um"] / disp_ref_um)
+
+
+def make_kpi_reward(venv, **kwargs):
+    """Wrap an SB3 VecEnv of rotor-drop environments (see module docstring)."""
+    from stable_baselines3.common.vec_env import VecEnvWrapper
+
+    class KpiReward(VecEnvWrapper):
+        def __init__(self, venv, w_whirl: float = 1.0, w_force: float = 0.5, w_disp: float = 0.5,
+                     force_ref: float = 1e4, disp_ref_um: float = 800.0, w_relevitate: float = 1.0):
+            super().__init__(venv)
+            self.w = dict(w_whirl=w_whirl, w_force=w_force, w_disp=w_disp, force_ref=force_ref,
+                          disp_ref_um=disp_ref_um)
+            self.w_relevitate = w_relevitate
+            self.phi = np.zeros(self.num_envs)
+            self.revs = np.zeros(self.num_envs)
+
+        def reset(self):
+            obs = self.venv.reset()
+            self.phi[:] = 0.0
+            self.revs[:] = 0.0
+            return obs
+
+        def step_wait(self):
+            obs, _, dones, infos = self.venv.step_wait()
+            running = self.venv.env_method("kpis")
+            rewards = np.zeros(self.num_envs, dtype=np.float32)
+            for i in range(self.num_envs):
+                k = infos[i] if dones[i] else running[i]       # a done env is already reset
+                self.revs[i] = max(self.revs[i], k["kpi_whirl_revolutions"])
+                phi = kpi_potential(k, self.revs[i], **self.w)
+                rewards[i] = self.phi[i] - phi
+                if infos[i].get("reward_success", 0.0) > 0.0:
+                    rewards[i] += self.w_relevitate
+                if dones[i]:
+                    self.phi[i] = 0.0
+                    self.revs[i] = 0.0
+                else:
+                    self.phi[i] = phi
+            return obs, rewards, dones, infos
+
+    return KpiReward(venv, **kwargs)
+

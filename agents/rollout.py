@@ -1,0 +1,76 @@
+"""Run a controller or a learned policy for whole episodes and collect the episode KPIs.
+
+``run_episodes`` is what ``evaluate`` and ``benchmark`` use: one environment per scenario,
+episodes seeded ``seeds[i]``, the KPIs taken from the final step's ``info`` (``kpi_*``), and,
+when asked, the time series needed for the orbit and force plots.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from .plant import Plant, make_env
+
+
+@dataclass
+class Episode:
+    """One finished episode: KPIs (``kpi_`` prefix removed), return, and optional time series."""
+    seed: int
+    kpis: dict
+    reward: float
+    length: int
+    t: np.ndarray | None = None                 # time since the fault [s]
+    obs: np.ndarray | None = None               # physical (SI) observations, (steps, n_obs)
+    actions: np.ndarray | None = None
+    contact_force: np.ndarray | None = None     # per step, (steps, n) [N]
+    obs_names: tuple[str, ...] = ()
+    extra: dict = field(default_factory=dict)
+
+
+def final_kpis(info: dict) -> dict:
+    return {k[4:]: (v.item() if isinstance(v, np.generic) else v)
+            for k, v in info.items() if k.startswith("kpi_")}
+
+
+def run_episodes(env_id: str, make_actor: Callable[[Plant], object], seeds, env_kwargs=None,
+                 record: bool = False) -> list[Episode]:
+    """Run one episode per seed with the actor built by ``make_actor(plant)``."""
+    env = make_env(env_id, **(env_kwargs or {}))
+    try:
+        plant = Plant.from_env(env)
+        actor = make_actor(plant)
+        return [_episode(env, plant, actor, int(s), record) for s in seeds]
+    finally:
+        env.close()
+
+
+def _episode(env, plant: Plant, actor, seed: int, record: bool) -> Episode:
+    obs, info = env.reset(seed=seed)
+    if hasattr(actor, "reset"):
+        actor.reset(1)
+    total, steps = 0.0, 0
+    rec_obs, rec_act, rec_f = [], [], []
+    start = np.ones(1, dtype=bool)
+    while True:
+        action, _ = actor.predict(obs[None, :], episode_start=start, deterministic=True)
+        start = np.zeros(1, dtype=bool)
+        a = action[0]
+        if record:
+            rec_obs.append(obs.astype(np.float64) * plant.obs_scale)
+            rec_act.append(np.atleast_1d(np.asarray(a, dtype=np.float64)))
+        obs, reward, terminated, truncated, info = env.step(a)
+        if record:
+            rec_f.append(np.atleast_1d(np.asarray(info.get("contact_force_N", np.nan), dtype=float)))
+        total += float(reward)
+        steps += 1
+        if terminated or truncated:
+            break
+    ep = Episode(seed, final_kpis(info), total, steps, obs_names=plant.obs_names)
+    if record:
+        ep.t = np.arange(steps) * plant.control_dt
+        ep.obs = np.array(rec_obs)
+        ep.actions = np.array(rec_act)
+        ep.contact_force = np.array(rec_f)
+    return ep
