@@ -47,7 +47,7 @@ class RotorDropEnv(gym.Env):
     terminate_on_failure        True        end at the stator or at a bearing overload
     w_whirl, w_contact,         10, 0.1,    reward weights (see Reward)
     w_displacement, w_effort,   0.1, 0.01,
-    w_success, w_failure        10, 1.0
+    w_success, w_failure        10, 10
     render_mode                 None        "rgb_array" or "human"
     ==========================  ==========  ====================================================
 
@@ -63,7 +63,8 @@ class RotorDropEnv(gym.Env):
     effort         -w_effort x mean squared normalised command (damper (C-C_min)/(C_max-C_min),
                    AMB control currents / current limit)
     success        +w_success once, when re-levitation is achieved (re-levitation envs)
-    failure        -w_failure x remaining control steps, on termination (failing never pays)
+    failure        -w_failure x remaining control steps, on termination (failing never pays:
+                   10 per step is above the per-step cost of riding out a whirl, about 3)
     =============  ========================================================================
 
     Episode end: ``terminated`` when the rotor reaches the AMB stator (radial displacement
@@ -82,7 +83,7 @@ class RotorDropEnv(gym.Env):
                  samples_per_step: int = 5, relevitation_hold: float = 0.02,
                  terminate_on_failure: bool = True, w_whirl: float = 10.0,
                  w_contact: float = 0.1, w_displacement: float = 0.1, w_effort: float = 0.01,
-                 w_success: float = 10.0, w_failure: float = 1.0, render_mode: str | None = None):
+                 w_success: float = 10.0, w_failure: float = 10.0, render_mode: str | None = None):
         self._check_options(command, power_return_time, render_mode)
         _positive("control_dt", control_dt, 1e-6, 0.1)
         _positive("episode_time", episode_time, control_dt, 100.0)

@@ -155,7 +155,8 @@ def observe(t, y, P, I, U, C, M, aux, cur, scale, obs):
     obs[n] = t - C[C_T_FAULT]
     n += 1
     if int(C[C_LEV]) != LEV_NONE:
-        obs[n] = M[M_POWER]
+        # power available for the next action (M_POWER latches only when that action is applied)
+        obs[n] = 1.0 if t >= C[C_T_POWER] - 1e-9 * C[C_DT] else 0.0
         obs[n + 1] = M[M_CTRL_ON]
         for j in range(4):
             obs[n + 2 + j] = cur[j]

@@ -118,15 +118,20 @@ def test_stator_contact_terminates_with_the_failure_penalty():
     env = gym.make("RotorDrop-Passive-v0", overrides={"contact.friction": 0.5}, episode_time=0.3)
     env.reset(seed=0)
     n = 0
+    worst_step = 0.0                  # most negative reward of a step that did not terminate
     while True:
         _, r, term, trunc, info = env.step(np.zeros(1, np.float32))
         n += 1
+        if not term:
+            worst_step = min(worst_step, r)
         if term or trunc:
             break
     # mu = 0.5: the whirling orbit passes the 600 um stator gap (the drop alone reaches ~450 um)
     assert term and not trunc and info["kpi_stator_contact"]
     assert info["kpi_max_displacement_um"] > 600.0 and n < 300
-    assert info["reward_failure"] == pytest.approx(-(300 - n))
+    assert info["reward_failure"] == pytest.approx(-10.0 * (300 - n))
+    # ending early never pays: the failure penalty per step beats the whirl penalties it cuts short
+    assert -info["reward_failure"] / (300 - n) > -worst_step
     assert sum(info[f"reward_{k}"] for k in rotordrop_env.env.REWARD_TERMS) == pytest.approx(r)
 
 

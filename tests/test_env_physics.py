@@ -147,6 +147,8 @@ def test_direct_currents_act_after_power_returns_only():
         cur = obs[names.index("i1y")] * u.obs_scale[names.index("i1y")]
         if k < 49:                                     # power returns at 50 ms
             assert cur == 0.0 and obs[names.index("amb_power")] == 0.0
+        if k == 49:                                    # observed as soon as the next action can use it
+            assert obs[names.index("amb_power")] == 1.0
     assert cur == pytest.approx(u.scene.amb.current_limit)
     # full lifting current from the bottom: the rotor rises off the retainer bearings
     assert obs[names.index("y1")] * u.obs_scale[names.index("y1")] > -u.scene.contact.clearance
