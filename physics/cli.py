@@ -14,6 +14,7 @@ import sys
 from pathlib import Path
 
 COMMAND_MODULES = ("physics.study", "physics.accuracy", "agents.cli")
+OPTIONAL_RL_MODULES = ("gymnasium", "stable_baselines3", "torch", "tensorboard", "yaml")
 
 
 def add_scene_args(p: argparse.ArgumentParser) -> None:
@@ -120,6 +121,13 @@ def main(argv: list[str] | None = None) -> int:
     except (SceneError, IntegrationError) as exc:
         print(f"rotordrop: error: {exc}", file=sys.stderr)
         return 2
+    except ModuleNotFoundError as exc:
+        if exc.name and exc.name.split(".")[0] in OPTIONAL_RL_MODULES:
+            print(f"rotordrop: error: `rotordrop {args.command}` needs {exc.name.split('.')[0]}, "
+                  "part of the rl extra: python3 -m pip install -c constraints.txt -e \".[rl]\"",
+                  file=sys.stderr)
+            return 2
+        raise
 
 
 if __name__ == "__main__":
