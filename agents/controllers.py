@@ -25,9 +25,9 @@ Baselines (spec §5-6):
     ``command="discrete"``: switches the environment's built-in PID (the same law, evaluated
     continuously inside the integrator, same ramp) on as soon as power is back.
 
-The PID starts when the ``amb_power`` observation shows the power, one control step after it
-returned (the environment's observation lags its power flag by one step); the built-in switch
-needs no observation and engages in the very step the power returns.
+The PID starts when the ``amb_power`` observation shows the power (from the control step whose
+action can first use it); the built-in switch needs no observation and engages in the very step
+the power returns.
 """
 from __future__ import annotations
 
@@ -162,8 +162,7 @@ class BuiltinRelevitate(Controller):
     """Switches the environment's built-in PID (ramped lift-off) on as soon as power is back.
 
     It commands "on" at every step: the environment ignores the command until power returns
-    and then engages the controller at once (waiting for the ``amb_power`` observation would
-    lose one control step, since the observation shows the power one step after it is back).
+    and then engages the controller at once, without reading the ``amb_power`` observation.
     """
 
     name = "builtin-relevitate"
