@@ -8,7 +8,7 @@ import math
 import numpy as np
 
 from .ball_bearing import ball_forces
-from .model import (I_PLANES, J_HVX, J_HX, J_SVX, J_SX, N_PLANE_IDX, P_CAGE, P_G, P_HALF_PLAY,
+from .model import (I_PLANES, J_HX, J_SX, N_PLANE_IDX, P_G, P_HALF_PLAY,
                     P_KLIN, P_KS, P_KTOT, P_MH, P_MS, P_NB, P_UB_PHASE, RB_LINEAR, RB_SM, F_RB, F_AMB,
                     AMB_LINEAR, S_PHI, S_VX, S_X, S_W, Model, AMB_ACTUATOR, AMB_AXES, I_AMB_INT,
                     I_AMB_FILT, I_AMB_COIL, P_AMB_IFF1, I_CS)

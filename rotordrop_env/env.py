@@ -178,7 +178,7 @@ class RotorDropEnv(gym.Env):
         self._needs_reset = True
 
     def _configure_static(self, hold: float, terminate: bool) -> None:
-        b, s = self._b, self.base_scene
+        b = self._b
         C = b.C
         C[K.C_DT] = self.dt
         C[K.C_DAMP] = 1.0 if self._damping else 0.0

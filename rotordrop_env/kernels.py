@@ -20,11 +20,9 @@ import numba
 
 from physics._jit import njit, njit_parallel
 from physics.integrate import integrate_segment
-from physics.model import (A_FR, A_WS, I_AMB_FILT, I_AMB_INT, I_CS, I_PLANES, J_HVX, J_HX, J_SVX,
-                           J_SX, N_AUX_PLANE, N_PLANE_IDX, P_CLR, P_Z_AMB1, P_Z_RB1, S_A,
-                           S_B, S_VA, S_VB, S_VX, S_VY, S_W, S_X, S_Y, U_AMB_DIRECT, U_AMB_POWER,
-                           U_CS1, U_ICMD, U_REF0, U_T_ON, amb_currents, rhs)
-from physics.rotor import axis_at
+from physics.model import (A_FR, A_WS, I_AMB_FILT, I_AMB_INT, I_CS, N_AUX_PLANE, P_CLR,
+                           P_Z_AMB1, P_Z_RB1, S_W, U_AMB_DIRECT, U_AMB_POWER, U_CS1, U_ICMD,
+                           U_REF0, U_T_ON, amb_currents, axis_motion, rhs, sleeve_motion)
 
 # ------------------------------------------------------------------------ configuration C --
 (C_DT, C_T_FAULT, C_T_END, C_T_POWER, C_DAMP, C_LEV, C_A_DAMP, C_A_LEV, C_N_ACT, C_N_SUB,
@@ -47,25 +45,9 @@ TWO_PI = 2.0 * math.pi
 
 
 @njit
-def _sleeve(y, I, k):
-    """Sleeve centre and velocity at retainer plane k (housing, or ground, when rigid)."""
-    base = I_PLANES + k * N_PLANE_IDX
-    i = I[base + J_SX]
-    if i >= 0:
-        return y[i], y[i + 1], y[I[base + J_SVX]], y[I[base + J_SVX] + 1]
-    i = I[base + J_HX]
-    if i >= 0:
-        return y[i], y[i + 1], y[I[base + J_HVX]], y[I[base + J_HVX] + 1]
-    return 0.0, 0.0, 0.0, 0.0
-
-
-@njit
-def _plane(y, I, z):
-    """Rotor axis position and velocity at axial station z."""
-    x, yy, a, b = y[I[S_X]], y[I[S_Y]], y[I[S_A]], y[I[S_B]]
-    px, py = axis_at(z, x, yy, a, b)
-    vx, vy = axis_at(z, y[I[S_VX]], y[I[S_VY]], y[I[S_VA]], y[I[S_VB]])
-    return px, py, vx, vy
+def _power_back(t, C):
+    """AMB power has returned by time t (control-step round-off tolerated)."""
+    return t >= C[C_T_POWER] - 1e-9 * C[C_DT]
 
 
 @njit
@@ -89,7 +71,7 @@ def _switch_on(t, y, P, I, U):
     U[U_AMB_DIRECT] = 0.0
     U[U_T_ON] = t
     for j in range(4):
-        px, py, _, _ = _plane(y, I, P[P_Z_AMB1 + j // 2])
+        px, py, _, _ = axis_motion(y, I, P[P_Z_AMB1 + j // 2])
         U[U_REF0 + j] = px if j % 2 == 0 else py
         y[I[I_AMB_INT] + j] = 0.0
         y[I[I_AMB_FILT] + j] = 0.0
@@ -113,7 +95,7 @@ def apply_action(a, y, P, I, U, C, M):
     lev = int(C[C_LEV])
     if lev != LEV_NONE:
         t = M[M_T]
-        if M[M_POWER] == 0.0 and t >= C[C_T_POWER] - 1e-9 * C[C_DT]:
+        if M[M_POWER] == 0.0 and _power_back(t, C):
             M[M_POWER] = 1.0
         o = int(C[C_A_LEV])
         if M[M_POWER] > 0.0:
@@ -141,7 +123,7 @@ def observe(t, y, P, I, U, C, M, aux, cur, scale, obs):
             n += 1
     else:
         for k in range(2):
-            px, py, vx, vy = _plane(y, I, P[P_Z_AMB1 + k])
+            px, py, vx, vy = axis_motion(y, I, P[P_Z_AMB1 + k])
             obs[n], obs[n + 1], obs[n + 2], obs[n + 3] = px, py, vx, vy
             n += 4
         obs[n] = y[I[S_W]]
@@ -156,7 +138,7 @@ def observe(t, y, P, I, U, C, M, aux, cur, scale, obs):
     n += 1
     if int(C[C_LEV]) != LEV_NONE:
         # power available for the next action (M_POWER latches only when that action is applied)
-        obs[n] = 1.0 if t >= C[C_T_POWER] - 1e-9 * C[C_DT] else 0.0
+        obs[n] = 1.0 if _power_back(t, C) else 0.0
         obs[n + 1] = M[M_CTRL_ON]
         for j in range(4):
             obs[n + 2 + j] = cur[j]
@@ -224,8 +206,8 @@ def step_one(a, y, P, I, U, atol, work, t_sub, Y_sub, aux, cur, C, M, scale, obs
         for k in range(2):
             fr = aux[k * N_AUX_PLANE + A_FR]
             f_step = max(f_step, fr)
-            px, py, pvx, pvy = _plane(ys, I, P[P_Z_RB1 + k])
-            sx, sy, svx, svy = _sleeve(ys, I, k)
+            px, py, pvx, pvy = axis_motion(ys, I, P[P_Z_RB1 + k])
+            sx, sy, svx, svy = sleeve_motion(ys, I, k)
             r_abs = math.sqrt(px * px + py * py)
             disp_step = max(disp_step, r_abs)
             ex, ey = px - sx, py - sy
@@ -237,7 +219,7 @@ def step_one(a, y, P, I, U, atol, work, t_sub, Y_sub, aux, cur, C, M, scale, obs
                 back += 0.5 * db
             if fr > 0.0 or r_abs >= C[C_RELEV_RADIUS]:
                 ok = False
-            ax, ay, _, _ = _plane(ys, I, P[P_Z_AMB1 + k])
+            ax, ay, _, _ = axis_motion(ys, I, P[P_Z_AMB1 + k])
             if ax * ax + ay * ay >= C[C_GAP] * C[C_GAP]:
                 stator = True
         if lev != LEV_NONE and M[M_RELEV] == 0.0:
