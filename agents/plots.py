@@ -45,6 +45,19 @@ def _plane_xy(ep, k: int):
     return ep.obs[:, names.index(f"x{k}")], ep.obs[:, names.index(f"y{k}")]
 
 
+def _finish_time_plot(plt, fig, ax, ylabel: str, title: str, path: Path) -> Path:
+    """Label, grid and legend a plot against episode time, save it (PNG) and close it."""
+    ax.set_xlabel("time since the episode start [ms]")
+    ax.set_ylabel(ylabel)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    ax.set_title(title)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return Path(path)
+
+
 def plot_episode_comparison(ep, passive, name: str, out: Path) -> list[Path]:
     """Orbits at both sensor planes, contact force and actions: ``name`` against passive."""
     plt = _plt()
@@ -75,29 +88,16 @@ def plot_episode_comparison(ep, passive, name: str, out: Path) -> list[Path]:
         for j in range(f.shape[1]):
             ax.plot(e.t * 1e3, f[:, j], color=color, lw=0.8, ls="-" if j == 0 else "--",
                     label=label if f.shape[1] == 1 else f"{label} RB{j + 1}")
-    ax.set_xlabel("time since the episode start [ms]")
-    ax.set_ylabel("contact force [N]")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
-    ax.set_title(f"contact force: {name} vs passive (seed {ep.seed})")
-    fig.tight_layout()
-    paths.append(out / "contact_force.png")
-    fig.savefig(paths[-1], dpi=110)
-    plt.close(fig)
+    paths.append(_finish_time_plot(plt, fig, ax, "contact force [N]",
+                                   f"contact force: {name} vs passive (seed {ep.seed})",
+                                   out / "contact_force.png"))
 
     if ep.actions is not None and ep.actions.size:
         fig, ax = plt.subplots(figsize=(9, 3.5))
         for j in range(ep.actions.shape[1]):
             ax.step(ep.t * 1e3, ep.actions[:, j], where="post", lw=0.8, label=f"action[{j}]")
-        ax.set_xlabel("time since the episode start [ms]")
-        ax.set_ylabel("action")
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=8)
-        ax.set_title(f"actions of {name}")
-        fig.tight_layout()
-        paths.append(out / "actions.png")
-        fig.savefig(paths[-1], dpi=110)
-        plt.close(fig)
+        paths.append(_finish_time_plot(plt, fig, ax, "action", f"actions of {name}",
+                                       out / "actions.png"))
     return paths
 
 

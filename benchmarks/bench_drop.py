@@ -20,22 +20,16 @@ import time
 import numpy as np
 
 from physics import load_scene, simulate
+from physics.accuracy import REDUCED
 from physics.model import N_AUX, build_model, rhs
 from physics.simulate import warm_up
 
-EFFECTS_OFF = [
-    ("full model (paper)", {}),
-    ("no EHL film", {"effects.ehl_film": False}),
-    ("no bearing friction torque", {"effects.bearing_friction": False}),
-    ("linear retainer bearing", {"effects.retainer_bearing": "linear"}),
-    ("rigid retainer bearing", {"effects.retainer_bearing": "rigid"}),
-    ("no housing flexibility", {"effects.housing": False}),
-    ("no sleeve inertia", {"effects.sleeve_inertia": False}),
-    ("no unbalance", {"effects.unbalance": False}),
-    ("no gyroscopic coupling", {"effects.gyroscopic": False}),
-    ("kinematic slip", {"effects.friction": "kinematic"}),
-    ("no friction", {"effects.friction": "none"}),
-]
+# the reduced-fidelity scenes of the accuracy study, plus the switches it does not vary
+EFFECTS_OFF = [("full model (paper)", {}), *REDUCED,
+               ("no unbalance", {"effects.unbalance": False}),
+               ("no gyroscopic coupling", {"effects.gyroscopic": False}),
+               ("kinematic slip", {"effects.friction": "kinematic"}),
+               ("no friction", {"effects.friction": "none"})]
 
 
 def ns_per_rhs(scene, samples=400, reps=50) -> float:

@@ -48,23 +48,29 @@ def plot_probability(a: dict, out: Path) -> str:
     return _save(fig, out / "whirl_probability.png")
 
 
-def plot_friction_runs(runs: dict[float, Result], out: Path) -> list[str]:
-    """Orbits (Fig. 3), contact forces (Fig. 4) and sleeve speeds (Fig. 5) at RB1."""
-    mus = sorted(runs)
-    c_um = next(iter(runs.values())).model.scene.contact.clearance * 1e6
-    fig, axes = plt.subplots(1, len(mus), figsize=(3.2 * len(mus), 3.6), constrained_layout=True,
-                             sharex=True, sharey=True)
+def _orbit_row(runs: dict[float, Result], label: str, path: Path, width: float, share: bool) -> str:
+    """One orbit panel at RB1 per run (after the fault) with the clearance circle (Fig. 3)."""
+    vals = sorted(runs)
+    c_um = runs[vals[0]].model.scene.contact.clearance * 1e6
+    fig, axes = plt.subplots(1, len(vals), figsize=(width * len(vals), 3.6 if share else 3.8),
+                             constrained_layout=True, sharex=share, sharey=share)
     axes = np.atleast_1d(axes)
-    for ax, mu in zip(axes, mus):
-        r = runs[mu]
+    for ax, v in zip(axes, vals):
+        r = runs[v]
         o = r.orbit(PLANE)[r.t >= r.t_fault] * 1e6
         ax.plot(o[:, 0], o[:, 1], lw=0.4)
         _circle(ax, c_um)
         ax.set_aspect("equal")
-        ax.set_title(f"μ = {mu:g}" + (" (whirl)" if _whirls(r) else ""), fontsize=9)
+        ax.set_title(f"{label} = {v:g}" + (" (whirl)" if _whirls(r) else ""), fontsize=9)
         ax.set_xlabel("X [µm]")
     axes[0].set_ylabel("Y [µm]")
-    names = [_save(fig, out / "friction_orbits.png")]
+    return _save(fig, path)
+
+
+def plot_friction_runs(runs: dict[float, Result], out: Path) -> list[str]:
+    """Orbits (Fig. 3), contact forces (Fig. 4) and sleeve speeds (Fig. 5) at RB1."""
+    mus = sorted(runs)
+    names = [_orbit_row(runs, "μ", out / "friction_orbits.png", width=3.2, share=True)]
 
     fig, axes = plt.subplots(len(mus), 1, figsize=(9, 1.6 * len(mus) + 0.8), sharex=True,
                              sharey=True, constrained_layout=True)
@@ -113,19 +119,8 @@ def plot_friction_response(a: dict, out: Path) -> str:
 
 def plot_support(runs: dict[float, Result], key: str, out: Path) -> list[str]:
     vals = sorted(runs)
-    c_um = runs[vals[0]].model.scene.contact.clearance * 1e6
-    fig, axes = plt.subplots(1, len(vals), figsize=(3.6 * len(vals), 3.8), constrained_layout=True)
-    for ax, v in zip(np.atleast_1d(axes), vals):
-        r = runs[v]
-        o = r.orbit(PLANE)[r.t >= r.t_fault] * 1e6
-        ax.plot(o[:, 0], o[:, 1], lw=0.4)
-        _circle(ax, c_um)
-        ax.set_aspect("equal")
-        ax.set_title(f"{key} = {v:g}" + (" (whirl)" if _whirls(r) else ""), fontsize=9)
-        ax.set_xlabel("X [µm]")
-    np.atleast_1d(axes)[0].set_ylabel("Y [µm]")
     stem = key.split(".")[1]
-    names = [_save(fig, out / f"{stem}_orbits.png")]
+    names = [_orbit_row(runs, key, out / f"{stem}_orbits.png", width=3.6, share=False)]
 
     fig, axes = plt.subplots(2, 1, figsize=(9, 6), sharex=True, constrained_layout=True)
     for v in vals:
