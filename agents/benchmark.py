@@ -47,7 +47,8 @@ TASKS = {"damping": "RotorDrop-Damping-v0", "relevitate": "RotorDrop-Relevitate-
          "full": "RotorDrop-Full-v0"}
 #: env kwargs of the baselines (the passive reference keeps the AMBs off)
 BASELINE_KWARGS = {"pid-relevitate": {"command": "continuous"},
-                   "builtin-relevitate": {"command": "discrete"}}
+                   "builtin-relevitate": {"command": "discrete"},
+                   "whirl-brake": {"command": "continuous"}}
 
 
 @dataclass(frozen=True)
@@ -138,8 +139,6 @@ def _entries(policies: list[LearnedPolicy]) -> list[Entry]:
     out = []
     for task, env_id in TASKS.items():
         task_policies = [p for p in policies if p.env_id == env_id]
-        if task == "full" and not task_policies:
-            continue
         for name, cls in BASELINES.items():
             kw = dict(BASELINE_KWARGS.get(name, {})) if task != "damping" else {}
             env = make_env(env_id, **kw)
@@ -240,6 +239,7 @@ def _row(entry: Entry, sc: Scenario, eps) -> dict:
                 group=sc.group, friction=sc.friction,
                 backward_whirl=s["backward_whirl_rate"],
                 whirl_revolutions=float(np.mean([d["whirl_revolutions"] for d in k])),
+                peak_whirl_revolutions=float(np.mean([d["peak_whirl_revolutions"] for d in k])),
                 peak_contact_force_N=s["peak_contact_force_N"],
                 max_displacement_um=s["max_displacement_um"],
                 relevitated=s["relevitation_success_rate"],
@@ -318,12 +318,12 @@ def leaderboard_markdown(report: dict) -> str:
                          f"{_fmt(e['whirl_rate_where_passive_whirls'], '.2f')} | "
                          f"{e['force_ratio']:.2f}, {e['max_force_ratio']:.2f} | "
                          f"{e['displacement_ratio']:.2f} | {_fmt(e['relevitation_rate'], '.2f')} |")
-        lines += ["", "| controller | scenario | mu | whirl | revs | peak F [N] | max disp [µm] | "
+        lines += ["", "| controller | scenario | mu | whirl | peak revs | peak F [N] | max disp [µm] | "
                       "relevitated | t_relev [ms] | J |", "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
         for r in [r for r in report["rows"] if r["task"] == task]:
             t = r["relevitation_time_s"]
             lines.append(f"| {r['controller']} | {r['scenario']} | {r['friction']:g} | "
-                         f"{r['backward_whirl']:.2f} | {r['whirl_revolutions']:.1f} | "
+                         f"{r['backward_whirl']:.2f} | {r['peak_whirl_revolutions']:.1f} | "
                          f"{r['peak_contact_force_N']:.0f} | {r['max_displacement_um']:.0f} | "
                          f"{_fmt(r['relevitated'], '.2f')} | {_fmt(t * 1e3 if t is not None else None, '.0f')} | "
                          f"{r.get('cost', float('nan')):.2f} |")

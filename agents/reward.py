@@ -15,7 +15,9 @@ force and D* the maximum displacement so far. The return of an episode is −Φ_
 benchmark cost of the episode's KPIs (with fixed references F_0, D_0 instead of the passive
 drop's), so maximising it is what the benchmark rewards, and the reward is dense: it arrives in
 the step in which a new peak or a backward revolution happens. Re-levitation tasks add
-``w_relevitate`` once at re-levitation.
+``w_relevitate`` once at re-levitation and ``−w_time · Δt / T_episode`` in every step before it,
+so that the episode's return also holds the score's ``(1 − R) + T_R / T_episode`` term
+(re-levitating sooner pays).
 """
 from __future__ import annotations
 
@@ -37,11 +39,14 @@ def make_kpi_reward(venv, **kwargs):
 
     class KpiReward(VecEnvWrapper):
         def __init__(self, venv, w_whirl: float = 1.0, w_force: float = 0.5, w_disp: float = 0.5,
-                     force_ref: float = 1e4, disp_ref_um: float = 800.0, w_relevitate: float = 1.0):
+                     force_ref: float = 1e4, disp_ref_um: float = 800.0, w_relevitate: float = 1.0,
+                     w_time: float = 1.0):
             super().__init__(venv)
             self.w = dict(w_whirl=w_whirl, w_force=w_force, w_disp=w_disp, force_ref=force_ref,
                           disp_ref_um=disp_ref_um)
             self.w_relevitate = w_relevitate
+            dt, horizon = (np.asarray(venv.get_attr(a), dtype=float) for a in ("dt", "episode_time"))
+            self.time_cost = w_time * dt / horizon
             self.phi = np.zeros(self.num_envs)
             self.revs = np.zeros(self.num_envs)
 
@@ -57,11 +62,13 @@ def make_kpi_reward(venv, **kwargs):
             rewards = np.zeros(self.num_envs, dtype=np.float32)
             for i in range(self.num_envs):
                 k = infos[i] if dones[i] else running[i]       # a done env is already reset
-                self.revs[i] = max(self.revs[i], k["kpi_whirl_revolutions"])
+                self.revs[i] = max(self.revs[i], k["kpi_peak_whirl_revolutions"])
                 phi = kpi_potential(k, self.revs[i], **self.w)
                 rewards[i] = self.phi[i] - phi
                 if infos[i].get("reward_success", 0.0) > 0.0:
                     rewards[i] += self.w_relevitate
+                elif "relevitated" in infos[i] and not infos[i]["relevitated"]:
+                    rewards[i] -= self.time_cost[i]
                 if dones[i]:
                     self.phi[i] = 0.0
                     self.revs[i] = 0.0

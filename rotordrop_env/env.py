@@ -320,6 +320,7 @@ class RotorDropEnv(gym.Env):
         relev = bool(M[K.M_RELEV])
         return {"kpi_backward_whirl": bool(M[K.M_WHIRL]),
                 "kpi_whirl_revolutions": float(max(M[K.M_REV1], M[K.M_REV2])),
+                "kpi_peak_whirl_revolutions": float(M[K.M_REV_PEAK]),
                 "kpi_peak_contact_force_N": float(M[K.M_PEAK_F]),
                 "kpi_max_displacement_um": float(M[K.M_MAX_DISP] * 1e6),
                 "kpi_relevitated": relev,

@@ -34,7 +34,7 @@ LEV_NONE, LEV_DISCRETE, LEV_CONTINUOUS = 0, 1, 2
 
 # ------------------------------------------------------------------------------ monitor M --
 (M_T, M_H, M_STEP, M_REV1, M_REV2, M_WHIRL, M_PEAK_F, M_MAX_DISP, M_OK_START, M_RELEV,
- M_RELEV_T, M_EFFORT, M_CTRL_ON, M_POWER, M_NRHS, N_M) = range(16)
+ M_RELEV_T, M_EFFORT, M_CTRL_ON, M_POWER, M_NRHS, M_REV_PEAK, N_M) = range(17)
 
 # ------------------------------------------------------------------------------ outputs --
 (O_REWARD, O_R_WHIRL, O_R_CONTACT, O_R_DISP, O_R_EFFORT, O_R_SUCCESS, O_R_FAILURE, O_FORCE,
@@ -244,7 +244,8 @@ def step_one(a, y, P, I, U, atol, work, t_sub, Y_sub, aux, cur, C, M, scale, obs
     M[M_STEP] += 1.0
     M[M_PEAK_F] = max(M[M_PEAK_F], f_step)
     M[M_MAX_DISP] = max(M[M_MAX_DISP], disp_step)
-    if max(M[M_REV1], M[M_REV2]) >= 3.0:
+    M[M_REV_PEAK] = max(M[M_REV_PEAK], M[M_REV1], M[M_REV2])
+    if M[M_REV_PEAK] >= 3.0:
         M[M_WHIRL] = 1.0
 
     # ---- reward terms ----

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from agents.controllers import (BASELINES, BuiltinRelevitate, MaxDamping, Passive, PidRelevitate,
-                                WhirlSwitch, make_baseline)
+                                WhirlBrake, WhirlSwitch, make_baseline)
 from agents.plant import Plant, make_env
 from agents.rollout import run_episodes
 
@@ -100,3 +100,48 @@ def test_pid_relevitates_after_power_returns(command, cls):
         currents = pid.actions
         assert np.all(currents[power < 0.5] == 0.0)
         assert np.all(np.abs(currents) <= 1.0)
+
+
+def _kpis(env_id, cls, mu, **kw):
+    kw = dict(overrides={"contact.friction": mu}, episode_time=0.2, terminate_on_failure=False, **kw)
+    return run_episodes(env_id, cls, [0], kw)[0].kpis
+
+
+def test_whirl_brake_stops_a_whirl_that_max_damping_does_not():
+    """Full task at mu = 0.46 (passive threshold 0.38; not a benchmark or tuning friction), power
+    back at 50 ms: constant C_max alone lets the orbit turn 3 net backward revolutions (backward
+    whirl); C_max with the whirl brake keeps the peak
+    below 3 revolutions, re-levitates, and its peak contact force stays below passive."""
+    full = "RotorDrop-Full-v0"
+    passive = _kpis(full, Passive, 0.46, command="continuous")
+    brake = _kpis(full, WhirlBrake, 0.46, command="continuous")
+    damping_only = _kpis(full, MaxDamping, 0.46, command="continuous")
+    assert passive["backward_whirl"] and damping_only["backward_whirl"]
+    assert not brake["backward_whirl"] and brake["peak_whirl_revolutions"] < 3.0
+    assert brake["relevitated"]
+    assert brake["peak_contact_force_N"] < passive["peak_contact_force_N"]
+
+
+def test_whirl_brake_relevitates_sooner_than_the_ramped_pid():
+    """Without a lift-off ramp the brake's PD lifts a resting rotor (mu = 0.2) sooner."""
+    kw = dict(power_return_time=0.02)
+    brake = _kpis("RotorDrop-Relevitate-v0", WhirlBrake, 0.2, command="continuous", **kw)
+    builtin = _kpis("RotorDrop-Relevitate-v0", BuiltinRelevitate, 0.2, command="discrete", **kw)
+    assert brake["relevitated"] and builtin["relevitated"]
+    assert brake["relevitation_time_s"] < builtin["relevitation_time_s"] - 0.01
+
+
+def test_whirl_brake_rejects_unknown_gains():
+    env = make_env("RotorDrop-Relevitate-v0", command="continuous", **SHORT)
+    with pytest.raises(TypeError, match="unknown whirl-brake gains"):
+        WhirlBrake(Plant.from_env(env), kq=1.0)
+
+
+def test_peak_whirl_revolutions_latch_the_whirl_verdict():
+    """kpi_backward_whirl is 'the net backward revolutions reached 3 at some time': the peak is
+    at least the final count, and the verdict equals peak >= 3."""
+    for mu in (0.2, 0.6):
+        k = _kpis("RotorDrop-Damping-v0", Passive, mu)
+        assert k["peak_whirl_revolutions"] >= k["whirl_revolutions"] - 1e-12
+        assert k["backward_whirl"] == (k["peak_whirl_revolutions"] >= 3.0)
+    assert k["backward_whirl"]                                     # mu = 0.6 whirls

@@ -1,0 +1,86 @@
+"""Tune the gains of the ``whirl-brake`` baseline (agents/controllers.py) by cross-entropy search.
+
+The tuning set deliberately avoids the benchmark's scenarios: frictions 0.45, 0.50, 0.55 (the
+benchmark uses mu* + 0.05/0.10/0.15 = 0.43/0.48/0.53 and 0.6) at unbalance phases 45° and 225°
+(the benchmark uses 0/90/180/270°), plus mu = 0.2 so that a candidate must also re-levitate a
+rotor that does not whirl. Cost per episode (lower is better):
+
+    max(peak revs, 0) + 2 [backward whirl] + 10 [not re-levitated] + T_R / 0.3 s
+
+averaged over the set, in the re-levitation task (support damping at the scene's C_s, the harder
+case; the Full task adds C_max on top of the same law).
+
+    python benchmarks/tune_whirl_brake.py --iterations 12 --population 24 --out out/tune
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+from tqdm.auto import tqdm
+
+from agents.benchmark import EVAL_KWARGS, monitor_kwargs
+from agents.controllers import WhirlBrake
+from agents.rollout import run_episodes
+
+NAMES = ("kp", "kd", "kc", "kt", "kr", "ff")
+LOW = np.array([0.0, 0.0, -3.0, -0.5, -1.0, 0.0])
+HIGH = np.array([30.0, 5.0, 3.0, 0.5, 1.0, 2.0])
+TUNING_SET = [(mu, ph) for mu in (0.45, 0.50, 0.55) for ph in (45.0, 225.0)] + [(0.2, 45.0)]
+
+
+def cost(theta: np.ndarray, env_id: str) -> tuple[float, list[dict]]:
+    gains = dict(zip(NAMES, map(float, theta)))
+    kpis = []
+    for mu, ph in TUNING_SET:
+        kw = dict(EVAL_KWARGS, command="continuous", **monitor_kwargs({}),
+                  overrides={"contact.friction": mu, "unbalance.angle_deg": ph})
+        kpis.append(run_episodes(env_id, lambda p: WhirlBrake(p, **gains), [0], kw)[0].kpis)
+    c = [max(k["peak_whirl_revolutions"], 0.0) + 2.0 * k["backward_whirl"]
+         + (10.0 if not k["relevitated"] else k["relevitation_time_s"] / EVAL_KWARGS["episode_time"])
+         for k in kpis]
+    return float(np.mean(c)), kpis
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--env", default="RotorDrop-Relevitate-v0")
+    ap.add_argument("--iterations", type=int, default=12)
+    ap.add_argument("--population", type=int, default=24)
+    ap.add_argument("--elite", type=int, default=6)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--out", default="out/tune_whirl_brake")
+    a = ap.parse_args(argv)
+    rng = np.random.default_rng(a.seed)
+    mean = np.array([WhirlBrake.GAINS[n] for n in NAMES])
+    std = 0.15 * (HIGH - LOW)
+    best = (cost(mean, a.env)[0], mean.copy())
+    history = [dict(iteration=0, best_cost=best[0], gains=dict(zip(NAMES, mean.tolist())))]
+    t0 = time.perf_counter()
+    for it in tqdm(range(1, a.iterations + 1), desc="cross-entropy search", unit="gen"):
+        pop = np.clip(mean + std * rng.standard_normal((a.population, len(NAMES))), LOW, HIGH)
+        costs = np.array([cost(x, a.env)[0] for x in pop])
+        elite = pop[np.argsort(costs)[:a.elite]]
+        if costs.min() < best[0]:
+            best = (float(costs.min()), pop[np.argmin(costs)].copy())
+        mean, std = elite.mean(0), elite.std(0) + 0.01 * (HIGH - LOW)
+        history.append(dict(iteration=it, best_cost=best[0], generation_best=float(costs.min()),
+                            gains=dict(zip(NAMES, best[1].tolist()))))
+        tqdm.write(f"gen {it}: best {best[0]:.3f}  " + " ".join(f"{n}={v:.3g}" for n, v in zip(NAMES, best[1])))
+    final, kpis = cost(best[1], a.env)
+    out = Path(a.out)
+    out.mkdir(parents=True, exist_ok=True)
+    rec = dict(env=a.env, tuning_set=TUNING_SET, cost=final, gains=dict(zip(NAMES, best[1].tolist())),
+               kpis=kpis, history=history, wall_time_s=time.perf_counter() - t0, seed=a.seed)
+    (out / "tune.json").write_text(json.dumps(rec, indent=2))
+    print(json.dumps(dict(cost=final, gains=rec["gains"]), indent=1))
+    for (mu, ph), k in zip(TUNING_SET, kpis):
+        print(f"mu={mu:.2f} phase={ph:5.1f}: peak revs {k['peak_whirl_revolutions']:5.2f} whirl {k['backward_whirl']!s:5}"
+              f" relevitated {k['relevitated']!s:5} t_R {k['relevitation_time_s']:.3f}")
+
+
+if __name__ == "__main__":
+    main()
