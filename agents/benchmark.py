@@ -206,12 +206,7 @@ def benchmark(out: str | Path, quick: bool = False, policies: list[str] | None =
     bar = tqdm(total=sum(e.task in s.tasks for e in entries for s in scenarios) * len(phases),
                desc="benchmark", unit="ep", disable=not progress)
     for entry in entries:
-        for sc in [s for s in scenarios if entry.task in s.tasks]:
-            eps = []
-            for ph in phases:
-                eps += run_episodes(TASKS[entry.task], entry.make, [0], _env_kwargs(entry, sc, ph))
-                bar.update(1)
-            rows.append(_row(entry, sc, eps))
+        rows += suite_rows(entry, scenarios, phases, bar)
     bar.close()
     board = leaderboard(rows, scenarios, sweep["threshold"])
     report = dict(quick=quick, episode_time_s=EPISODE_TIME, phases_deg=list(phases),
@@ -230,6 +225,45 @@ def benchmark(out: str | Path, quick: bool = False, policies: list[str] | None =
           + "".join(f", {f}" for f in report.get("figures", []))
           + f" in {report['wall_time_s']:.0f} s")
     return report
+
+
+def suite_rows(entry: Entry, scenarios: list[Scenario], phases, progress=None) -> list[dict]:
+    """One row per scenario of the entry's task: its KPIs averaged over the unbalance phases."""
+    rows = []
+    for sc in [s for s in scenarios if entry.task in s.tasks]:
+        eps = []
+        for ph in phases:
+            eps += run_episodes(TASKS[entry.task], entry.make, [0], _env_kwargs(entry, sc, ph))
+            if progress is not None:
+                progress.update(1)
+        rows.append(_row(entry, sc, eps))
+    return rows
+
+
+#: model selection during training (``rotordrop train``, config key ``validation: true``):
+#: nominal scene, frictions and unbalance phases that the benchmark suite does not use
+VALIDATION_FRICTIONS = (0.2, 0.36, 0.41, 0.46, 0.51)
+VALIDATION_PHASES = (45.0, 225.0)
+
+
+class Validator:
+    """The benchmark score of one policy on the validation suite (``VALIDATION_*``) of a task,
+    against the passive drop on the same suite (computed once)."""
+
+    def __init__(self, env_id: str):
+        tasks = {v: k for k, v in TASKS.items()}
+        if env_id not in tasks:
+            raise ValueError(f"validation needs one of {', '.join(TASKS.values())}, got {env_id!r}")
+        self.task = tasks[env_id]
+        self.scenarios = [Scenario(f"mu={m:g}", m) for m in VALIDATION_FRICTIONS]
+        self.passive = suite_rows(Entry("passive", self.task, Passive, {}), self.scenarios,
+                                  VALIDATION_PHASES)
+
+    def score(self, make_actor, env_kwargs: dict) -> tuple[float, list[dict]]:
+        rows = suite_rows(Entry("candidate", self.task, make_actor, env_kwargs), self.scenarios,
+                          VALIDATION_PHASES)
+        board = leaderboard(self.passive + rows, self.scenarios, None)
+        return next(e["score"] for e in board if e["controller"] == "candidate"), rows
 
 
 def _row(entry: Entry, sc: Scenario, eps) -> dict:

@@ -19,6 +19,11 @@ algorithm's constructor arguments a block may hold:
                    reward of :mod:`agents.reward`), with optional ``reward_kwargs``
 ``residual``       a baseline controller name: the agent's action corrects that controller's
                    (:mod:`agents.residual`; the saved policy applies it too)
+``residual_scale`` the residual's authority: env action = clip(base + scale * a, -1, 1)
+                   (default 2: the agent can override the baseline anywhere)
+``validation``     ``true``: keep as ``best/`` the model with the highest benchmark score on the
+                   validation suite (:class:`agents.benchmark.Validator`: frictions and unbalance
+                   phases the benchmark does not use) instead of the highest evaluation reward
 =================  ===========================================================================
 
 ``learning_rate``, ``clip_range`` accept ``lin_<value>`` (linear decay to zero, as in rl-zoo3).
@@ -34,7 +39,7 @@ from typing import Any
 ALGOS = ("ppo", "sac", "td3")
 META_KEYS = ("n_timesteps", "n_envs", "policy", "policy_kwargs", "normalize", "env_kwargs",
              "eval_freq", "n_eval_episodes", "checkpoint_freq", "noise_type", "noise_std",
-             "reward", "reward_kwargs", "residual")
+             "reward", "reward_kwargs", "residual", "residual_scale", "validation")
 REWARDS = ("env", "kpi")
 SCHEDULE_KEYS = ("learning_rate", "clip_range")
 
@@ -162,6 +167,15 @@ def split(hp: dict) -> tuple[dict, dict]:
         if meta["residual"] not in BASELINES:
             raise ConfigError(f"residual must be a baseline controller ({', '.join(BASELINES)}), "
                               f"got {meta['residual']!r}")
+    if "residual_scale" in meta:
+        try:
+            meta["residual_scale"] = float(meta["residual_scale"])
+        except (TypeError, ValueError) as exc:
+            raise ConfigError(f"residual_scale must be a number, got {meta['residual_scale']!r}") from exc
+        if not 0.0 < meta["residual_scale"] <= 2.0:
+            raise ConfigError(f"residual_scale must be in (0, 2], got {meta['residual_scale']}")
+    if not isinstance(meta.setdefault("validation", False), bool):
+        raise ConfigError(f"validation must be true or false, got {meta['validation']!r}")
     if not isinstance(meta.setdefault("reward_kwargs", {}) or {}, dict):
         raise ConfigError(f"reward_kwargs must be a mapping, got {meta['reward_kwargs']!r}")
     for k, lo in (("n_timesteps", 1), ("n_envs", 1), ("eval_freq", 0), ("n_eval_episodes", 1),

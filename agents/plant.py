@@ -36,7 +36,7 @@ def make_env(env_id: str, **kwargs):
 
 def make_vec_env(env_id: str, n_envs: int, seed: int, env_kwargs: dict, monitor_file=None,
                  reward: str = "env", reward_kwargs: dict | None = None,
-                 residual: str | None = None):
+                 residual: str | None = None, residual_scale: float | None = None):
     """The batched SB3 VecEnv of ``rotordrop_env`` with episode statistics (``VecMonitor``);
     ``reward="kpi"`` replaces the reward by :mod:`agents.reward`'s KPI-aligned one, ``residual``
     makes the agent's action a correction of that baseline controller's."""
@@ -45,7 +45,8 @@ def make_vec_env(env_id: str, n_envs: int, seed: int, env_kwargs: dict, monitor_
     venv = BatchedRotorDropVecEnv(env_id, n_envs, seed=seed, **env_kwargs)
     if residual:
         from .residual import make_residual
-        venv = make_residual(venv, residual)
+        venv = make_residual(venv, residual, **({} if residual_scale is None else
+                                                {"scale": residual_scale}))
     if reward == "kpi":
         from .reward import make_kpi_reward
         venv = make_kpi_reward(venv, **(reward_kwargs or {}))

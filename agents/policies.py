@@ -42,6 +42,7 @@ class LearnedPolicy:
     vecnormalize: object | None
     meta: dict = field(default_factory=dict)
     residual: str | None = None          # baseline whose action the policy corrects
+    residual_scale: float = RESIDUAL_SCALE
     base: object | None = None
 
     def bound(self, plant: Plant) -> "LearnedPolicy":
@@ -60,7 +61,7 @@ class LearnedPolicy:
                 raise RuntimeError(f"{self.name} corrects the {self.residual} controller: call "
                                    f".bound(Plant.from_env(env)) before predict")
             b, _ = self.base.predict(raw, episode_start=episode_start)
-            action = np.clip(b + RESIDUAL_SCALE * action, -1.0, 1.0).astype(np.float32)
+            action = np.clip(b + self.residual_scale * action, -1.0, 1.0).astype(np.float32)
         return action, state
 
     def reset(self, n: int, which=None) -> None:
@@ -79,7 +80,8 @@ class LearnedPolicy:
             model_path = path
             vn_path = next((p for p in (path.with_suffix(".pkl"), path.parent / "vecnormalize.pkl")
                             if p.is_file()), path.with_suffix(".pkl"))
-            meta = _read_meta(path.with_suffix(".json")) or _read_meta(path.parent / "config.yaml")
+            meta = (_read_meta(path.with_suffix(".json")) or _read_meta(path.parent / "config.yaml")
+                    or _read_meta(path.parent.parent / "config.yaml"))      # a run's best/
         else:
             raise FileNotFoundError(f"{path} is neither a training directory nor a model .zip")
         if not model_path.is_file():
@@ -98,9 +100,11 @@ class LearnedPolicy:
                 vn = pickle.load(fh)
             vn.training = False
         task = env_id.split("-")[1].lower() if env_id.count("-") >= 2 else "policy"
-        residual = meta.get("residual") or meta.get("hyperparams", {}).get("residual")
+        hp = meta.get("hyperparams", {})
+        residual = meta.get("residual") or hp.get("residual")
+        scale = float(meta.get("residual_scale") or hp.get("residual_scale") or RESIDUAL_SCALE)
         return cls(name or meta.get("name") or f"{algo}-{task}", algo, env_id, env_kwargs, model,
-                   vn, meta, residual)
+                   vn, meta, residual, scale)
 
 
 def _read_meta(path: Path) -> dict:

@@ -116,14 +116,50 @@ def _callbacks():
             self.bar.update(self.training_env.num_envs)
             if self.eval_cb is not None and self.eval_cb.kpi_history and self.n_calls % 50 == 0:
                 last = self.eval_cb.kpi_history[-1]
+                extra = ({"validation": f"{last['validation_score']:.1f}"}
+                         if "validation_score" in last else {})
                 self.bar.set_postfix(eval_reward=f"{last['mean_reward']:.1f}",
-                                     failure=f"{last.get('mean_failure', float('nan')):.2f}")
+                                     failure=f"{last.get('mean_failure', float('nan')):.2f}", **extra)
             return True
 
         def _on_training_end(self):
             self.bar.close()
 
-    return SaveVecNormalize, KpiEvalCallback, TqdmCallback
+    class ValidationCallback(BaseCallback):
+        """At every evaluation, the benchmark score of the deterministic policy on the validation
+        suite (:class:`agents.benchmark.Validator`); the best-scoring model goes to ``best/``
+        with its VecNormalize statistics, and the score into the learning curve."""
+
+        def __init__(self, env_id, algo, env_kwargs, meta, best_dir: Path, eval_cb):
+            super().__init__()
+            from .benchmark import Validator
+            self.validator = Validator(env_id)
+            self.env_id, self.algo, self.env_kwargs, self.meta = env_id, algo, env_kwargs, meta
+            self.best_dir, self.eval_cb = best_dir, eval_cb
+            self.best = -np.inf
+            self.seen = 0
+
+        def _on_step(self) -> bool:
+            if len(self.eval_cb.kpi_history) == self.seen:
+                return True
+            self.seen = len(self.eval_cb.kpi_history)
+            from .policies import LearnedPolicy
+            from .residual import RESIDUAL_SCALE
+            vn = self.model.get_vec_normalize_env()
+            pol = LearnedPolicy("candidate", self.algo, self.env_id, self.env_kwargs, self.model, vn,
+                                residual=self.meta.get("residual"),
+                                residual_scale=self.meta.get("residual_scale") or RESIDUAL_SCALE)
+            score, _ = self.validator.score(pol.bound, self.env_kwargs)
+            self.eval_cb.kpi_history[-1]["validation_score"] = score
+            self.logger.record("eval/validation_score", score)
+            if score > self.best:
+                self.best = score
+                self.model.save(str(self.best_dir / "best_model.zip"))
+                if vn is not None:
+                    vn.save(str(self.best_dir / "vecnormalize.pkl"))
+            return True
+
+    return SaveVecNormalize, KpiEvalCallback, TqdmCallback, ValidationCallback
 
 
 def find_checkpoint(path: str | Path) -> tuple[Path, Path | None, Path | None]:
@@ -183,7 +219,7 @@ def train(env_id: str, algo: str, out: str | Path, timesteps: int | None = None,
         raise ConfigError(f"{algo} needs continuous actions: set env_kwargs.command = continuous")
 
     rw = dict(reward=meta["reward"], reward_kwargs=meta["reward_kwargs"],
-              residual=meta.get("residual"))
+              residual=meta.get("residual"), residual_scale=meta.get("residual_scale"))
     venv = make_vec_env(env_id, n, seed, env_kwargs, monitor_file=out / "monitor.csv", **rw)
     eval_venv = make_vec_env(env_id, 1, seed + 10_000, env_kwargs, **rw)
     norm = meta["normalize"]
@@ -214,15 +250,18 @@ def train(env_id: str, algo: str, out: str | Path, timesteps: int | None = None,
                                  **{k: v for k, v in norm_kwargs.items()
                                     if k not in ("norm_reward", "training")})
 
-    SaveVecNormalize, KpiEvalCallback, TqdmCallback = _callbacks()
+    SaveVecNormalize, KpiEvalCallback, TqdmCallback, ValidationCallback = _callbacks()
     (out / "best").mkdir(exist_ok=True)
     eval_cb = KpiEvalCallback(
         eval_venv, n_eval_episodes=meta.get("n_eval_episodes", 5),
         eval_freq=max(meta.get("eval_freq", 10_000) // n, 1) if meta.get("eval_freq", 1) else -1,
-        best_model_save_path=str(out / "best"), log_path=str(out / "eval"), deterministic=True,
-        verbose=0, callback_on_new_best=SaveVecNormalize(out / "best" / "vecnormalize.pkl"),
+        best_model_save_path=None if meta["validation"] else str(out / "best"),
+        log_path=str(out / "eval"), deterministic=True, verbose=0,
+        callback_on_new_best=None if meta["validation"] else SaveVecNormalize(out / "best" / "vecnormalize.pkl"),
         eval_seed=seed + 10_000)
     cbs = [eval_cb]
+    if meta["validation"]:
+        cbs.append(ValidationCallback(env_id, algo, env_kwargs, meta, out / "best", eval_cb))
     if meta.get("checkpoint_freq", 0):
         cbs.append(CheckpointCallback(save_freq=max(meta["checkpoint_freq"] // n, 1),
                                       save_path=str(out / "checkpoints"), name_prefix="rl_model",

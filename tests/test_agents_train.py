@@ -156,3 +156,55 @@ def test_residual_zero_action_is_the_base_controller():
         env = venv.venv.venv.envs[0]
         c = obs[:, env.obs_names.index("damping1")] * env.obs_scale[env.obs_names.index("damping1")]
         np.testing.assert_allclose(c, target, rtol=0.01)
+
+
+def test_kpi_reward_charges_the_time_before_relevitation():
+    """Re-levitation tasks: the return is minus the final KPI potential, plus w_relevitate once,
+    minus w_time * dt / T for every step before re-levitation (the score's T_R / T term)."""
+    from agents.plant import make_vec_env
+    from agents.reward import kpi_potential
+    kw = dict(episode_time=0.15, terminate_on_failure=False, command="discrete",
+              power_return_time=0.02, overrides={"contact.friction": 0.1})
+    venv = make_vec_env("RotorDrop-Relevitate-v0", 1, 0, kw, reward="kpi")
+    venv.reset()
+    ret, pre, done = 0.0, 0, False
+    while not done:
+        _, r, dones, infos = venv.step(np.ones(1, dtype=np.int64))
+        ret += float(r[0])
+        done = bool(dones[0])
+        pre += int(not infos[0]["relevitated"] and infos[0].get("reward_success", 0.0) == 0.0)
+    k = infos[0]
+    assert k["kpi_relevitated"]
+    dt, horizon = 1e-3, 0.15
+    assert pre * dt >= k["kpi_relevitation_time_s"]            # charged until it is confirmed
+    expected = -kpi_potential(k, k["kpi_peak_whirl_revolutions"], 1.0, 0.5, 0.5, 1e4, 800.0) \
+        + 1.0 - pre * dt / horizon
+    assert ret == pytest.approx(expected, rel=1e-4, abs=1e-4)
+
+
+def test_validation_keeps_the_best_model_by_validation_score(tmp_path):
+    """validation: true scores each evaluation on the validation suite, records the score in the
+    learning curve and keeps the best-scoring model in best/; residual_scale is saved and a
+    residual policy at a ~zero action scores what its base scores."""
+    from agents.benchmark import Validator
+    from agents.controllers import WhirlBrake
+    from agents.policies import LearnedPolicy
+    from agents.train import train
+    cfg = tmp_path / "val.yaml"
+    cfg.write_text("RotorDrop-Full-v0:\n  n_steps: 128\n  batch_size: 128\n  n_epochs: 1\n"
+                   "  eval_freq: 512\n  n_eval_episodes: 1\n  checkpoint_freq: 0\n"
+                   "  policy_kwargs: \"dict(net_arch=[16], log_std_init=-3.0)\"\n"
+                   "  residual: whirl-brake\n  residual_scale: 0.01\n  validation: true\n"
+                   "  reward: kpi\n  env_kwargs: {command: continuous, terminate_on_failure: false}\n")
+    res = train("RotorDrop-Full-v0", "ppo", tmp_path / "run", timesteps=1024, n_envs=4, config=cfg,
+                progress=False)
+    curve = json.loads((res.out / "training.json").read_text())["learning_curve"]
+    scores = [e["validation_score"] for e in curve]
+    assert len(scores) == 2 and (res.out / "best" / "best_model.zip").is_file()
+    pol = LearnedPolicy.load(res.out / "best" / "best_model.zip")
+    assert pol.residual == "whirl-brake" and pol.residual_scale == pytest.approx(0.01)
+    v = Validator("RotorDrop-Full-v0")
+    base, _ = v.score(WhirlBrake, {"command": "continuous"})
+    assert max(scores) == pytest.approx(base, abs=1.0)       # a 1 % residual barely moves it
+    with pytest.raises(ConfigError, match="residual_scale"):
+        split({"residual_scale": 3.0})
