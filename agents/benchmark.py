@@ -12,9 +12,11 @@
    scenario is in-distribution when all its values lie inside the environments' default
    randomisation ranges (the training distribution of the shipped policies), else out of it.
    Each scenario runs once per unbalance phase (``PHASES``): the episodes are deterministic.
-3. **Tasks.** ``damping`` (``RotorDrop-Damping-v0``) and ``relevitate``
-   (``RotorDrop-Relevitate-v0``; the passive reference with the AMBs left off, the PID baseline
-   with continuous currents, learned policies with the command they were trained with).
+3. **Tasks.** ``damping`` (``RotorDrop-Damping-v0``), ``relevitate``
+   (``RotorDrop-Relevitate-v0``) and ``full`` (``RotorDrop-Full-v0``, both channels): every
+   baseline that has its channels in the task (``BASELINE_KWARGS`` picks the re-levitation
+   command), the passive reference with the AMBs left off, learned policies with the command
+   they were trained with.
    Episodes last ``EPISODE_TIME`` and are not cut short at the stator (``terminate_on_failure =
    False``) so that whirl is measured as ``rotordrop drop`` measures it.
 4. **Score** (:mod:`agents.score`): per task, 100 (1 − Σ J / Σ J_passive) over the suite.
