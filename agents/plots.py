@@ -14,17 +14,29 @@ def _plt():
 
 
 def plot_learning_curve(history: list[dict], path: Path, title: str) -> Path | None:
-    """Evaluation return (± std) and failure rate (whirl, stator contact) against steps."""
+    """Evaluation return (± std) and failure rate (whirl, stator contact) against steps, and
+    below it the validation score when the run had ``validation: true``."""
     if not history:
         return None
     plt = _plt()
     steps = np.array([h["timesteps"] for h in history])
     mean = np.array([h["mean_reward"] for h in history])
-    std = np.array([h["std_reward"] for h in history])
-    fig, ax = plt.subplots(figsize=(7, 4))
+    std = np.array([h.get("std_reward", 0.0) for h in history])
+    validation = [h.get("validation_score", np.nan) for h in history]
+    if np.all(np.isnan(validation)):
+        fig, ax = plt.subplots(figsize=(7, 4))
+    else:
+        fig, (ax, axv) = plt.subplots(2, 1, figsize=(7, 6), sharex=True,
+                                      gridspec_kw=dict(height_ratios=(3, 2)))
+        axv.plot(steps, validation, "d-", color="C2")
+        best = int(np.nanargmax(validation))
+        axv.plot(steps[best], validation[best], "*", ms=14, color="C1", label="kept as best/")
+        axv.set_ylabel("validation score")
+        axv.grid(alpha=0.3)
+        axv.legend(fontsize=8)
     ax.plot(steps, mean, "o-", label="evaluation return")
     ax.fill_between(steps, mean - std, mean + std, alpha=0.2)
-    ax.set_xlabel("environment steps")
+    fig.axes[-1].set_xlabel("environment steps")
     ax.set_ylabel("return")
     if any("mean_failure" in h for h in history):
         ax2 = ax.twinx()
