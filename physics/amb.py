@@ -37,6 +37,17 @@ def weight_shares(weight: float, z1: float, z2: float) -> tuple[float, float]:
     return weight * z2 / (z2 - z1), -weight * z1 / (z2 - z1)
 
 
+STANDARD_GRAVITY = 9.80665
+
+
+def static_weight_share(scene) -> float:
+    """The rotor weight on the more loaded retainer bearing [N]: the film law's reference load
+    (spec §4) and the environments' force scale. Without gravity (``world.gravity = 0``) the
+    share under standard gravity keeps both defined."""
+    g = scene.world.gravity if scene.world.gravity > 0.0 else STANDARD_GRAVITY
+    return max(weight_shares(scene.rotor.mass * g, scene.positions.rb1, scene.positions.rb2))
+
+
 # ------------------------------------------------------------------------- actuator level --
 @njit
 def magnet_pair_force(i, x, k_mag, g0, i0, ratio_max):
@@ -88,9 +99,6 @@ class ActuatorConstants:
     ratio_max: float             # largest current / gap ratio of one magnet (saturation) [A/m]
     force_capacity: float        # force of one magnet at saturation [N]
     feedforward: tuple[float, float]   # gravity current of AMB1 and AMB2 (y axes) [A]
-
-    def force(self, i: float, x: float, g0: float, i0: float) -> float:
-        return magnet_pair_force(i, x, self.force_constant, g0, i0, self.ratio_max)
 
 
 def actuator_constants(amb, weight1: float, weight2: float) -> ActuatorConstants:

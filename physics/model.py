@@ -187,11 +187,8 @@ def build_model(scene: Scene) -> Model:
     P[P_VL] = P[P_WL] * s.rotor.journal_radius
     P[P_MS], P[P_JS] = s.sleeve.mass, s.sleeve.spin_inertia
     b = s.bearing
-    # film reference load (spec §4: Q_n = 5 x static bearing load / z): the rotor's weight share;
-    # at zero gravity the share under standard gravity keeps the film law defined
-    g_ref = s.world.gravity if s.world.gravity > 0.0 else 9.80665
-    static_load = max(amb_mod.weight_shares(s.rotor.mass * g_ref, s.positions.rb1, s.positions.rb2))
-    bc = bearing_constants(b, static_load)
+    # film reference load (spec §4: Q_n = 5 x static bearing load / z)
+    bc = bearing_constants(b, amb_mod.static_weight_share(s))
     P[P_NB], P[P_HALF_PLAY], P[P_KTOT], P[P_FILM] = b.balls, b.clearance / 2.0, bc.K_tot, bc.film_coef
     P[P_CB], P[P_KLIN], P[P_CAGE] = b.damping, b.linear_stiffness, cage_ratio(b)
     P[P_M0_LOW], P[P_M0_COEF], P[P_M1_COEF], P[P_MSEAL] = bc.m0_low, bc.m0_coef, bc.m1_coef, b.seal_torque
@@ -274,6 +271,11 @@ def rhs(t, y, P, I, U, dy, aux):
     # AMBs (hold the rotor until the fault)
     amb = I[F_AMB]
     if amb == AMB_ACTUATOR or (amb == AMB_LINEAR and U[U_AMB_POWER] > 0.0):
+        # actuator (spec §5): the PID states evolve only under the built-in controller; the
+        # magnets pull while powered or driven directly. The per-axis law takes scalars so that
+        # it compiles inline here (as an array-taking call it cost ~90 ns per axis)
+        pid_on = U[U_AMB_POWER] > 0.0 and U[U_AMB_DIRECT] <= 0.0
+        pulls = U[U_AMB_POWER] > 0.0 or U[U_AMB_DIRECT] > 0.0
         for k in range(2):
             z = P[P_Z_AMB1 + k]
             dx, dyy, ddx, ddy = axis_motion(y, I, z)
@@ -281,8 +283,31 @@ def rhs(t, y, P, I, U, dy, aux):
                 fx = amb_mod.linear_force(dx, ddx, P[P_K_AMB], P[P_C_AMB], 0.0)
                 fy = amb_mod.linear_force(dyy, ddy, P[P_K_AMB], P[P_C_AMB], P[P_AMB_BIAS1 + k])
             else:
-                fx = _actuator_axis(t, 2 * k, dx, y, P, I, U, dy)
-                fy = _actuator_axis(t, 2 * k + 1, dyy, y, P, I, U, dy)
+                fx = fy = 0.0
+                for a in range(2):                      # x, then y axis of AMB k
+                    j = 2 * k + a
+                    d = dyy if a == 1 else dx
+                    i_int, i_q = I[I_AMB_INT] + j, I[I_AMB_FILT] + j
+                    i_cmd, e, de_int = _actuator_command(
+                        t, d, y[i_int], y[i_q], U[U_AMB_DIRECT], U[U_AMB_POWER], U[U_ICMD + j],
+                        U[U_T_ON], U[U_REF0 + j], P[P_AMB_ILIM], P[P_AMB_RAMP],
+                        P[P_AMB_IFF1 + k] if a == 1 else 0.0,
+                        P[P_AMB_KP], P[P_AMB_KI], P[P_AMB_KD], P[P_AMB_TD])
+                    i_act = i_cmd
+                    if I[I_AMB_COIL] >= 0:               # first-order coil lag
+                        ic = I[I_AMB_COIL] + j
+                        i_act = y[ic]
+                        dy[ic] = (i_cmd - i_act) / P[P_AMB_TL]
+                    if pid_on:
+                        dy[i_int] = de_int
+                        dy[i_q] = (e - y[i_q]) / P[P_AMB_TD]
+                    if pulls:
+                        f = amb_mod.magnet_pair_force(i_act, d, P[P_AMB_KMAG], P[P_AMB_G0],
+                                                      P[P_AMB_I0], P[P_AMB_RMAX])
+                        if a == 1:
+                            fy = f
+                        else:
+                            fx = f
             Fx += fx
             Fy += fy
             Ma += z * fx
@@ -401,6 +426,8 @@ def rhs(t, y, P, I, U, dy, aux):
         if i_hx >= 0:
             cs = U[U_CS1 + k]
             if I[I_CS] >= 0:                     # semi-active damper lags its command (spec §6)
+                # the clamp is needed: U is a public input, and even the env's command
+                # C_min + frac (C_max - C_min) can exceed C_max by one ulp at frac = 1
                 i_cs = I[I_CS] + k
                 dy[i_cs] = (amb_mod.clamp(cs, P[P_CS_MIN], P[P_CS_MAX]) - y[i_cs]) / P[P_CS_TAU]
                 cs = y[i_cs]
@@ -442,55 +469,46 @@ def rhs(t, y, P, I, U, dy, aux):
 
 
 @njit
-def _actuator_command(t, j, d, y, P, I, U):
-    """Commanded control current of actuator axis j, its error e and integral rate (spec §5).
+def _actuator_command(t, d, z_int, q, u_direct, u_power, u_icmd, t_on, ref0, lim, ramp, i_ff,
+                      kp, ki, kd, td):
+    """Commanded control current of one actuator axis, its error e and integral rate (spec §5).
 
-    Direct mode: U_ICMD + j. PID mode: feed-forward minus PID of e = d - ramped reference, with
-    conditional-integration anti-windup (the integral stops while the current is saturated and
-    the error would saturate it further). Off: zero.
+    ``d``: displacement at the axis; ``z_int``, ``q``: its PID integral and derivative-filter
+    states; ``u_*``, ``t_on``, ``ref0``: its controls (``U_AMB_DIRECT``, ``U_AMB_POWER``,
+    ``U_ICMD + j``, ``U_T_ON``, ``U_REF0 + j``); the rest its parameters (``P_AMB_*``; ``i_ff``
+    the gravity feed-forward current, zero on x axes). Scalars only, so that ``rhs`` inlines it.
+
+    Direct mode: ``u_icmd`` clipped to the current limit (U is a public input). PID mode:
+    feed-forward minus PID of e = d - ramped reference, with conditional-integration anti-windup
+    (the integral stops while the current is saturated and the error would saturate it further).
+    Off: zero.
     """
-    lim = P[P_AMB_ILIM]
-    if U[U_AMB_DIRECT] > 0.0:
-        return amb_mod.clamp(U[U_ICMD + j], -lim, lim), 0.0, 0.0
-    if U[U_AMB_POWER] <= 0.0:
+    if u_direct > 0.0:
+        return amb_mod.clamp(u_icmd, -lim, lim), 0.0, 0.0
+    if u_power <= 0.0:
         return 0.0, 0.0, 0.0
-    e = d - amb_mod.ramp_reference(t, U[U_T_ON], U[U_REF0 + j], P[P_AMB_RAMP])
-    i_ff = P[P_AMB_IFF1 + j // 2] if j % 2 == 1 else 0.0
-    raw = amb_mod.pid_current(e, y[I[I_AMB_INT] + j], y[I[I_AMB_FILT] + j], P[P_AMB_KP],
-                              P[P_AMB_KI], P[P_AMB_KD], P[P_AMB_TD], i_ff)
+    e = d - amb_mod.ramp_reference(t, t_on, ref0, ramp)
+    raw = amb_mod.pid_current(e, z_int, q, kp, ki, kd, td, i_ff)
     if (raw > lim and e < 0.0) or (raw < -lim and e > 0.0):
         return (lim if raw > lim else -lim), e, 0.0
     return amb_mod.clamp(raw, -lim, lim), e, e
 
 
 @njit
-def _actuator_axis(t, j, d, y, P, I, U, dy):
-    """Force of actuator axis j at displacement d; sets its controller and coil state rates."""
-    i_cmd, e, de_int = _actuator_command(t, j, d, y, P, I, U)
-    i_act = i_cmd
-    if I[I_AMB_COIL] >= 0:
-        ic = I[I_AMB_COIL] + j
-        i_act = y[ic]
-        dy[ic] = (i_cmd - i_act) / P[P_AMB_TL]
-    on = U[U_AMB_POWER] > 0.0 and U[U_AMB_DIRECT] <= 0.0
-    if on:
-        iq = I[I_AMB_FILT] + j
-        dy[I[I_AMB_INT] + j] = de_int
-        dy[iq] = (e - y[iq]) / P[P_AMB_TD]
-    if not on and U[U_AMB_DIRECT] <= 0.0:
-        return 0.0
-    return amb_mod.magnet_pair_force(i_act, d, P[P_AMB_KMAG], P[P_AMB_G0], P[P_AMB_I0], P[P_AMB_RMAX])
-
-
-@njit
 def amb_currents(t, y, P, I, U, out):
-    """Control currents of the 4 actuator axes (AMB1 x, AMB1 y, AMB2 x, AMB2 y) now [A]."""
+    """Control currents of the 4 actuator axes (AMB1 x, AMB1 y, AMB2 x, AMB2 y) now [A]: the coil
+    currents when they lag, else the command of the law ``rhs`` applies."""
     for j in range(4):
-        dx, dyy, _, _ = axis_motion(y, I, P[P_Z_AMB1 + j // 2])
         if I[I_AMB_COIL] >= 0:
             out[j] = y[I[I_AMB_COIL] + j]
-        else:
-            out[j] = _actuator_command(t, j, dx if j % 2 == 0 else dyy, y, P, I, U)[0]
+            continue
+        k = j // 2
+        dx, dyy, _, _ = axis_motion(y, I, P[P_Z_AMB1 + k])
+        out[j] = _actuator_command(
+            t, dyy if j % 2 == 1 else dx, y[I[I_AMB_INT] + j], y[I[I_AMB_FILT] + j],
+            U[U_AMB_DIRECT], U[U_AMB_POWER], U[U_ICMD + j], U[U_T_ON], U[U_REF0 + j],
+            P[P_AMB_ILIM], P[P_AMB_RAMP], P[P_AMB_IFF1 + k] if j % 2 == 1 else 0.0,
+            P[P_AMB_KP], P[P_AMB_KI], P[P_AMB_KD], P[P_AMB_TD])[0]
 
 
 @njit

@@ -32,6 +32,16 @@ def steady_unbalance_orbit(m_u_e: float, Omega: float, mass: float, k: float, c:
     """Complex amplitude Z of the settled translational orbit x + iy = Z e^{i Omega t}.
 
     Solves (k - m Omega^2 + i c Omega) Z = m_u e Omega^2 for the total support stiffness k and
-    damping c (unbalance at the centre of a symmetric support excites no tilt).
+    damping c (unbalance at the centre of a symmetric support excites no tilt). Without
+    excitation (no spin or no unbalance) the orbit is 0 whatever the support; an undamped
+    support exactly at resonance has no settled orbit (ValueError).
     """
-    return m_u_e * Omega ** 2 / complex(k - mass * Omega ** 2, c * Omega)
+    force = m_u_e * Omega ** 2
+    if force == 0.0:
+        return 0j
+    dyn = complex(k - mass * Omega ** 2, c * Omega)
+    if dyn == 0.0:
+        raise ValueError("the AMB support is undamped and exactly at resonance with the spin "
+                         "(amb.stiffness = rotor.mass x Omega^2, amb.damping = 0): no settled "
+                         "unbalance orbit; change amb.stiffness, amb.damping or rotor.speed_rpm")
+    return force / dyn
