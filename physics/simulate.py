@@ -96,6 +96,24 @@ def segments(model: Model, t_end: float) -> list[tuple[float, float, bool]]:
     return [(0.0, t_off, True), (t_off, t_end, False)]
 
 
+def run_segments(integ: Integrator, y: np.ndarray, t_end: float, t_out=None, Y=None,
+                 bar=None) -> None:
+    """Advance ``y`` from t = 0 to ``t_end`` through the AMB-powered/unpowered segments in
+    chunks of ``CHUNK_S`` (so a progress bar moves), filling ``Y`` at ``t_out[1:]`` if given.
+    The drop driver and the environments' fault state both use it, so they are bit-identical."""
+    model = integ.model
+    pos = 1
+    for a, b, powered in segments(model, t_end):
+        U = model.controls(powered)
+        edges = np.append(np.arange(a, b, CHUNK_S), b)
+        for c0, c1 in zip(edges[:-1], edges[1:]):
+            if c1 - c0 <= 0.0:
+                continue
+            pos = integ.advance(y, c0, c1, U, t_out, Y, pos)
+            if bar is not None:
+                bar.update(c1 - c0)
+
+
 def simulate(scene: Scene, t_end: float | None = None, progress: bool = False) -> Result:
     """Simulate a scene from the levitated state to ``t_end`` (default ``solver.t_end``)."""
     if t_end is not None:
@@ -110,17 +128,8 @@ def simulate(scene: Scene, t_end: float | None = None, progress: bool = False) -
     Y[0] = y
     integ = Integrator(model)
     bar = _progress(progress, t_end, scene.name)
-    pos = 1
     wall0 = time.perf_counter()
-    for a, b, powered in segments(model, t_end):
-        U = model.controls(powered)
-        edges = np.append(np.arange(a, b, CHUNK_S), b)
-        for c0, c1 in zip(edges[:-1], edges[1:]):
-            if c1 - c0 <= 0.0:
-                continue
-            pos = integ.advance(y, c0, c1, U, t_out, Y, pos)
-            if bar is not None:
-                bar.update(c1 - c0)
+    run_segments(integ, y, t_end, t_out, Y, bar)
     integ.stats.wall_time_s = time.perf_counter() - wall0
     integ.stats.compile_time_s = compile_s
     if bar is not None:

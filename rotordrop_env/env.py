@@ -7,7 +7,9 @@ import math
 import gymnasium as gym
 import numpy as np
 
-from physics.model import P_Z_RB1, S_A, S_B, S_X, S_Y
+from physics.amb import static_weight_share
+from physics.metrics import WHIRL_MIN_REVOLUTIONS, WHIRL_RADIUS_FRACTION
+from physics.model import P_Z_RB1, axis_motion
 from physics.scene import Scene, SceneError, load_scene
 from physics.simulate import IntegrationError, _explain
 
@@ -121,12 +123,6 @@ class RotorDropEnv(gym.Env):
         n_act = 1 if self._discrete else self.action_space.shape[0]
         self._bind(Buffers(model.n_state, n_obs, n_act, int(samples_per_step)))
         self._configure_static(relevitation_hold, terminate_on_failure)
-        self.actuator = None
-        if self._relevitate:
-            from physics.amb import actuator_constants
-            from physics.model import P_AMB_BIAS1, P_AMB_BIAS2
-            self.actuator = actuator_constants(self.base_scene.amb, model.P[P_AMB_BIAS1],
-                                               model.P[P_AMB_BIAS2])
         self._renderer = None
         self._scenario: dict = {}
         self._needs_reset = True
@@ -184,10 +180,8 @@ class RotorDropEnv(gym.Env):
         C[K.C_DAMP] = 1.0 if self._damping else 0.0
         C[K.C_LEV] = (K.LEV_NONE if not self._relevitate else
                       K.LEV_DISCRETE if self.command == "discrete" else K.LEV_CONTINUOUS)
-        C[K.C_A_DAMP] = 0.0
         C[K.C_A_LEV] = 2.0 if self._damping else 0.0
-        C[K.C_N_ACT] = b.act.shape[-1]
-        C[K.C_N_SUB] = b.t_sub.shape[-1]
+        C[K.C_WHIRL_RADIUS], C[K.C_WHIRL_REVS] = WHIRL_RADIUS_FRACTION, WHIRL_MIN_REVOLUTIONS
         w = self.weights
         C[K.C_W_WHIRL], C[K.C_W_CONTACT], C[K.C_W_DISP] = w["w_whirl"], w["w_contact"], w["w_displacement"]
         C[K.C_W_EFFORT], C[K.C_W_SUCCESS], C[K.C_W_FAILURE] = w["w_effort"], w["w_success"], w["w_failure"]
@@ -196,20 +190,23 @@ class RotorDropEnv(gym.Env):
         C[K.C_FULL] = 1.0 if self.full_state else 0.0
         b.scale[:] = self.obs_scale
 
-    def _configure_episode(self, scene: Scene, t_fault: float, power_return: float | None) -> None:
-        C, sv = self._b.C, scene.solver
+    def _configure_episode(self, fs, power_return: float | None) -> None:
+        """Episode constants of the kernel; the solver settings are the fault state's
+        integrator's, so the episode continues exactly as ``rotordrop drop`` would."""
+        b, scene, integ = self._b, fs.scene, fs.integrator
+        C = b.C
+        t_fault = fs.t_fault
         C[K.C_T_FAULT] = t_fault
         C[K.C_T_END] = t_fault + self.n_steps * self.dt
         if power_return is None:
             C[K.C_T_POWER] = math.inf
         else:                                   # on the control-step grid (documented)
             C[K.C_T_POWER] = t_fault + math.ceil(power_return / self.dt - 1e-9) * self.dt
-        C[K.C_RTOL], C[K.C_HMAX], C[K.C_HMIN] = sv.rtol, sv.max_step, sv.min_step
-        C[K.C_FIXED] = 1.0 if sv.method == "fixed" else 0.0
-        C[K.C_MAXSTEPS] = sv.max_steps
-        g = scene.world.gravity if scene.effects.gravity else 9.80665
-        z1, z2 = scene.positions.rb1, scene.positions.rb2
-        C[K.C_F_REF] = scene.rotor.mass * g * max(z2, -z1) / (z2 - z1)    # static weight share
+        C[K.C_RTOL], C[K.C_HMAX], C[K.C_HMIN] = integ.rtol, integ.h_max, integ.h_min
+        C[K.C_FIXED] = 1.0 if integ.fixed else 0.0
+        C[K.C_MAXSTEPS] = integ.max_steps
+        b.atol[:] = integ.atol
+        C[K.C_F_REF] = static_weight_share(scene)
         C[K.C_GAP] = scene.amb.air_gap
         C[K.C_LOAD_RATING] = scene.bearing.static_load_rating
         C[K.C_CS_MIN], C[K.C_CS_MAX] = scene.support.damping_min, scene.support.damping_max
@@ -239,15 +236,14 @@ class RotorDropEnv(gym.Env):
         pr = values.get(POWER_RETURN, self.power_return_time)
         if pr is not None:
             _positive(POWER_RETURN, pr, 0.0, 100.0)
-        self._configure_episode(scene, fs.t_fault, pr)
+        self._configure_episode(fs, pr)
         b.y[:] = fs.y
         b.P[:] = fs.model.P
         b.I[:] = fs.model.I
         b.U[:] = fs.model.controls(False)
-        b.atol[:] = scene.solver.rtol * fs.model.scale
         b.M[:] = 0.0
         b.M[K.M_T] = fs.t_fault
-        b.M[K.M_H] = fs.h
+        b.M[K.M_H] = fs.integrator.h
         b.M[K.M_OK_START] = -1.0
         b.M[K.M_RELEV_T] = math.nan
         K.observe_now(b.y, b.P, b.I, b.U, b.C, b.M, b.work, b.aux, b.cur, b.scale, b.obs)
@@ -303,12 +299,7 @@ class RotorDropEnv(gym.Env):
 
     def _step_info(self, done: bool) -> dict:
         b = self._b
-        o = b.out.tolist()
-        m = b.M.tolist()
-        info = dict(zip(_INFO_KEYS, [o[j] for j in _INFO_COLS]),
-                    time_s=m[K.M_T] - b.C[K.C_T_FAULT].item(), backward_whirl=m[K.M_WHIRL] > 0.0)
-        if self._relevitate:
-            info["relevitated"] = m[K.M_RELEV] > 0.0
+        info = step_infos(b.out[None], b.M[None], b.C[None], self._relevitate)[0]
         if done:
             info.update(self.kpis())
         return info
@@ -320,25 +311,21 @@ class RotorDropEnv(gym.Env):
         relev = bool(M[K.M_RELEV])
         return {"kpi_backward_whirl": bool(M[K.M_WHIRL]),
                 "kpi_whirl_revolutions": float(max(M[K.M_REV1], M[K.M_REV2])),
-                "kpi_peak_whirl_revolutions": float(M[K.M_REV_PEAK]),
-                "kpi_peak_contact_force_N": float(M[K.M_PEAK_F]),
-                "kpi_max_displacement_um": float(M[K.M_MAX_DISP] * 1e6),
+                **{k: float(v) for k, v in peak_kpis(M).items()},
                 "kpi_relevitated": relev,
                 "kpi_relevitation_time_s": float(M[K.M_RELEV_T]) if relev else math.nan,
                 "kpi_control_effort": float(M[K.M_EFFORT]),
                 "kpi_stator_contact": bool(out[K.O_STATOR]),
                 "kpi_bearing_overload": bool(out[K.O_OVERLOAD]),
-                "kpi_episode_time_s": float(M[K.M_T] - b.C[K.C_T_FAULT])}
+                "kpi_episode_time_s": self.time}
 
     # ---------------------------------------------------------------------- rendering --
     def _record(self) -> None:
         y, I, P = self._b.y, self._b.I, self._b.P
         orbit = []
         for k in range(2):
-            z = P[P_Z_RB1 + k]
-            orbit += [y[I[S_X]] + z * y[I[S_A]], y[I[S_Y]] + z * y[I[S_B]]]
-        self._renderer.add(self._b.M[K.M_T] - self._b.C[K.C_T_FAULT], orbit,
-                           float(self._b.out[K.O_FORCE]))
+            orbit += axis_motion(y, I, P[P_Z_RB1 + k])[:2]
+        self._renderer.add(self.time, orbit, float(self._b.out[K.O_FORCE]))
 
     def render(self):
         if self.render_mode is None:
@@ -372,6 +359,14 @@ class RotorDropEnv(gym.Env):
 
 _INFO_KEYS = ("contact_force_N",) + tuple("reward_" + n for n in REWARD_TERMS)
 _INFO_COLS = [K.O_FORCE, *_O_TERMS]
+
+
+def peak_kpis(M: np.ndarray) -> dict:
+    """The KPIs that are running episode maxima, from a monitor ``M`` (one env) or a stack
+    (N, ...) of them: the KPI reward of ``agents.reward`` reads these every step."""
+    return {"kpi_peak_whirl_revolutions": M[..., K.M_REV_PEAK],
+            "kpi_peak_contact_force_N": M[..., K.M_PEAK_F],
+            "kpi_max_displacement_um": M[..., K.M_MAX_DISP] * 1e6}
 
 
 def step_infos(out: np.ndarray, M: np.ndarray, C: np.ndarray, relevitate: bool) -> list[dict]:

@@ -25,16 +25,16 @@ from physics.model import (A_FR, A_WS, I_AMB_FILT, I_AMB_INT, I_CS, N_AUX_PLANE,
                            U_REF0, U_T_ON, amb_currents, axis_motion, rhs, sleeve_motion)
 
 # ------------------------------------------------------------------------ configuration C --
-(C_DT, C_T_FAULT, C_T_END, C_T_POWER, C_DAMP, C_LEV, C_A_DAMP, C_A_LEV, C_N_ACT, C_N_SUB,
+(C_DT, C_T_FAULT, C_T_END, C_T_POWER, C_DAMP, C_LEV, C_A_LEV,
  C_RTOL, C_HMAX, C_HMIN, C_FIXED, C_MAXSTEPS,
  C_W_WHIRL, C_W_CONTACT, C_W_DISP, C_W_EFFORT, C_W_SUCCESS, C_W_FAILURE,
  C_F_REF, C_GAP, C_LOAD_RATING, C_HOLD, C_TERMINATE, C_FULL, C_CS_MIN, C_CS_MAX, C_ILIM,
- C_RELEV_RADIUS, N_C) = range(32)
+ C_RELEV_RADIUS, C_WHIRL_RADIUS, C_WHIRL_REVS, N_C) = range(31)
 LEV_NONE, LEV_DISCRETE, LEV_CONTINUOUS = 0, 1, 2
 
 # ------------------------------------------------------------------------------ monitor M --
-(M_T, M_H, M_STEP, M_REV1, M_REV2, M_WHIRL, M_PEAK_F, M_MAX_DISP, M_OK_START, M_RELEV,
- M_RELEV_T, M_EFFORT, M_CTRL_ON, M_POWER, M_NRHS, M_REV_PEAK, N_M) = range(17)
+(M_T, M_H, M_REV1, M_REV2, M_WHIRL, M_PEAK_F, M_MAX_DISP, M_OK_START, M_RELEV,
+ M_RELEV_T, M_EFFORT, M_CTRL_ON, M_POWER, M_REV_PEAK, N_M) = range(15)
 
 # ------------------------------------------------------------------------------ outputs --
 (O_REWARD, O_R_WHIRL, O_R_CONTACT, O_R_DISP, O_R_EFFORT, O_R_SUCCESS, O_R_FAILURE, O_FORCE,
@@ -53,13 +53,13 @@ def _power_back(t, C):
 @njit
 def check_action(a, C):
     """ERR_NONE, ERR_NAN (non-finite entry) or ERR_RANGE (outside [-1, 1] / not 0 or 1)."""
-    n = int(C[C_N_ACT])
+    n = a.shape[0]
     for j in range(n):
         if not math.isfinite(a[j]):
             return ERR_NAN
         if a[j] < -1.0 - ACTION_TOL or a[j] > 1.0 + ACTION_TOL:
             return ERR_RANGE
-    if int(C[C_LEV]) == LEV_DISCRETE and int(C[C_N_ACT]) == 1 and a[0] != 0.0 and a[0] != 1.0:
+    if int(C[C_LEV]) == LEV_DISCRETE and n == 1 and a[0] != 0.0 and a[0] != 1.0:
         return ERR_RANGE
     return ERR_NONE
 
@@ -86,9 +86,8 @@ def apply_action(a, y, P, I, U, C, M):
     effort = 0.0
     n_eff = 0
     if C[C_DAMP] > 0.0:
-        o = int(C[C_A_DAMP])
-        for k in range(2):
-            frac = 0.5 * (min(max(a[o + k], -1.0), 1.0) + 1.0)
+        for k in range(2):                      # the damper commands come first
+            frac = 0.5 * (min(max(a[k], -1.0), 1.0) + 1.0)
             U[U_CS1 + k] = C[C_CS_MIN] + frac * (C[C_CS_MAX] - C[C_CS_MIN])
             effort += frac * frac
             n_eff += 1
@@ -100,7 +99,7 @@ def apply_action(a, y, P, I, U, C, M):
         o = int(C[C_A_LEV])
         if M[M_POWER] > 0.0:
             if lev == LEV_DISCRETE:
-                want = a[o] >= 0.5 if int(C[C_N_ACT]) == 1 else a[o] > 0.0
+                want = a[o] >= 0.5 if a.shape[0] == 1 else a[o] > 0.0
                 if want and M[M_CTRL_ON] == 0.0:
                     _switch_on(t, y, P, I, U)
                     M[M_CTRL_ON] = 1.0
@@ -177,12 +176,13 @@ def step_one(a, y, P, I, U, atol, work, t_sub, Y_sub, aux, cur, C, M, scale, obs
     for k in range(n_sub):
         t_sub[k] = t0 + dt * (k + 1) / n_sub
     t_sub[n_sub - 1] = t1
-    status, _, h, _, n_rhs, _, _ = integrate_segment(
+    status, t_end, h, _, _, _, _ = integrate_segment(
         y, t0, t1, P, I, U, C[C_RTOL], atol, M[M_H], C[C_HMAX], C[C_HMIN], C[C_FIXED] > 0.0,
         int(C[C_MAXSTEPS]), t_sub, Y_sub, 0, work)
-    M[M_NRHS] += n_rhs
-    if status != 0:
+    if status != 0:                             # y is at t_end: report where and with what step
         out[O_STATUS] = status
+        M[M_T] = t_end
+        M[M_H] = h
         return
     if C[C_FIXED] == 0.0:
         M[M_H] = h
@@ -212,7 +212,7 @@ def step_one(a, y, P, I, U, atol, work, t_sub, Y_sub, aux, cur, C, M, scale, obs
             disp_step = max(disp_step, r_abs)
             ex, ey = px - sx, py - sy
             r2 = ex * ex + ey * ey
-            if r2 > (0.5 * clr) ** 2:               # orbit angle, beyond half the clearance
+            if r2 > (C[C_WHIRL_RADIUS] * clr) ** 2:  # orbit angle, beyond part of the clearance
                 dth = (ex * (pvy - svy) - ey * (pvx - svx)) / r2 * dts
                 db = -spin * dth / TWO_PI
                 M[M_REV1 + k] += db
@@ -241,11 +241,10 @@ def step_one(a, y, P, I, U, atol, work, t_sub, Y_sub, aux, cur, C, M, scale, obs
     if n_eff > 0:
         effort /= n_eff                          # mean squared normalised command
     M[M_T] = t1
-    M[M_STEP] += 1.0
     M[M_PEAK_F] = max(M[M_PEAK_F], f_step)
     M[M_MAX_DISP] = max(M[M_MAX_DISP], disp_step)
     M[M_REV_PEAK] = max(M[M_REV_PEAK], M[M_REV1], M[M_REV2])
-    if M[M_REV_PEAK] >= 3.0:
+    if M[M_REV_PEAK] >= C[C_WHIRL_REVS]:
         M[M_WHIRL] = 1.0
 
     # ---- reward terms ----

@@ -11,7 +11,7 @@ import numpy as np
 from physics.equilibrium import levitated_state
 from physics.model import AMB_NONE, F_AMB, Model, build_model
 from physics.scene import Scene, SceneError
-from physics.simulate import CHUNK_S, Integrator, segments
+from physics.simulate import Integrator, run_segments
 
 POWER_RETURN = "power_return_time"
 
@@ -68,27 +68,20 @@ def sample(ranges: Mapping[str, tuple[str, float, float]], rng: np.random.Genera
 
 
 class FaultState:
-    """A scene compiled, and its state (and integrator step) at the instant of the fault."""
+    """A scene compiled, its state at the instant of the fault, and the integrator (its
+    settings and its step size there) that the episode continues with."""
 
     def __init__(self, scene: Scene):
         self.scene = scene
         self.model: Model = build_model(scene)
-        y = levitated_state(self.model)
-        integ = Integrator(self.model)
+        self.y = levitated_state(self.model)
+        self.integrator = Integrator(self.model)
         t_off = scene.amb.off_time
         if self.model.I[F_AMB] == AMB_NONE or t_off <= 0.0:
             self.t_fault = 0.0                  # no AMBs: the drop starts at t = 0
         else:
             self.t_fault = t_off
-            # the same segments and chunks as physics.simulate, so the state is bit-identical
-            for a, b, powered in segments(self.model, t_off):
-                U = self.model.controls(powered)
-                edges = np.append(np.arange(a, b, CHUNK_S), b)
-                for c0, c1 in zip(edges[:-1], edges[1:]):
-                    if c1 - c0 > 0.0:
-                        integ.advance(y, c0, c1, U)
-        self.y = y
-        self.h = integ.h
+            run_segments(self.integrator, self.y, t_off)     # as physics.simulate: bit-identical
 
 
 _CACHE: "OrderedDict[Scene, FaultState]" = OrderedDict()

@@ -29,7 +29,7 @@ from stable_baselines3.common.vec_env.base_vec_env import VecEnv
 
 from . import kernels as K
 from .buffers import Buffers
-from .env import RotorDropEnv, step_infos
+from .env import RotorDropEnv, peak_kpis, step_infos
 
 
 class BatchedRotorDropVecEnv(VecEnv):
@@ -114,6 +114,11 @@ class BatchedRotorDropVecEnv(VecEnv):
             new_obs, self.reset_infos[e] = self.envs[e].reset()
             obs[e] = new_obs
         return obs, rewards, dones, infos
+
+    def running_kpis(self) -> dict[str, np.ndarray]:
+        """Every environment's running-maximum KPIs as arrays (see ``env.peak_kpis``); after an
+        auto-reset they belong to the new episode (the finished one's are in its ``info``)."""
+        return {k: np.array(v, dtype=float) for k, v in peak_kpis(self.stack.M).items()}
 
     def close(self) -> None:
         for env in self.envs:
