@@ -22,6 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .metrics import worst_plane
+
 WINDOW_S = 0.02          # trajectory comparison window after the reference's first contact
 CAPTURE_S = 0.06         # orbit samples kept from each run after the fault (covers the window)
 TOLERANCE = 0.01         # the default must keep peak force and max displacement within 1 %
@@ -66,6 +68,7 @@ class AccuracyPlan:
 
 def settings(plan: AccuracyPlan, scene) -> list[Setting]:
     """Reference, adaptive tolerances, fixed steps, and reduced-fidelity variants of ``scene``."""
+    from .sweep import changes
     out = [Setting(f"reference (adaptive rtol {plan.reference_rtol:g})", "reference",
                    {"solver.method": "adaptive", "solver.rtol": plan.reference_rtol})]
     out += [Setting(f"adaptive rtol {r:g}", "adaptive", {"solver.method": "adaptive", "solver.rtol": r})
@@ -77,9 +80,7 @@ def settings(plan: AccuracyPlan, scene) -> list[Setting]:
     if scene.effects.friction != "none":
         reduced.append((f"{other} slip instead of {scene.effects.friction}",
                         {"effects.friction": other}))
-    for label, ov in reduced:
-        if any(scene.get(k) != v for k, v in ov.items()):
-            out.append(Setting(label, "reduced", ov))
+    out += [Setting(label, "reduced", ov) for label, ov in reduced if changes(scene, ov)]
     return out
 
 
@@ -107,10 +108,6 @@ def plan_runs(plan: AccuracyPlan, source: str, overrides: dict):
 
 
 # ------------------------------------------------------------------------------ scoring --
-def _peak(o, key):
-    return max(v[key] for v in o.metrics["planes"].values())
-
-
 def _window(o, t0: float) -> tuple[np.ndarray, dict, dict]:
     t = np.asarray(o.extra["t"])
     sel = (t >= t0 - 1e-12) & (t <= t0 + WINDOW_S + 1e-12)
@@ -122,8 +119,9 @@ def _window(o, t0: float) -> tuple[np.ndarray, dict, dict]:
 def score(o, ref) -> dict:
     """Errors of one run against the reference run of the same drop."""
     t_fc = ref.metrics["first_contact_time_s"]
-    err = {f"{name}_rel": _rel(_peak(o, key), _peak(ref, key)) for name, key in
-           (("peak_contact_force", "peak_contact_force_N"), ("max_displacement", "max_displacement_um"))}
+    extremes = (("peak_contact_force", "peak_contact_force_N"), ("max_displacement", "max_displacement_um"))
+    err = {f"{name}_rel": _rel(worst_plane(o.metrics, key), worst_plane(ref.metrics, key))
+           for name, key in extremes}
     err["whirl_agrees"] = bool(o.metrics["backward_whirl"]) == bool(ref.metrics["backward_whirl"])
     fc = o.metrics["first_contact_time_s"]
     err["first_contact_time_abs_us"] = (abs(fc - t_fc) * 1e6 if fc is not None and t_fc is not None
@@ -194,8 +192,8 @@ def analyse(plan: AccuracyPlan, rows: list, outcomes: list) -> dict:
     default, why = choose_default(table)
     ref_rows = [dict(member=k, command=o.run.to_dict()["command"],
                      wall_time_s=o.metrics["wall_time_s"], rhs_evaluations=o.metrics["rhs_evaluations"],
-                     peak_contact_force_N=_peak(o, "peak_contact_force_N"),
-                     max_displacement_um=_peak(o, "max_displacement_um"),
+                     peak_contact_force_N=worst_plane(o.metrics, "peak_contact_force_N"),
+                     max_displacement_um=worst_plane(o.metrics, "max_displacement_um"),
                      first_contact_time_s=o.metrics["first_contact_time_s"],
                      backward_whirl=o.metrics["backward_whirl"], chaotic=k in chaotic)
                 for k, o in refs.items()]
@@ -375,12 +373,9 @@ def register(subparsers) -> None:
 
 
 def cmd_accuracy(args) -> int:
-    from .scene import load_scene, parse_assignment
-    pairs = dict(parse_assignment(a) for a in args.overrides)
-    scene = load_scene(args.scene, pairs)
-    overrides = {k: scene.get(k) for k in pairs}
-    a, paths = run_accuracy(args.scene, overrides, args.out, quick=args.quick, jobs=args.jobs,
-                            progress=not args.quiet)
+    from .cli import overrides_from_args
+    a, paths = run_accuracy(args.scene, overrides_from_args(args), args.out, quick=args.quick,
+                            jobs=args.jobs, progress=not args.quiet)
     print(Path(paths[1]).read_text().split("\n\n![")[0])
     print(f"\ndefault: {a['default']} ({a['default_reason']})")
     print("wrote " + ", ".join(str(p) for p in paths))

@@ -25,9 +25,22 @@ def add_scene_args(p: argparse.ArgumentParser) -> None:
                    help="override a parameter by dotted key (repeatable), e.g. contact.friction=0.4")
 
 
+def _assignments(args) -> dict:
+    from .scene import parse_assignment
+    return dict(parse_assignment(a) for a in args.overrides)
+
+
 def scene_from_args(args):
-    from .scene import load_scene, parse_assignment
-    return load_scene(args.scene, dict(parse_assignment(a) for a in args.overrides))
+    """The scene named by --scene with the --set overrides applied (validated)."""
+    from .scene import load_scene
+    return load_scene(args.scene, _assignments(args))
+
+
+def overrides_from_args(args) -> dict:
+    """The --set overrides as typed values, validated against --scene now (before any run of a
+    batch starts), for commands that pass a scene on as source + overrides."""
+    scene = scene_from_args(args)
+    return {k: scene.get(k) for k in _assignments(args)}
 
 
 def cmd_drop(args) -> int:

@@ -10,6 +10,7 @@ from .results import Result
 
 WHIRL_MIN_REVOLUTIONS = 3.0     # net backward orbit revolutions that make a backward whirl
 WHIRL_RADIUS_FRACTION = 0.5     # only orbit samples beyond this fraction of the clearance count
+RPM = 30.0 / math.pi            # rad/s -> rpm
 
 
 def first_contact_time(result: Result) -> float | None:
@@ -64,12 +65,11 @@ def compute_metrics(result: Result) -> dict:
     """The numbers written to metrics.json (SI, with µm and rpm at the edges)."""
     t_fault = result.t_fault if result.t_fault is not None else result.t[-1]
     post = result.t >= t_fault
-    rpm = 30.0 / math.pi
     t_fc = first_contact_time(result)
     out = dict(scene=result.model.scene.name, t_end=float(result.t[-1]), t_fault_s=result.t_fault,
                first_contact_time_s=t_fc,
                first_contact_after_fault_s=(t_fc - t_fault) if t_fc is not None else None,
-               final_rotor_speed_rpm=float(result.rotor_speed[-1] * rpm),
+               final_rotor_speed_rpm=float(result.rotor_speed[-1] * RPM),
                wall_time_s=result.stats.wall_time_s, compile_time_s=result.stats.compile_time_s,
                rhs_evaluations=result.stats.rhs_evaluations, steps=result.stats.steps,
                rejected_steps=result.stats.rejected_steps, n_state=result.model.n_state, planes={})
@@ -80,8 +80,14 @@ def compute_metrics(result: Result) -> dict:
         entry = dict(max_displacement_um=float(disp.max() * 1e6),
                      max_y_displacement_um=float(np.abs(o[:, 1]).max() * 1e6) if len(o) else 0.0,
                      peak_contact_force_N=float(f.max()) if len(f) else 0.0,
-                     final_sleeve_speed_rpm=float(result.sleeve_speed(p)[-1] * rpm))
+                     final_sleeve_speed_rpm=float(result.sleeve_speed(p)[-1] * RPM))
         entry.update(whirl(result, p, t_fault))
         out["planes"][p] = entry
     out["backward_whirl"] = any(out["planes"][p]["backward_whirl"] for p in PLANES)
     return out
+
+
+def worst_plane(metrics: dict, key: str) -> float:
+    """The larger of the two retainer planes' values of a per-plane metric (``metrics["planes"]``
+    of :func:`compute_metrics`, e.g. ``"peak_contact_force_N"``)."""
+    return max(v[key] for v in metrics["planes"].values())

@@ -9,28 +9,33 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from .metrics import RPM  # noqa: E402
 from .model import PLANES  # noqa: E402
 from .results import Result  # noqa: E402
 
-RPM = 30.0 / np.pi
+
+def orbit_panel(ax, result: Result, plane: str, lw: float = 0.5, circle_lw: float = 1.0,
+                **circle) -> None:
+    """Rotor orbit at ``plane`` after the fault [µm] with the static clearance circle (Fig. 3);
+    ``circle`` holds further style of the dashed circle (e.g. its legend label)."""
+    o = result.orbit(plane)[result.t >= (result.t_fault or 0.0)] * 1e6
+    ax.plot(o[:, 0], o[:, 1], lw=lw)
+    c_um = result.model.scene.contact.clearance * 1e6
+    a = np.linspace(0, 2 * np.pi, 361)
+    ax.plot(c_um * np.cos(a), c_um * np.sin(a), "k--", lw=circle_lw, **circle)
+    ax.set_aspect("equal")
+    ax.set_xlabel("X [µm]")
 
 
 def plot_orbits(result: Result, path: Path, title: str = "") -> Path:
     """Rotor orbit at RB1 and RB2 after the fault with the static clearance circle (Fig. 3)."""
-    c_um = result.model.scene.contact.clearance * 1e6
     fig, axes = plt.subplots(1, 2, figsize=(10, 5), constrained_layout=True)
-    post = result.t >= (result.t_fault or 0.0)
-    circ = np.linspace(0, 2 * np.pi, 361)
     for ax, p in zip(axes, PLANES):
-        o = result.orbit(p)[post] * 1e6
-        ax.plot(o[:, 0], o[:, 1], lw=0.5)
-        ax.plot(c_um * np.cos(circ), c_um * np.sin(circ), "k--", lw=1, label="clearance")
-        ax.set_aspect("equal")
-        ax.set_xlabel("X [µm]")
+        orbit_panel(ax, result, p, label="clearance")
         ax.set_ylabel("Y [µm]")
         ax.set_title(f"{p} {title}".strip())
         ax.legend(loc="upper right", fontsize=8)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def plot_time_series(t, series: dict, ylabel: str, title: str, path: Path, **style) -> Path:
@@ -42,7 +47,7 @@ def plot_time_series(t, series: dict, ylabel: str, title: str, path: Path, **sty
     ax.set_ylabel(ylabel)
     ax.set_title(title.strip())
     ax.legend(ncol=style.get("ncol", 1), fontsize=8)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def plot_forces(result: Result, path: Path, title: str = "") -> Path:
@@ -76,7 +81,8 @@ def plot_drop(result: Result, out_dir: Path, title: str = "") -> list[Path]:
             plot_housing(result, out_dir / "housing.png", title)]
 
 
-def _save(fig, path: Path) -> Path:
+def save_figure(fig, path: Path) -> Path:
+    """Write ``fig`` as PNG (110 dpi, creating the directory) and close it."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=110)

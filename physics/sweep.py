@@ -42,6 +42,11 @@ class Run:
     def label(self) -> dict[str, Any]:
         return dict(self.labels)
 
+    def to_scene(self):
+        """The :class:`physics.scene.Scene` this run simulates."""
+        from .scene import load_scene
+        return load_scene(self.scene, self.settings)
+
     def to_dict(self) -> dict:
         return dict(scene=self.scene, overrides=self.settings, labels=self.label,
                     command=reproduce_command(self))
@@ -72,18 +77,28 @@ def reproduce_command(run: Run) -> str:
     return " ".join(shlex.quote(p) for p in parts)
 
 
+def changes(scene, overrides: dict) -> bool:
+    """Whether ``overrides`` change any value of ``scene``: a variant that does not would only
+    repeat the scene's own run (a sweep skips it)."""
+    return any(scene.get(k) != v for k, v in overrides.items())
+
+
 Evaluate = Callable[[Result], dict]
+
+
+def outcome_of(run: Run, result: Result, evaluate: Evaluate | None = None) -> Outcome:
+    """The :class:`Outcome` of ``run`` from its simulated ``result`` (for a caller that also
+    keeps the full result, e.g. to draw it)."""
+    metrics = compute_metrics(result)
+    extra = evaluate(result) if evaluate is not None else {}
+    return Outcome(run, True, metrics, extra)
 
 
 def simulate_run(run: Run, evaluate: Evaluate | None = None) -> Outcome:
     """Simulate one run; every exception becomes a failed :class:`Outcome` with its message."""
-    from .scene import load_scene
     from .simulate import simulate
     try:
-        result = simulate(load_scene(run.scene, run.settings))
-        metrics = compute_metrics(result)
-        extra = evaluate(result) if evaluate is not None else {}
-        return Outcome(run, True, metrics, extra)
+        return outcome_of(run, simulate(run.to_scene()), evaluate)
     except Exception as exc:                                   # reported, never dropped
         detail = "" if _expected(exc) else "\n" + traceback.format_exc(limit=3)
         return Outcome(run, False, error=f"{type(exc).__name__}: {exc}{detail}")
@@ -146,10 +161,6 @@ def run_sweep(runs: Sequence[Run] | Iterable[Run], evaluate: Evaluate | None = N
         if bar is not None:
             bar.close()
     return out
-
-
-def failures(outcomes: Iterable[Outcome]) -> list[Outcome]:
-    return [o for o in outcomes if not o.ok]
 
 
 def _bar(enabled: bool, total: int, desc: str):

@@ -23,15 +23,9 @@ def register(subparsers) -> None:
 
 
 def cmd_study_paper(args) -> int:
+    from ..cli import overrides_from_args
     from .run import run_paper_study
-    summary = run_paper_study(args.scene, _overrides(args), args.out, quick=args.quick,
+    summary = run_paper_study(args.scene, overrides_from_args(args), args.out, quick=args.quick,
                               jobs=args.jobs, progress=not args.quiet)
     print(summary)
     return 0
-
-
-def _overrides(args) -> dict:
-    from ..scene import load_scene, parse_assignment
-    pairs = dict(parse_assignment(a) for a in args.overrides)
-    scene = load_scene(args.scene, pairs)              # validates now, before any run starts
-    return {k: scene.get(k) for k in pairs}

@@ -5,11 +5,12 @@ disagree with the criterion rather than with a bare yes/no.
 """
 from __future__ import annotations
 
+from .paper import BASE, DAMPING, SOFT, STIFF, STIFFNESS
 
 PAPER_THRESHOLD = 0.39          # paper §V-A
 PAPER_SOFT_Y_UM = 600.0         # paper §V-B
-# undamped first-impact bounds with half the rotor mass (spec §7) [N]: K_s 5e6 / 5e7 / 5e8
-FIRST_IMPACT_BOUND_N = {5e6: 1685.0, 5e7: 2858.0, 5e8: 3402.0}
+# undamped first-impact bounds with half the rotor mass (spec §7) [N], per support stiffness
+FIRST_IMPACT_BOUND_N = dict(zip(STIFFNESS, (1685.0, 2858.0, 3402.0)))
 
 
 def claims(a: dict, clearance_um: float) -> list[dict]:
@@ -166,7 +167,7 @@ def _stiff(a, k):
 
 
 def _soft_600(a, _c):
-    s = _stiff(a, 5e6)
+    s = _stiff(a, SOFT)
     y, t = s["max_y_displacement_um"], s["t_max_response_s"]
     ok = abs(y / PAPER_SOFT_Y_UM - 1.0) <= 0.15 and t <= 0.05
     return _row("μ = 0.25, K_s = 5e6: largest Y response just after the drop, ≈ 600 µm",
@@ -186,7 +187,7 @@ def _same_regime(e1: dict, e2: dict, key: str) -> tuple[float, float, str]:
 
 
 def _soft_settles(a, _c):
-    s, h = _stiff(a, 5e6)["ensemble"], _stiff(a, 5e8)["ensemble"]
+    s, h = _stiff(a, SOFT)["ensemble"], _stiff(a, STIFF)["ensemble"]
     ss, hs, note = _same_regime(s, h, "force_settling_s")
     ok = ss < hs
     return _row("K_s = 5e6 settles quickly, unlike the stiffly supported rotor",
@@ -197,19 +198,19 @@ def _soft_settles(a, _c):
 
 
 def _ratio_note(a):
-    h = _stiff(a, 5e8)
+    h = _stiff(a, STIFF)
     pw = h.get("ensemble", {}).get("whirl_probability")
     b = FIRST_IMPACT_BOUND_N
     return (f"at K_s = 5e8 our rotor whirls (probability {_fmt(pw)}) and whirl forces dwarf impact "
             f"forces; without whirl the first impact is limited by the contact compliance in "
-            f"series: the undamped bounds give only {b[5e8] / b[5e7]:.1f}× the base and "
-            f"{b[5e8] / b[5e6]:.1f}× the soft case, so the paper's 2× and 5× cannot both be "
+            f"series: the undamped bounds give only {b[STIFF] / b[BASE]:.1f}× the base and "
+            f"{b[STIFF] / b[SOFT]:.1f}× the soft case, so the paper's 2× and 5× cannot both be "
             f"first-impact forces")
 
 
 def _stiff_ratio(a, other_ks: float, claim: str, paper: str, paper_ratio: float):
     """K_s = 5e8 peak contact force against another support; reproduced within ±25 %."""
-    h, o = _stiff(a, 5e8), _stiff(a, other_ks)
+    h, o = _stiff(a, STIFF), _stiff(a, other_ks)
     r = h["peak_contact_force_N"] / o["peak_contact_force_N"]
     lo, hi = 0.75 * paper_ratio, 1.25 * paper_ratio
     return _row(claim, paper, f"peak {h['peak_contact_force_N']:.0f} N vs "
@@ -218,16 +219,16 @@ def _stiff_ratio(a, other_ks: float, claim: str, paper: str, paper_ratio: float)
 
 
 def _stiff_ratio_base(a, _c):
-    return _stiff_ratio(a, 5e7, "μ = 0.25: K_s = 5e8 gives contact forces 2× the base case "
+    return _stiff_ratio(a, BASE, "μ = 0.25: K_s = 5e8 gives contact forces 2× the base case "
                         "(K_s = 5e7)", "2×", 2.0)
 
 
 def _stiff_ratio_soft(a, _c):
-    return _stiff_ratio(a, 5e6, "… and almost 5× the soft case (K_s = 5e6)", "≈ 5×", 5.0)
+    return _stiff_ratio(a, SOFT, "… and almost 5× the soft case (K_s = 5e6)", "≈ 5×", 5.0)
 
 
 def _stiff_small(a, _c):
-    h, s = _stiff(a, 5e8), _stiff(a, 5e6)
+    h, s = _stiff(a, STIFF), _stiff(a, SOFT)
     ok = h["max_y_displacement_um"] < s["max_y_displacement_um"]
     return _row("Displacements of the stiff case are minimal compared with the soft case",
                 "stiff ≪ soft", f"max Y {h['max_y_displacement_um']:.0f} µm (5e8) vs "
@@ -242,7 +243,7 @@ def _damp(a, c):
 
 
 def _damping_smooth(a, _c):
-    lo, hi = _damp(a, 2790.0), _damp(a, 27900.0)
+    lo, hi = (_damp(a, c) for c in DAMPING)
     vh, vl, note = _same_regime(hi, lo, "radial_speed_rms_mm_s")
     ok = vh < vl
     return _row("C_s = 27900 gives a smoother orbit than C_s = 2790", "smoother",
@@ -252,7 +253,7 @@ def _damping_smooth(a, _c):
 
 
 def _damping_settles(a, _c):
-    lo, hi = _damp(a, 2790.0), _damp(a, 27900.0)
+    lo, hi = (_damp(a, c) for c in DAMPING)
     sh, sl, note = _same_regime(hi, lo, "force_settling_s")
     ok = sh < sl
     return _row("… and contact forces that settle faster", "faster",

@@ -8,11 +8,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..metrics import first_contact_time
+from ..metrics import RPM, first_contact_time
 from ..model import PLANES
 from ..results import Result
 
-RPM = 30.0 / np.pi
 WINDOW_S = 0.01            # window of the contact-force fluctuation used for settling
 SETTLE_FRACTION = 0.25     # settled: window mean and std within this fraction of the late mean
 BOUNCE_WINDOW_S = 0.05     # "just after the drop": separations counted in this window

@@ -2,7 +2,8 @@
 support damping, plus the sensitivity of the results to every assumed [A] parameter.
 
 :func:`plan_runs` turns a :class:`Plan` into :class:`physics.sweep.Run` s (each labelled with the
-study it belongs to), :func:`run_study` simulates them on all cores and :func:`analyse` reduces
+study it belongs to), :func:`run_study` simulates them on all cores (keeping the full results of
+the nominal drops the figures draw) and :func:`analyse` reduces
 the outcomes to the numbers written to ``study.json``; :mod:`physics.study.report` draws the
 figures and writes the Markdown report.
 """
@@ -13,15 +14,18 @@ from typing import Any
 
 import numpy as np
 
+from ..metrics import worst_plane
+from ..results import Result
 from ..scene import Scene, load_scene
-from ..sweep import Outcome, Run, run_sweep
+from ..simulate import simulate
+from ..sweep import Outcome, Run, changes, outcome_of, run_sweep
 from .ensemble import onset, perturbations, probability_curve
 from .observables import drop_observables
 
 SLIPS = ("paper", "kinematic")
 STIFFNESS = (5e6, 5e7, 5e8)               # support stiffness study [N/m] (paper §V)
-DAMPING = (2790.0, 27900.0)               # support damping study [N s/m] (paper §V)
-SOFT = 5e6                                # the soft support of the ~600 µm statement
+SOFT, BASE, STIFF = STIFFNESS             # soft (the ~600 µm statement), base case, stiff
+DAMPING = (2790.0, 27900.0)               # support damping study [N s/m] (paper §V): low, high
 
 
 @dataclass(frozen=True)
@@ -132,16 +136,29 @@ def sensitivity_settings(scene: Scene) -> list[tuple[str, str, dict]]:
     """(factor, label, overrides): the nominal scene first, then every value that differs from it."""
     out = [("nominal", "nominal", {})]
     for f in SENSITIVITY:
-        for label, ov in f.settings:
-            if any(scene.get(k) != v for k, v in ov.items()):
-                out.append((f.name, label, ov))
+        out += [(f.name, label, ov) for label, ov in f.settings if changes(scene, ov)]
     return out
 
 
 def run_study(plan: Plan, base: StudyInput, jobs: int | None = None,
-              progress: bool = True) -> list[Outcome]:
-    return run_sweep(plan_runs(plan, base), drop_observables, jobs=jobs, desc="study paper",
-                     progress=progress)
+              progress: bool = True) -> tuple[list[Outcome], dict[str, dict[float, Result]]]:
+    """Simulate every drop of the plan; outcomes in plan order.
+
+    The nominal drops of the support studies (``member`` -1) are drawn in the figures, so they
+    run here in this process and their full results come back too, as ``{study: {value:
+    result}}``; an error in one of them stops the study, as a figure cannot be drawn without it.
+    The rest run on the process pool.
+    """
+    runs = plan_runs(plan, base)
+    nominal = {r: simulate(r.to_scene()) for r in runs if r.label["member"] == -1}
+    swept = iter(run_sweep([r for r in runs if r not in nominal], drop_observables, jobs=jobs,
+                           desc="study paper", progress=progress))
+    outcomes = [outcome_of(r, nominal[r], drop_observables) if r in nominal else next(swept)
+                for r in runs]
+    results: dict[str, dict[float, Result]] = {}
+    for r, result in nominal.items():
+        results.setdefault(r.label["study"], {})[r.label["value"]] = result
+    return outcomes, results
 
 
 # ------------------------------------------------------------------------------ analysis --
@@ -178,10 +195,6 @@ def _index(outcomes: list[Outcome]) -> dict[str, list[Outcome]]:
 
 def _whirl(o: Outcome) -> bool:
     return bool(o.metrics["backward_whirl"])
-
-
-def _worst(o: Outcome, key: str) -> float:
-    return max(v[key] for v in o.metrics["planes"].values())
 
 
 def _friction(plan: Plan, outs: list[Outcome]) -> dict:
@@ -237,10 +250,10 @@ def _medians(grp: list[Outcome]) -> dict:
         return float(np.median(vals)) if vals else None
     return dict(
         runs=len(grp),
-        max_displacement_um=med([_worst(o, "max_displacement_um") for o in grp]),
-        max_y_displacement_um=med([_worst(o, "max_y_displacement_um") for o in grp]),
+        max_displacement_um=med([worst_plane(o.metrics, "max_displacement_um") for o in grp]),
+        max_y_displacement_um=med([worst_plane(o.metrics, "max_y_displacement_um") for o in grp]),
         max_x_um=med([o.extra["max_x_um"] for o in grp]),
-        peak_contact_force_N=med([_worst(o, "peak_contact_force_N") for o in grp]),
+        peak_contact_force_N=med([worst_plane(o.metrics, "peak_contact_force_N") for o in grp]),
         mean_late_force_N=med([o.extra["mean_late_force_N"] for o in grp]),
         t_max_response_s=med([o.extra["t_max_response_s"] for o in grp]),
         sleeve_spin_up_s=med([o.extra["sleeve_spin_up_s"] for o in grp]),
@@ -262,9 +275,9 @@ def _support(outs: list[Outcome], what: str) -> list[dict]:
         if nominal is not None and nominal.ok:
             m, x = nominal.metrics, nominal.extra
             row.update(
-                max_displacement_um=_worst(nominal, "max_displacement_um"),
-                max_y_displacement_um=_worst(nominal, "max_y_displacement_um"),
-                peak_contact_force_N=_worst(nominal, "peak_contact_force_N"),
+                max_displacement_um=worst_plane(nominal.metrics, "max_displacement_um"),
+                max_y_displacement_um=worst_plane(nominal.metrics, "max_y_displacement_um"),
+                peak_contact_force_N=worst_plane(nominal.metrics, "peak_contact_force_N"),
                 backward_whirl=bool(m["backward_whirl"]),
                 t_max_response_s=x["t_max_response_s"], force_settling_s=x["force_settling_s"],
                 mean_late_force_N=x["mean_late_force_N"], separations=x["separations"],
@@ -284,7 +297,7 @@ def _support(outs: list[Outcome], what: str) -> list[dict]:
 
 
 def _ensemble_stats(ens: list[Outcome]) -> dict:
-    return {**{k: _stats([_worst(o, k) for o in ens]) for k in
+    return {**{k: _stats([worst_plane(o.metrics, k) for o in ens]) for k in
                ("max_displacement_um", "max_y_displacement_um", "peak_contact_force_N")},
             **{k: _stats([o.extra[k] for o in ens]) for k in
                ("force_settling_s", "radial_speed_rms_mm_s", "separations", "mean_late_force_N")}}
@@ -312,10 +325,12 @@ def _sensitivity(outs: list[Outcome], settings: list[tuple[str, str, dict]]) -> 
             factor=factor, setting=setting, overrides=overrides,
             onset=ons, probability=[dict(friction=c["value"], probability=c["probability"],
                                          runs=c["runs"]) for c in curve],
-            soft_max_y_displacement_um=(float(np.median([_worst(o, "max_y_displacement_um")
-                                                         for o in soft])) if soft else None),
-            soft_peak_contact_force_N=(float(np.median([_worst(o, "peak_contact_force_N")
-                                                        for o in soft])) if soft else None),
+            soft_max_y_displacement_um=_median_worst(soft, "max_y_displacement_um"),
+            soft_peak_contact_force_N=_median_worst(soft, "peak_contact_force_N"),
             failed=sum(not o.ok for o in grp)))
     return rows
 
+
+def _median_worst(outs: list[Outcome], key: str) -> float | None:
+    """Median over the drops of the worst plane's ``key`` (None without drops)."""
+    return float(np.median([worst_plane(o.metrics, key) for o in outs])) if outs else None

@@ -9,23 +9,18 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from ..plots import RPM, orbit_panel, save_figure  # noqa: E402
 from ..results import Result  # noqa: E402
 from .claims import PAPER_SOFT_Y_UM, PAPER_THRESHOLD  # noqa: E402
+from .paper import BASE, SOFT  # noqa: E402
 
-RPM = 30.0 / np.pi
 PLANE = "RB1"           # the paper's figures are at retainer bearing 1
 
 
 # --------------------------------------------------------------------------------- figures --
 def _save(fig, path: Path) -> str:
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path.name
-
-
-def _circle(ax, c_um):
-    a = np.linspace(0, 2 * np.pi, 361)
-    ax.plot(c_um * np.cos(a), c_um * np.sin(a), "k--", lw=0.8)
+    """Write the figure; its file name is what the report links to."""
+    return save_figure(fig, path).name
 
 
 def plot_probability(a: dict, out: Path) -> str:
@@ -51,18 +46,12 @@ def plot_probability(a: dict, out: Path) -> str:
 def _orbit_row(runs: dict[float, Result], label: str, path: Path, width: float, share: bool) -> str:
     """One orbit panel at RB1 per run (after the fault) with the clearance circle (Fig. 3)."""
     vals = sorted(runs)
-    c_um = runs[vals[0]].model.scene.contact.clearance * 1e6
     fig, axes = plt.subplots(1, len(vals), figsize=(width * len(vals), 3.6 if share else 3.8),
                              constrained_layout=True, sharex=share, sharey=share)
     axes = np.atleast_1d(axes)
     for ax, v in zip(axes, vals):
-        r = runs[v]
-        o = r.orbit(PLANE)[r.t >= r.t_fault] * 1e6
-        ax.plot(o[:, 0], o[:, 1], lw=0.4)
-        _circle(ax, c_um)
-        ax.set_aspect("equal")
-        ax.set_title(f"{label} = {v:g}" + (" (whirl)" if _whirls(r) else ""), fontsize=9)
-        ax.set_xlabel("X [µm]")
+        orbit_panel(ax, runs[v], PLANE, lw=0.4, circle_lw=0.8)
+        ax.set_title(f"{label} = {v:g}" + (" (whirl)" if _whirls(runs[v]) else ""), fontsize=9)
     axes[0].set_ylabel("Y [µm]")
     return _save(fig, path)
 
@@ -188,7 +177,7 @@ def write_report(a: dict, out: Path, figures: dict[str, list[str]], meta: dict) 
     w("| quantity | paper | ours |\n|---|---|---|")
     w(f"| whirl threshold (50 % probability), paper slip | 0.39 | {_f(th['paper'])} |")
     w(f"| whirl threshold (50 % probability), kinematic slip | – | {_f(th['kinematic'])} |")
-    soft = next((r for r in a["support_stiffness"] if r["stiffness"] == 5e6), {})
+    soft = next((r for r in a["support_stiffness"] if r["stiffness"] == SOFT), {})
     w(f"| max Y at K_s = 5e6, μ = 0.25 | ≈ 600 µm | {_f(soft.get('max_y_displacement_um'), '.0f')} µm |")
     n_ok = sum(c["reproduced"] for c in a["claims"])
     w(f"| claims reproduced | – | {n_ok} of {len(a['claims'])} |\n")
@@ -225,7 +214,7 @@ def write_report(a: dict, out: Path, figures: dict[str, list[str]], meta: dict) 
 
     w("\n## 2. Support stiffness (μ = 0.25, C_s = 5000 N s/m)\n")
     base_f = next((r.get("peak_contact_force_N") for r in a["support_stiffness"]
-                   if r["stiffness"] == 5e7), None)
+                   if r["stiffness"] == BASE), None)
     soft_f = soft.get("peak_contact_force_N")
     w("| K_s [N/m] | max Y [µm] | max radial [µm] | peak F_r [N] | ÷ base | ÷ soft | whirl | "
       "ensemble: whirl prob., peak F_r median (min–max) |\n|---|---|---|---|---|---|---|---|")

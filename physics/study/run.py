@@ -10,7 +10,7 @@ from ..simulate import simulate
 from ..sweep import default_jobs
 from . import report
 from .claims import claims
-from .paper import DAMPING, SENSITIVITY, STIFFNESS, Plan, StudyInput, analyse, run_study
+from .paper import SENSITIVITY, Plan, StudyInput, analyse, run_study
 
 
 def run_paper_study(source: str, overrides: dict, out_dir, quick: bool = False,
@@ -22,18 +22,17 @@ def run_paper_study(source: str, overrides: dict, out_dir, quick: bool = False,
     base = StudyInput(source, dict(overrides))
     jobs = default_jobs() if jobs is None else jobs
     t0 = time.perf_counter()
-    outcomes = run_study(plan, base, jobs=jobs, progress=progress)
+    outcomes, nominal = run_study(plan, base, jobs=jobs, progress=progress)
     a = analyse(plan, base, outcomes)
     scene = base.scene
     a["claims"] = claims(a, scene.contact.clearance * 1e6)
     a["calibration"] = calibration(source, overrides)
-    runs = figure_runs(base, plan)
     figures = dict(
         probability=[report.plot_probability(a, out)],
-        friction=report.plot_friction_runs(runs["friction"], out),
+        friction=report.plot_friction_runs(friction_runs(base, plan), out),
         response=[report.plot_friction_response(a, out)],
-        stiffness=report.plot_support(runs["stiffness"], "support.stiffness", out),
-        damping=report.plot_support(runs["damping"], "support.damping", out),
+        stiffness=report.plot_support(nominal["stiffness"], "support.stiffness", out),
+        damping=report.plot_support(nominal["damping"], "support.damping", out),
         sensitivity=[report.plot_sensitivity(a, out)])
     commands = interesting_runs(a, outcomes, base, plan)
     a["reproduce"] = [dict(label=l, command=c) for l, c in commands]
@@ -53,14 +52,12 @@ def run_paper_study(source: str, overrides: dict, out_dir, quick: bool = False,
             f"{a['runs']['total']} runs failed; {wall:.0f} s\nwrote {path}, {out / 'study.json'}")
 
 
-def figure_runs(base: StudyInput, plan: Plan) -> dict:
-    """The nominal drops drawn in the figures (full time series, simulated here)."""
+def friction_runs(base: StudyInput, plan: Plan) -> dict:
+    """The nominal drops at the figure frictions (full time series, simulated here; the support
+    studies' nominal drops come from :func:`physics.study.paper.run_study`)."""
     scene = base.scene
-    return dict(
-        friction={mu: simulate(scene.with_overrides({"contact.friction": mu}))
-                  for mu in plan.figure_frictions},
-        stiffness={k: simulate(scene.with_overrides({"support.stiffness": k})) for k in STIFFNESS},
-        damping={c: simulate(scene.with_overrides({"support.damping": c})) for c in DAMPING})
+    return {mu: simulate(scene.with_overrides({"contact.friction": mu}))
+            for mu in plan.figure_frictions}
 
 
 def interesting_runs(a: dict, outcomes, base: StudyInput, plan: Plan) -> list[tuple[str, str]]:
