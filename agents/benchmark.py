@@ -36,7 +36,7 @@ import numpy as np
 from .controllers import BASELINES, Passive
 from .policies import LearnedPolicy, load_shipped, shipped_names
 from .rollout import run_episodes
-from .score import overall_score, row_cost, summarize
+from .score import fmt_or_dash, json_default, overall_score, row_cost, summarize
 
 EPISODE_TIME = 0.3
 EVAL_KWARGS = dict(episode_time=EPISODE_TIME, terminate_on_failure=False, randomize=False)
@@ -162,7 +162,7 @@ def monitor_kwargs(kw: dict) -> dict:
     return {"samples_per_step": max(5, int(round(dt / MONITOR_DT)))}
 
 
-def _env_kwargs(entry: Entry, scenario: Scenario, phase: float) -> dict:
+def episode_kwargs(entry: Entry, scenario: Scenario, phase: float) -> dict:
     kw = {k: v for k, v in entry.env_kwargs.items()
           if k not in ("randomize", "randomization", "overrides", "terminate_on_failure",
                        "episode_time", "samples_per_step")}
@@ -217,7 +217,7 @@ def benchmark(out: str | Path, quick: bool = False, policies: list[str] | None =
                                   group=s.group, env_kwargs=s.env_kwargs, tasks=list(s.tasks))
                              for s in scenarios],
                   rows=rows, leaderboard=board, wall_time_s=time.perf_counter() - t0)
-    (out / "benchmark.json").write_text(json.dumps(report, indent=2, default=_json))
+    (out / "benchmark.json").write_text(json.dumps(report, indent=2, default=json_default))
     (out / "leaderboard.md").write_text(leaderboard_markdown(report))
     if plots:
         from .plots import plot_benchmark
@@ -235,7 +235,7 @@ def suite_rows(entry: Entry, scenarios: list[Scenario], phases, progress=None) -
     for sc in [s for s in scenarios if entry.task in s.tasks]:
         eps = []
         for ph in phases:
-            eps += run_episodes(TASKS[entry.task], entry.make, [0], _env_kwargs(entry, sc, ph))
+            eps += run_episodes(TASKS[entry.task], entry.make, [0], episode_kwargs(entry, sc, ph))
             if progress is not None:
                 progress.update(1)
         rows.append(_row(entry, sc, eps))
@@ -332,14 +332,11 @@ def _group_score(mine, costs, p_costs, group):
     return overall_score([costs[n] for n in names], [p_costs[n] for n in names])
 
 
-def _fmt(v, f):
-    return "-" if v is None else format(v, f)
-
 
 def leaderboard_markdown(report: dict) -> str:
     thr = report["passive_threshold"]
     lines = [f"# rotordrop benchmark{' (quick)' if report['quick'] else ''}", "",
-             f"Passive whirl threshold mu* = {_fmt(thr, 'g')} (paper scene, {len(report['phases_deg'])} "
+             f"Passive whirl threshold mu* = {fmt_or_dash(thr, 'g')} (paper scene, {len(report['phases_deg'])} "
              f"unbalance phases, {report['episode_time_s']:g} s after the fault). "
              f"Score: 100 (1 - sum J / sum J_passive), see docs/agents.md.", ""]
     for task in dict.fromkeys(e["task"] for e in report["leaderboard"]):
@@ -349,11 +346,11 @@ def leaderboard_markdown(report: dict) -> str:
                   "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
         for i, e in enumerate([e for e in report["leaderboard"] if e["task"] == task], 1):
             lines.append(f"| {i} | {e['controller']} | {e['score']:.1f} | "
-                         f"{_fmt(e['in_distribution_score'], '.1f')} | "
-                         f"{_fmt(e['out_of_distribution_score'], '.1f')} | {e['whirl_rate']:.2f} | "
-                         f"{_fmt(e['whirl_rate_where_passive_whirls'], '.2f')} | "
+                         f"{fmt_or_dash(e['in_distribution_score'], '.1f')} | "
+                         f"{fmt_or_dash(e['out_of_distribution_score'], '.1f')} | {e['whirl_rate']:.2f} | "
+                         f"{fmt_or_dash(e['whirl_rate_where_passive_whirls'], '.2f')} | "
                          f"{e['force_ratio']:.2f}, {e['max_force_ratio']:.2f} | "
-                         f"{e['displacement_ratio']:.2f} | {_fmt(e['relevitation_rate'], '.2f')} |")
+                         f"{e['displacement_ratio']:.2f} | {fmt_or_dash(e['relevitation_rate'], '.2f')} |")
         lines += ["", "| controller | scenario | mu | whirl | peak revs | peak F [N] | max disp [µm] | "
                       "relevitated | t_relev [ms] | J |", "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
         for r in [r for r in report["rows"] if r["task"] == task]:
@@ -361,13 +358,8 @@ def leaderboard_markdown(report: dict) -> str:
             lines.append(f"| {r['controller']} | {r['scenario']} | {r['friction']:g} | "
                          f"{r['backward_whirl']:.2f} | {r['peak_whirl_revolutions']:.1f} | "
                          f"{r['peak_contact_force_N']:.0f} | {r['max_displacement_um']:.0f} | "
-                         f"{_fmt(r['relevitated'], '.2f')} | {_fmt(t * 1e3 if t is not None else None, '.0f')} | "
+                         f"{fmt_or_dash(r['relevitated'], '.2f')} | {fmt_or_dash(t * 1e3 if t is not None else None, '.0f')} | "
                          f"{r.get('cost', float('nan')):.2f} |")
         lines.append("")
     return "\n".join(lines)
 
-
-def _json(o):
-    if isinstance(o, np.generic):
-        return o.item()
-    return str(o)

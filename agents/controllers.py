@@ -125,6 +125,7 @@ class WhirlSwitch(Controller):
                  window: float = 0.01, hold_time: float = 0.02):
         super().__init__(plant)
         self.r_on, self.angle, self.window, self.hold_time = r_on, angle, window, hold_time
+        self.decay = np.exp(-plant.control_dt / window)
         self.last = np.zeros((0, 2))
         self.theta = np.zeros((0, 2))
         self.backward = np.zeros((0, 2))
@@ -142,9 +143,8 @@ class WhirlSwitch(Controller):
 
     def commands(self, obs):
         p = self.plant
-        spin = np.sign(p.get(obs, "rotor_speed"))
-        spin[spin == 0] = 1.0
-        decay = np.exp(-p.control_dt / self.window)
+        spin = p.spin_sign(obs)
+        decay = self.decay
         for k in range(2):
             x, y = p.get(obs, f"x{k + 1}"), p.get(obs, f"y{k + 1}")
             theta = np.arctan2(y, x)
@@ -185,7 +185,7 @@ class PidRelevitate(Controller):
         lim = plant.current_limit
         kp, ki, kd = plant.pid               # the scene's AMB PID gains, per A -> normalised
         self.kp, self.ki, self.kd = kp / lim, ki / lim, kd / lim
-        self.ff = np.array([0.0, plant.feedforward[0], 0.0, plant.feedforward[1]]) / lim
+        self.ff = plant.gravity_currents
         self.on_t = np.zeros(0)
         self.start = np.zeros((0, 4))
         self.integral = np.zeros((0, 4))
@@ -203,8 +203,7 @@ class PidRelevitate(Controller):
     def commands(self, obs):
         p = self.plant
         powered = p.power_available(obs)
-        pos = np.stack([p.get(obs, k) for k in ("x1", "y1", "x2", "y2")], axis=1)
-        vel = np.stack([p.get(obs, k) for k in ("vx1", "vy1", "vx2", "vy2")], axis=1)
+        pos, vel = p.positions(obs), p.velocities(obs)
         new = powered & np.isnan(self.on_t)
         self.on_t[new] = self.t[new]
         self.start[new] = pos[new]
@@ -248,18 +247,16 @@ class WhirlBrake(Controller):
         if unknown:
             raise TypeError(f"unknown {self.name} gains {sorted(unknown)}; known: {sorted(self.GAINS)}")
         self.g = {**self.GAINS, **gains}
-        self.ug = np.array([0.0, plant.feedforward[0], 0.0, plant.feedforward[1]]) / plant.current_limit
 
     def commands(self, obs):
         p, g = self.plant, self.g
-        pos = np.stack([p.get(obs, k) for k in ("x1", "y1", "x2", "y2")], axis=1) / p.clearance
-        vel = np.stack([p.get(obs, k) for k in ("vx1", "vy1", "vx2", "vy2")], axis=1) * 1e-3 / p.clearance
-        spin = np.sign(p.get(obs, "rotor_speed"))[:, None]
-        spin[spin == 0.0] = 1.0
+        pos = p.positions(obs) / p.clearance
+        vel = p.velocities(obs) * 1e-3 / p.clearance
+        spin = p.spin_sign(obs)[:, None]
         r = np.repeat(np.hypot(pos[:, 0::2], pos[:, 1::2]), 2, axis=1)
         unit = pos / np.maximum(r, 1e-9)
         outer = r > g["r_on"]
-        u = (g["ff"] * self.ug - g["kp"] * pos - g["kd"] * vel + g["kc"] * spin * _rot90(vel)
+        u = (g["ff"] * p.gravity_currents - g["kp"] * pos - g["kd"] * vel + g["kc"] * spin * _rot90(vel)
              + np.where(outer, g["kt"] * spin * _rot90(unit) - g["kr"] * unit, 0.0))
         out = {"currents": np.where(p.power_available(obs)[:, None], np.clip(u, -1.0, 1.0), 0.0)}
         if "damping" in p.channels:
@@ -267,9 +264,12 @@ class WhirlBrake(Controller):
         return out
 
 
+_ROT90 = np.array([-1.0, 1.0, -1.0, 1.0])
+
+
 def _rot90(v: np.ndarray) -> np.ndarray:
     """(x1, y1, x2, y2) rows rotated by +90° in each plane."""
-    return np.stack([-v[:, 1], v[:, 0], -v[:, 3], v[:, 2]], axis=1)
+    return v[:, [1, 0, 3, 2]] * _ROT90
 
 
 BASELINES: dict[str, type[Controller]] = {c.name: c for c in (

@@ -13,7 +13,7 @@ from .benchmark import monitor_kwargs
 from .controllers import BASELINES, Passive
 from .policies import resolve
 from .rollout import run_episodes
-from .score import summarize
+from .score import fmt_or_dash, json_default, summarize
 
 
 def _merge_kwargs(base: dict, user: dict, randomize: bool) -> dict:
@@ -77,18 +77,10 @@ def evaluate(policy: str, env_id: str | None, episodes: int, out: str | Path,
         from .plots import plot_episode_comparison
         report["figures"] = [p.name for p in plot_episode_comparison(
             eps[0], passive[0] if passive else None, name, out)]
-    (out / "kpis.json").write_text(json.dumps(report, indent=2, default=_json_default))
+    (out / "kpis.json").write_text(json.dumps(report, indent=2, default=json_default))
     report["out"] = str(out)
     return report
 
-
-def _json_default(o):
-    import numpy as np
-    if isinstance(o, np.generic):
-        return o.item()
-    if isinstance(o, np.ndarray):
-        return o.tolist()
-    return str(o)
 
 
 def print_summary(report: dict) -> None:
@@ -101,13 +93,10 @@ def print_summary(report: dict) -> None:
           f"{'relev. rate':>12}{'relev. t [ms]':>14}{'effort':>9}{'return':>9}")
     for name, s in rows:
         t = s["relevitation_time_s"]
-        print(f"{name:18}{_f(s['backward_whirl_rate'], '.2f'):>11}{_f(s['peak_contact_force_N'], '.0f'):>12}"
-              f"{_f(s['max_displacement_um'], '.0f'):>15}{_f(s['relevitation_success_rate'], '.2f'):>12}"
-              f"{_f(t * 1e3 if t is not None else None, '.1f'):>14}{_f(s['control_effort'], '.3g'):>9}"
-              f"{_f(s['mean_return'], '.1f'):>9}")
+        print(f"{name:18}{fmt_or_dash(s['backward_whirl_rate'], '.2f'):>11}{fmt_or_dash(s['peak_contact_force_N'], '.0f'):>12}"
+              f"{fmt_or_dash(s['max_displacement_um'], '.0f'):>15}{fmt_or_dash(s['relevitation_success_rate'], '.2f'):>12}"
+              f"{fmt_or_dash(t * 1e3 if t is not None else None, '.1f'):>14}{fmt_or_dash(s['control_effort'], '.3g'):>9}"
+              f"{fmt_or_dash(s['mean_return'], '.1f'):>9}")
     print(f"wrote {Path(report['out']) / 'kpis.json'}"
           + "".join(f", {f}" for f in report.get("figures", [])))
 
-
-def _f(v, fmt: str) -> str:
-    return "-" if v is None else format(v, fmt)

@@ -167,6 +167,9 @@ def split(hp: dict) -> tuple[dict, dict]:
         if meta["residual"] not in BASELINES:
             raise ConfigError(f"residual must be a baseline controller ({', '.join(BASELINES)}), "
                               f"got {meta['residual']!r}")
+    if meta.get("residual") is not None:
+        from .residual import RESIDUAL_SCALE
+        meta.setdefault("residual_scale", RESIDUAL_SCALE)
     if "residual_scale" in meta:
         try:
             meta["residual_scale"] = float(meta["residual_scale"])

@@ -20,11 +20,15 @@ start, AMBs off).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
+from rotordrop_env.layout import CURRENT_ACTIONS as CURRENT_NAMES
+
 SENSORS = ("x1", "y1", "vx1", "vy1", "x2", "y2", "vx2", "vy2", "rotor_speed")
-CURRENT_NAMES = ("current_amb1_x", "current_amb1_y", "current_amb2_x", "current_amb2_y")
+POSITIONS = ("x1", "y1", "x2", "y2")
+VELOCITIES = ("vx1", "vy1", "vx2", "vy2")
 
 
 def make_env(env_id: str, **kwargs):
@@ -80,22 +84,27 @@ class Plant:
         if missing:
             raise ValueError(f"controllers need the sensor observations {', '.join(missing)}; "
                              f"create the environment without full_state=True")
+        from physics.model import P_AMB_IFF1, P_AMB_IFF2
         s = u.base_scene
-        act = u.actuator
+        P = u.model.P              # gravity feed-forward currents: 0 without actuator AMBs
         return cls(env_id=u.spec.id if u.spec is not None else type(u).__name__,
                    obs_names=tuple(u.obs_names), obs_scale=np.asarray(u.obs_scale, dtype=np.float64),
                    action_names=tuple(u.action_names), discrete=bool(u._discrete),
                    control_dt=float(u.dt), clearance=s.contact.clearance,
                    damping_range=(s.support.damping_min, s.support.damping_max),
                    current_limit=s.amb.current_limit, pid=(s.amb.kp, s.amb.ki, s.amb.kd),
-                   feedforward=tuple(act.feedforward) if act is not None else (0.0, 0.0),
+                   feedforward=(float(P[P_AMB_IFF1]), float(P[P_AMB_IFF2])),
                    liftoff_ramp=s.amb.liftoff_ramp_time)
 
     # ------------------------------------------------------------------ observations --
+    @cached_property
+    def _columns(self) -> dict[str, int]:
+        return {n: j for j, n in enumerate(self.obs_names)}
+
     def index(self, name: str) -> int:
         try:
-            return self.obs_names.index(name)
-        except ValueError:
+            return self._columns[name]
+        except KeyError:
             raise KeyError(f"{self.env_id} has no observation {name!r} "
                            f"(it has {', '.join(self.obs_names)})") from None
 
@@ -103,6 +112,27 @@ class Plant:
         """Physical (SI) value of observation ``name`` for each row of ``obs``."""
         j = self.index(name)
         return obs[:, j] * self.obs_scale[j]
+
+    def _block(self, obs: np.ndarray, names: tuple[str, ...]) -> np.ndarray:
+        j = [self.index(n) for n in names]
+        return obs[:, j] * self.obs_scale[j]
+
+    def positions(self, obs: np.ndarray) -> np.ndarray:
+        """(n, 4) sensed displacements x1, y1, x2, y2 [m]."""
+        return self._block(obs, POSITIONS)
+
+    def velocities(self, obs: np.ndarray) -> np.ndarray:
+        """(n, 4) sensed velocities vx1, vy1, vx2, vy2 [m/s]."""
+        return self._block(obs, VELOCITIES)
+
+    def spin_sign(self, obs: np.ndarray) -> np.ndarray:
+        """(n,) sign of the rotor speed (+1 at standstill)."""
+        return np.where(self.get(obs, "rotor_speed") < 0.0, -1.0, 1.0)
+
+    @cached_property
+    def gravity_currents(self) -> np.ndarray:
+        """(4,) gravity feed-forward per AMB axis (x1, y1, x2, y2) / current limit."""
+        return np.array([0.0, self.feedforward[0], 0.0, self.feedforward[1]]) / self.current_limit
 
     def damping_level(self, obs: np.ndarray) -> np.ndarray:
         """(n, 2) current damper values as commands in [-1, 1]."""
@@ -116,7 +146,7 @@ class Plant:
         return self.get(obs, "amb_power") > 0.5
 
     # --------------------------------------------------------------------- actions --
-    @property
+    @cached_property
     def channels(self) -> tuple[str, ...]:
         ch = []
         if "damping1" in self.action_names:
@@ -126,10 +156,6 @@ class Plant:
         if CURRENT_NAMES[0] in self.action_names:
             ch.append("currents")
         return tuple(ch)
-
-    @property
-    def continuous_currents(self) -> bool:
-        return CURRENT_NAMES[0] in self.action_names
 
     def compose(self, n: int, commands: dict, hold_damping: np.ndarray | None = None) -> np.ndarray:
         """The env action for each of n environments from channel commands (module docstring).

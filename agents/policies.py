@@ -17,9 +17,8 @@ import numpy as np
 
 from .controllers import BASELINES, make_baseline
 from .plant import Plant
-from .residual import RESIDUAL_SCALE
-
-ALGO_NAMES = ("ppo", "sac", "td3")
+from .hyperparams import ALGOS as ALGO_NAMES
+from .residual import RESIDUAL_SCALE, residual_action
 
 
 def shipped_dir() -> Path:
@@ -60,14 +59,9 @@ class LearnedPolicy:
             if self.base is None:
                 raise RuntimeError(f"{self.name} corrects the {self.residual} controller: call "
                                    f".bound(Plant.from_env(env)) before predict")
-            b, _ = self.base.predict(raw, episode_start=episode_start)
-            action = np.clip(b + self.residual_scale * action, -1.0, 1.0).astype(np.float32)
+            action = residual_action(self.base, raw, action, self.residual_scale, episode_start)
         return action, state
 
-    def reset(self, n: int, which=None) -> None:
-        """MLP policies are stateless; a residual's base controller starts new episodes."""
-        if self.base is not None:
-            self.base.reset(n, which)
 
     @classmethod
     def load(cls, path: str | Path, name: str | None = None) -> "LearnedPolicy":
@@ -91,7 +85,8 @@ class LearnedPolicy:
         if env_id is None:
             raise FileNotFoundError(f"cannot tell which environment {model_path} was trained on: "
                                     f"no config.yaml or .json next to it")
-        env_kwargs = dict(meta.get("env_kwargs") or meta.get("hyperparams", {}).get("env_kwargs") or {})
+        hp = meta.get("hyperparams", {})
+        env_kwargs = dict(meta.get("env_kwargs") or hp.get("env_kwargs") or {})
         from .train import _algo_class
         model = _algo_class(algo).load(str(model_path), device="cpu")
         vn = None
@@ -100,9 +95,8 @@ class LearnedPolicy:
                 vn = pickle.load(fh)
             vn.training = False
         task = env_id.split("-")[1].lower() if env_id.count("-") >= 2 else "policy"
-        hp = meta.get("hyperparams", {})
-        residual = meta.get("residual") or hp.get("residual")
-        scale = float(meta.get("residual_scale") or hp.get("residual_scale") or RESIDUAL_SCALE)
+        residual = hp.get("residual")
+        scale = float(hp.get("residual_scale") or RESIDUAL_SCALE)
         return cls(name or meta.get("name") or f"{algo}-{task}", algo, env_id, env_kwargs, model,
                    vn, meta, residual, scale)
 

@@ -1,9 +1,10 @@
 """Residual policy learning (config key ``residual: <baseline>``): the agent corrects a baseline.
 
-The environment receives ``clip(base(obs) + 2 a, -1, 1)`` with ``a`` the agent's action, so a
-freshly initialised policy (a ≈ 0) is the baseline controller and learning changes it only where
-that pays (Johannink et al. 2019). :class:`agents.policies.LearnedPolicy` applies the same
-correction when a saved residual policy is loaded (``RESIDUAL_SCALE``).
+The environment receives ``clip(base(obs) + s a, -1, 1)`` with ``a`` the agent's action and
+``s`` the config's ``residual_scale`` (default ``RESIDUAL_SCALE`` = 2), so a freshly initialised
+policy (a ≈ 0) is the baseline controller and learning changes it only where that pays
+(Johannink et al. 2019). :class:`agents.policies.LearnedPolicy` applies the same correction
+(:func:`residual_action`) when a saved residual policy is loaded.
 """
 from __future__ import annotations
 
@@ -12,12 +13,19 @@ import numpy as np
 RESIDUAL_SCALE = 2.0
 
 
+def residual_action(base, raw_obs: np.ndarray, a: np.ndarray, scale: float,
+                    episode_start=None) -> np.ndarray:
+    """``clip(base(obs) + scale * a, -1, 1)`` as float32: the action a residual policy sends,
+    in training (:func:`make_residual`) and when a saved policy drives an env."""
+    b, _ = base.predict(raw_obs, episode_start=episode_start)
+    return np.clip(b + scale * np.asarray(a), -1.0, 1.0).astype(np.float32)
+
+
 def make_residual(venv, base: str, scale: float = RESIDUAL_SCALE):
-    """Residual actions (config key ``residual: <baseline>``): the environment receives
-    ``clip(base(obs) + scale * a, -1, 1)``, with ``a`` the agent's action and ``base`` a baseline
-    controller of :mod:`agents.controllers`. A freshly initialised policy (a ≈ 0) reproduces the
-    baseline; learning changes it only where that pays (residual policy learning, Johannink et
-    al. 2019). Box action spaces only."""
+    """Residual actions (config key ``residual: <baseline>``) on an SB3 VecEnv: see
+    :func:`residual_action`. A freshly initialised policy (a ≈ 0) reproduces the baseline;
+    learning changes it only where that pays (residual policy learning, Johannink et al.
+    2019). Box action spaces only."""
     from stable_baselines3.common.vec_env import VecEnvWrapper
 
     from .controllers import make_baseline
@@ -28,21 +36,19 @@ def make_residual(venv, base: str, scale: float = RESIDUAL_SCALE):
             super().__init__(venv)
             self.base = make_baseline(base, Plant.from_env(venv))
             self.obs = None
+            self.starts = np.ones(self.num_envs, dtype=bool)
 
         def reset(self):
             self.obs = self.venv.reset()
-            self.base.reset(self.num_envs)
+            self.starts[:] = True
             return self.obs
 
         def step_async(self, actions):
-            b, _ = self.base.predict(self.obs)
-            self.venv.step_async(np.clip(b + scale * np.asarray(actions), -1.0, 1.0))
+            self.venv.step_async(residual_action(self.base, self.obs, actions, scale, self.starts))
 
         def step_wait(self):
             obs, rewards, dones, infos = self.venv.step_wait()
-            if np.any(dones):
-                self.base.reset(self.num_envs, np.asarray(dones, dtype=bool))
-            self.obs = obs
+            self.obs, self.starts = obs, np.asarray(dones, dtype=bool)
             return obs, rewards, dones, infos
 
     return ResidualAction(venv)

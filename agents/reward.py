@@ -23,14 +23,17 @@ from __future__ import annotations
 
 import numpy as np
 
-REVS_FOR_WHIRL = 3.0
+from physics.metrics import WHIRL_MIN_REVOLUTIONS
+
+PEAK_KEYS = ("kpi_peak_whirl_revolutions", "kpi_peak_contact_force_N", "kpi_max_displacement_um")
 
 
-def kpi_potential(k: dict, revs_max: float, w_whirl: float, w_force: float, w_disp: float,
-                  force_ref: float, disp_ref_um: float) -> float:
-    return (w_whirl * min(revs_max, REVS_FOR_WHIRL) / REVS_FOR_WHIRL
-            + w_force * k["kpi_peak_contact_force_N"] / force_ref
-            + w_disp * k["kpi_max_displacement_um"] / disp_ref_um)
+def kpi_potential(revs, force_N, disp_um, w_whirl: float, w_force: float, w_disp: float,
+                  force_ref: float, disp_ref_um: float):
+    """Φ of the module docstring from the peak net backward revolutions, the peak contact force
+    and the maximum displacement (floats or arrays)."""
+    return (w_whirl * np.minimum(revs, WHIRL_MIN_REVOLUTIONS) / WHIRL_MIN_REVOLUTIONS
+            + w_force * np.asarray(force_N) / force_ref + w_disp * np.asarray(disp_um) / disp_ref_um)
 
 
 def make_kpi_reward(venv, **kwargs):
@@ -48,33 +51,25 @@ def make_kpi_reward(venv, **kwargs):
             dt, horizon = (np.asarray(venv.get_attr(a), dtype=float) for a in ("dt", "episode_time"))
             self.time_cost = w_time * dt / horizon
             self.phi = np.zeros(self.num_envs)
-            self.revs = np.zeros(self.num_envs)
 
         def reset(self):
             obs = self.venv.reset()
             self.phi[:] = 0.0
-            self.revs[:] = 0.0
             return obs
 
         def step_wait(self):
             obs, _, dones, infos = self.venv.step_wait()
-            running = self.venv.env_method("kpis")
-            rewards = np.zeros(self.num_envs, dtype=np.float32)
-            for i in range(self.num_envs):
-                k = infos[i] if dones[i] else running[i]       # a done env is already reset
-                self.revs[i] = max(self.revs[i], k["kpi_peak_whirl_revolutions"])
-                phi = kpi_potential(k, self.revs[i], **self.w)
-                rewards[i] = self.phi[i] - phi
-                if infos[i].get("reward_success", 0.0) > 0.0:
-                    rewards[i] += self.w_relevitate
-                elif "relevitated" in infos[i] and not infos[i]["relevitated"]:
-                    rewards[i] -= self.time_cost[i]
-                if dones[i]:
-                    self.phi[i] = 0.0
-                    self.revs[i] = 0.0
-                else:
-                    self.phi[i] = phi
-            return obs, rewards, dones, infos
+            peaks = self.venv.unwrapped.running_kpis()
+            for i in np.flatnonzero(dones):                # a done env is already reset
+                for key in PEAK_KEYS:
+                    peaks[key][i] = infos[i][key]
+            phi = kpi_potential(*(peaks[key] for key in PEAK_KEYS), **self.w)
+            rewards = self.phi - phi
+            if "relevitated" in infos[0]:
+                success = np.array([i.get("reward_success", 0.0) > 0.0 for i in infos])
+                pending = np.array([not i["relevitated"] for i in infos]) & ~success
+                rewards += self.w_relevitate * success - self.time_cost * pending
+            self.phi = np.where(dones, 0.0, phi)
+            return obs, rewards.astype(np.float32), dones, infos
 
     return KpiReward(venv, **kwargs)
-

@@ -6,7 +6,7 @@ when asked, the time series needed for the orbit and force plots.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
@@ -26,7 +26,6 @@ class Episode:
     actions: np.ndarray | None = None
     contact_force: np.ndarray | None = None     # per step, (steps, n) [N]
     obs_names: tuple[str, ...] = ()
-    extra: dict = field(default_factory=dict)
 
 
 def final_kpis(info: dict) -> dict:
@@ -48,8 +47,6 @@ def run_episodes(env_id: str, make_actor: Callable[[Plant], object], seeds, env_
 
 def _episode(env, plant: Plant, actor, seed: int, record: bool) -> Episode:
     obs, info = env.reset(seed=seed)
-    if hasattr(actor, "reset"):
-        actor.reset(1)
     total, steps = 0.0, 0
     rec_obs, rec_act, rec_f = [], [], []
     start = np.ones(1, dtype=bool)

@@ -20,11 +20,22 @@ import math
 
 import numpy as np
 
-KPI_KEYS = ("backward_whirl", "peak_contact_force_N", "max_displacement_um", "relevitated",
-            "relevitation_time_s", "control_effort")
+def fmt_or_dash(v, fmt: str) -> str:
+    """``format(v, fmt)``, or "-" for a missing value (tables of evaluate and benchmark)."""
+    return "-" if v is None else format(v, fmt)
 
 
-def _mean(values) -> float | None:
+def json_default(o):
+    """``json.dumps(default=...)`` for numpy scalars and arrays in the KPI reports."""
+    if isinstance(o, np.generic):
+        return o.item()
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    return str(o)
+
+
+def mean_finite(values) -> float | None:
+    """Mean of the values that are neither None nor NaN; None when there are none."""
     vals = [float(v) for v in values if v is not None and not (isinstance(v, float) and math.isnan(v))]
     return float(np.mean(vals)) if vals else None
 
@@ -33,15 +44,15 @@ def summarize(episodes) -> dict:
     """Aggregate KPIs over episodes (rates for booleans, means and maxima for the rest)."""
     k = [e.kpis for e in episodes]
     out = dict(episodes=len(episodes),
-               backward_whirl_rate=_mean(d.get("backward_whirl") for d in k),
-               peak_contact_force_N=_mean(d.get("peak_contact_force_N") for d in k),
+               backward_whirl_rate=mean_finite(d.get("backward_whirl") for d in k),
+               peak_contact_force_N=mean_finite(d.get("peak_contact_force_N") for d in k),
                peak_contact_force_N_max=max((float(d["peak_contact_force_N"]) for d in k
                                              if d.get("peak_contact_force_N") is not None), default=None),
-               max_displacement_um=_mean(d.get("max_displacement_um") for d in k),
-               relevitation_success_rate=_mean(d.get("relevitated") for d in k),
-               relevitation_time_s=_mean(d.get("relevitation_time_s") for d in k if d.get("relevitated")),
-               control_effort=_mean(d.get("control_effort") for d in k),
-               mean_return=_mean(e.reward for e in episodes))
+               max_displacement_um=mean_finite(d.get("max_displacement_um") for d in k),
+               relevitation_success_rate=mean_finite(d.get("relevitated") for d in k),
+               relevitation_time_s=mean_finite(d.get("relevitation_time_s") for d in k if d.get("relevitated")),
+               control_effort=mean_finite(d.get("control_effort") for d in k),
+               mean_return=mean_finite(e.reward for e in episodes))
     return out
 
 

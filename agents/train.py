@@ -51,6 +51,9 @@ def _callbacks():
     """SB3 callback classes, defined lazily so that importing this module stays light."""
     from stable_baselines3.common.callbacks import BaseCallback, EvalCallback
 
+    from .rollout import final_kpis
+    from .score import mean_finite
+
     class SaveVecNormalize(BaseCallback):
         """Saves the VecNormalize statistics next to the best model."""
 
@@ -76,9 +79,7 @@ def _callbacks():
         def _log_success_callback(self, locals_, globals_):
             super()._log_success_callback(locals_, globals_)
             if locals_["done"]:
-                info = locals_["info"]
-                kpis = {k[4:]: float(v) for k, v in info.items()
-                        if k.startswith("kpi_") and v is not None}
+                kpis = {k: float(v) for k, v in final_kpis(locals_["info"]).items()}
                 kpis["failure"] = float(any(kpis.get(k, 0.0) for k in
                                             ("backward_whirl", "stator_contact", "bearing_overload")))
                 self._kpis.append(kpis)
@@ -94,9 +95,10 @@ def _callbacks():
                 entry = dict(timesteps=int(self.num_timesteps), mean_reward=float(np.mean(rewards)),
                              std_reward=float(np.std(rewards)))
                 for key in sorted({k for d in self._kpis for k in d}):
-                    vals = [d[key] for d in self._kpis if key in d]
-                    entry[f"mean_{key}"] = float(np.mean(vals))
-                    self.logger.record(f"eval/{key}", float(np.mean(vals)))
+                    mean = mean_finite(d.get(key) for d in self._kpis)      # NaN (no value) skipped
+                    if mean is not None:
+                        entry[f"mean_{key}"] = mean
+                        self.logger.record(f"eval/{key}", mean)
                 self.kpi_history.append(entry)
             return cont
 
@@ -144,11 +146,10 @@ def _callbacks():
                 return True
             self.seen = len(self.eval_cb.kpi_history)
             from .policies import LearnedPolicy
-            from .residual import RESIDUAL_SCALE
             vn = self.model.get_vec_normalize_env()
-            pol = LearnedPolicy("candidate", self.algo, self.env_id, self.env_kwargs, self.model, vn,
-                                residual=self.meta.get("residual"),
-                                residual_scale=self.meta.get("residual_scale") or RESIDUAL_SCALE)
+            pol = LearnedPolicy("candidate", self.algo, self.env_id, self.env_kwargs, self.model, vn)
+            if self.meta.get("residual") is not None:
+                pol.residual, pol.residual_scale = self.meta["residual"], self.meta["residual_scale"]
             score, _ = self.validator.score(pol.bound, self.env_kwargs)
             self.eval_cb.kpi_history[-1]["validation_score"] = score
             self.logger.record("eval/validation_score", score)

@@ -5,7 +5,7 @@ benchmark uses mu* + 0.05/0.10/0.15 = 0.43/0.48/0.53 and 0.6) at unbalance phase
 (the benchmark uses 0/90/180/270°), plus mu = 0.2 so that a candidate must also re-levitate a
 rotor that does not whirl. Cost per episode (lower is better):
 
-    max(peak revs, 0) + 2 [backward whirl] + 10 [not re-levitated] + T_R / 0.3 s
+    peak revs + 2 [backward whirl] + 10 [not re-levitated] + T_R / 0.3 s
 
 averaged over the set, in the re-levitation task (support damping at the scene's C_s, the harder
 case; the Full task adds C_max on top of the same law).
@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 from tqdm.auto import tqdm
 
-from agents.benchmark import EVAL_KWARGS, monitor_kwargs
+from agents.benchmark import BASELINE_KWARGS, EVAL_KWARGS, TASKS, Entry, Scenario, episode_kwargs
 from agents.controllers import WhirlBrake
 from agents.rollout import run_episodes
 
@@ -34,12 +34,12 @@ TUNING_SET = [(mu, ph) for mu in (0.45, 0.50, 0.55) for ph in (45.0, 225.0)] + [
 
 def cost(theta: np.ndarray, env_id: str) -> tuple[float, list[dict]]:
     gains = dict(zip(NAMES, map(float, theta)))
-    kpis = []
-    for mu, ph in TUNING_SET:
-        kw = dict(EVAL_KWARGS, command="continuous", **monitor_kwargs({}),
-                  overrides={"contact.friction": mu, "unbalance.angle_deg": ph})
-        kpis.append(run_episodes(env_id, lambda p: WhirlBrake(p, **gains), [0], kw)[0].kpis)
-    c = [max(k["peak_whirl_revolutions"], 0.0) + 2.0 * k["backward_whirl"]
+    task = next(t for t, e in TASKS.items() if e == env_id)
+    entry = Entry(WhirlBrake.name, task, lambda p: WhirlBrake(p, **gains),
+                  BASELINE_KWARGS[WhirlBrake.name])
+    kpis = [run_episodes(env_id, entry.make, [0], episode_kwargs(entry, Scenario("tune", mu), ph))[0].kpis
+            for mu, ph in TUNING_SET]
+    c = [k["peak_whirl_revolutions"] + 2.0 * k["backward_whirl"]
          + (10.0 if not k["relevitated"] else k["relevitation_time_s"] / EVAL_KWARGS["episode_time"])
          for k in kpis]
     return float(np.mean(c)), kpis
