@@ -32,11 +32,10 @@ EFFECTS_OFF = [("full model (paper)", {}), *REDUCED,
                ("no friction", {"effects.friction": "none"})]
 
 
-def ns_per_rhs(scene, samples=400, reps=50) -> float:
-    """Median cost of one right-hand-side evaluation over states sampled from a real run [ns]."""
-    r = simulate(scene, t_end=0.5)
-    m = r.model
-    Y = r.Y[:: max(1, len(r.Y) // samples)].copy()
+def ns_per_rhs(result, samples=400, reps=50) -> float:
+    """Median cost of one right-hand-side evaluation over states sampled from a run [ns]."""
+    m = result.model
+    Y = result.Y[:: max(1, len(result.Y) // samples)].copy()
     U = m.controls(False)
     dy, aux = np.empty(m.n_state), np.empty(N_AUX)
     times = []
@@ -61,8 +60,10 @@ def _make_loop():
 _rhs_loop = _make_loop()
 
 
-def run_case(overrides: dict, t_end: float, repeats: int) -> dict:
-    scene = load_scene("paper", overrides)
+def run_case(overrides: dict, t_end: float, repeats: int, source: str = "paper") -> dict:
+    """Median wall time of ``repeats`` drops of scene ``source`` with ``overrides``, the solver
+    statistics of the last one and the cost of one rhs evaluation over its states."""
+    scene = load_scene(source, overrides)
     walls, last = [], None
     for _ in range(repeats):
         last = simulate(scene, t_end=t_end)
@@ -70,7 +71,7 @@ def run_case(overrides: dict, t_end: float, repeats: int) -> dict:
     wall = statistics.median(walls)
     return dict(n_state=last.model.n_state, wall_s_per_sim_s=wall / t_end,
                 rhs_evaluations=last.stats.rhs_evaluations, steps=last.stats.steps,
-                rejected=last.stats.rejected_steps, ns_per_rhs=ns_per_rhs(scene))
+                rejected=last.stats.rejected_steps, ns_per_rhs=ns_per_rhs(last))
 
 
 def compile_times() -> dict:

@@ -6,8 +6,9 @@
 For each algorithm and thread count (torch and numba threads, ``rotordrop train --threads``)
 a short ``agents.train.train`` run on ``RotorDrop-Damping-v0`` with the shipped
 hyperparameters (evaluation and checkpoints off) is timed; figures are medians of
-``--repeats`` runs after a warm-up. Also the raw batched env with random actions, to separate
-the physics from the learning cost. Numbers depend on the load of the machine: run it alone.
+``--repeats`` runs after a warm-up. Also the raw batched env with random actions
+(``bench_env.batched_rate``, timed by the wall clock like the training runs), to separate the
+physics from the learning cost. Numbers depend on the load of the machine: run it alone.
 """
 from __future__ import annotations
 
@@ -17,25 +18,22 @@ import statistics
 import tempfile
 import time
 
-import numpy as np
+import numba
+
+import bench_env
+from bench_env import batched_rate
 
 ENV = "RotorDrop-Damping-v0"
+ENV_KWARGS = dict(randomize=True, terminate_on_failure=False)
+N_ENVS, ENV_STEPS = 8, 500
 
 
-def env_steps_per_s(threads: int, n_envs: int = 8, steps: int = 500) -> float:
-    import numba
-    from agents.plant import make_vec_env
-    numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
-    venv = make_vec_env(ENV, n_envs, 0, dict(randomize=True, terminate_on_failure=False))
-    venv.reset()
-    rng = np.random.default_rng(0)
-    for _ in range(20):
-        venv.step(rng.uniform(-1, 1, (n_envs, 2)).astype(np.float32))
-    t0 = time.perf_counter()
-    for _ in range(steps):
-        venv.step(rng.uniform(-1, 1, (n_envs, 2)).astype(np.float32))
-    venv.close()
-    return n_envs * steps / (time.perf_counter() - t0)
+def env_steps_per_s(threads: int, repeats: int) -> float:
+    """Median env steps per second of the batched env alone (random actions drawn up front)."""
+    threads = min(threads, numba.config.NUMBA_NUM_THREADS)
+    run = batched_rate(ENV, ENV_KWARGS, N_ENVS, ENV_STEPS, threads)
+    run()                                                  # warm-up (compile / cache load)
+    return statistics.median(run() for _ in range(repeats))
 
 
 def train_steps_per_s(algo: str, steps: int, threads: int) -> float:
@@ -57,12 +55,13 @@ def main() -> None:
     ap.add_argument("--threads", nargs="+", type=int, default=[1, 2])
     ap.add_argument("--json", default=None)
     args = ap.parse_args()
+    bench_env.CLOCK = time.perf_counter                    # wall clock, as the training runs
     out = {}
     for th in args.threads:
-        env_steps_per_s(th, steps=50)                      # warm-up (compile / cache load)
-        v = statistics.median(env_steps_per_s(th) for _ in range(args.repeats))
+        v = env_steps_per_s(th, args.repeats)
         out[f"env random actions, {th} thread(s)"] = v
-        print(f"batched env (8 envs, random actions), {th} thread(s): {v:9.0f} steps/s", flush=True)
+        print(f"batched env ({N_ENVS} envs, random actions), {th} thread(s): {v:9.0f} steps/s",
+              flush=True)
     for algo in args.algos:
         for th in args.threads:
             steps = args.steps

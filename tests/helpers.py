@@ -1,4 +1,6 @@
-"""Small helpers shared by the physics tests."""
+"""Small helpers shared by the tests."""
+import warnings
+
 import numpy as np
 
 from physics.model import build_model
@@ -16,3 +18,29 @@ def free_flight(scene, y0_updates: dict, t_end: float, n_out: int = 2001):
     Y[0] = y
     Integrator(model).advance(y, 0.0, t_end, model.controls(False), t, Y, 1)
     return t, Y, model
+
+
+def energy_residual(result):
+    """Energy audit (spec §1): |E_mech + E_dissipated - W_external - (its value at t = 0)| at each
+    sample [J], and the energy series of ``result.energy()``."""
+    e = result.energy()
+    balance = e["mechanical"] + e["dissipated"] - e["external"]
+    return np.abs(balance - balance[0]), e
+
+
+def phys(env, obs, name: str) -> float:
+    """Physical (SI) value of observation ``name`` of one observation of a rotor-drop env, read
+    the way the controllers read it (``agents.plant.Plant.get``)."""
+    from agents.plant import Plant
+    return Plant.from_env(env).get(np.atleast_2d(obs), name)[0]
+
+
+def run_env_checkers(make_env) -> None:
+    """Gymnasium's and SB3's environment checkers, each on the env ``make_env()`` returns
+    (their warnings about the intended infinite Box bounds are silenced)."""
+    from gymnasium.utils.env_checker import check_env as gym_check_env
+    from stable_baselines3.common.env_checker import check_env as sb3_check_env
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        gym_check_env(make_env())
+        sb3_check_env(make_env())

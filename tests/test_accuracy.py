@@ -9,15 +9,38 @@ from physics.cli import main as cli_main
 from physics.scene import Scene
 
 
+# the rule that picks the default: whole-run errors over the converged drops, early-window
+# errors over every drop
+CRITERIA = (("peak_contact_force_rel", "max_converged"), ("max_displacement_rel", "max_converged"),
+            ("early_peak_force_rel", "max"), ("early_max_displacement_rel", "max"))
+
+
+def _quick_study(tmp_path_factory, scene: str):
+    out = tmp_path_factory.mktemp(f"accuracy-{scene}")
+    assert cli_main(["accuracy", "--quick", "--scene", scene, "--jobs", "2", "--quiet",
+                     "--out", str(out)]) == 0
+    return out, json.loads((out / "accuracy.json").read_text())
+
+
 @pytest.fixture(scope="module")
 def quick(tmp_path_factory):
-    out = tmp_path_factory.mktemp("accuracy")
-    assert cli_main(["accuracy", "--quick", "--jobs", "2", "--quiet", "--out", str(out)]) == 0
-    return out, json.loads((out / "accuracy.json").read_text())
+    """The quick study of the paper scene (its loosest tolerance already meets the rule)."""
+    return _quick_study(tmp_path_factory, "paper")
+
+
+@pytest.fixture(scope="module")
+def quick_spec(tmp_path_factory):
+    """The quick study of the spec scene, where a loose tolerance breaks the rule."""
+    return _quick_study(tmp_path_factory, "spec")
 
 
 def _rows(a):
     return {r["setting"]: r for r in a["rows"]}
+
+
+def _worst_error(row) -> float:
+    """The largest relative error of a row over the criteria of the rule."""
+    return max(v for v in (row["errors"][k][stat] for k, stat in CRITERIA) if v is not None)
 
 
 def test_accuracy_json_holds_reference_rows_and_default(quick):
@@ -57,25 +80,34 @@ def test_default_meets_the_criterion_and_reduced_models_err_more(quick):
     rows = _rows(a)
     d = rows[a["default"]]
     assert d["kind"] in ("adaptive", "fixed")
-    for key in ("peak_contact_force_rel", "max_displacement_rel"):
-        assert d["errors"][key]["max_converged"] <= TOLERANCE
-    cheaper = [r for r in a["rows"] if r["kind"] in ("adaptive", "fixed")
-               and r["rhs_evaluations"] < d["rhs_evaluations"]]
-    for r in cheaper:                       # everything cheaper breaks the 1 % rule somewhere
-        e = r["errors"]
-        assert max(e["peak_contact_force_rel"]["max_converged"], e["max_displacement_rel"]["max_converged"],
-                   e["early_peak_force_rel"]["max"], e["early_max_displacement_rel"]["max"]) > TOLERANCE
+    assert _worst_error(d) <= TOLERANCE
     # model simplifications change the first 20 ms far more than the default's integration error
     for name in ("rigid retainer bearing", "no housing flexibility"):
         assert rows[name]["errors"]["trajectory_um"]["max"] > 20 * d["errors"]["trajectory_um"]["max"]
 
 
-def test_the_package_default_tolerance_is_one_the_study_accepts(quick):
-    """The scene default solver.rtol is the accuracy study's choice (or tighter)."""
-    _, a = quick
-    chosen = _rows(a)[a["default"]]["overrides"]
+def test_every_setting_cheaper_than_the_default_breaks_the_rule(quick_spec):
+    """On the spec scene rtol 1e-3 errs ~2.9 % in peak force: the study must pass it over."""
+    _, a = quick_spec
+    d = _rows(a)[a["default"]]
+    assert d["kind"] in ("adaptive", "fixed") and _worst_error(d) <= TOLERANCE
+    cheaper = [r for r in a["rows"] if r["kind"] in ("adaptive", "fixed")
+               and r["rhs_evaluations"] < d["rhs_evaluations"]]
+    assert cheaper
+    for r in cheaper:
+        assert _worst_error(r) > TOLERANCE, r["setting"]
+
+
+def test_the_package_default_tolerance_is_one_the_study_accepts(quick_spec):
+    """The scene default solver.rtol meets the rule on the spec scene and is the study's choice
+    (or tighter)."""
+    _, a = quick_spec
+    rows = _rows(a)
+    solver = Scene().solver
+    assert _worst_error(rows[f"adaptive rtol {solver.rtol:g}"]) <= TOLERANCE
+    chosen = rows[a["default"]]["overrides"]
     if chosen.get("solver.method") == "adaptive":
-        assert Scene().solver.rtol <= chosen["solver.rtol"]
+        assert solver.rtol <= chosen["solver.rtol"]
 
 
 def _row(name, kind, rhs, peak, disp, early=0.0):

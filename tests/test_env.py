@@ -1,16 +1,16 @@
 """Gymnasium environments: checkers, seeding, passive env == simulator, errors, episode end."""
 import math
-import warnings
 
 import gymnasium as gym
 import numpy as np
 import pytest
-from gymnasium.utils.env_checker import check_env as gym_check_env
-from stable_baselines3.common.env_checker import check_env as sb3_check_env
 
 import rotordrop_env
 from physics import compute_metrics, load_scene, simulate
 from physics.scene import SceneError
+from rotordrop_env.scenario import DEFAULT_RANGES
+
+from helpers import phys, run_env_checkers
 
 VARIANTS = [("RotorDrop-Passive-v0", {}), ("RotorDrop-Damping-v0", {}),
             ("RotorDrop-Relevitate-v0", {"command": "discrete"}),
@@ -22,10 +22,7 @@ VARIANTS = [("RotorDrop-Passive-v0", {}), ("RotorDrop-Damping-v0", {}),
 @pytest.mark.parametrize("env_id,kwargs", VARIANTS, ids=lambda v: v if isinstance(v, str) else
                          v.get("command", ""))
 def test_gymnasium_and_sb3_checkers_pass(env_id, kwargs):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")               # infinite Box bounds are intended
-        gym_check_env(gym.make(env_id, episode_time=0.004, **kwargs).unwrapped)
-        sb3_check_env(gym.make(env_id, episode_time=0.004, **kwargs).unwrapped)
+    run_env_checkers(lambda: gym.make(env_id, episode_time=0.004, **kwargs).unwrapped)
 
 
 def test_registered_ids_and_public_attributes():
@@ -39,11 +36,11 @@ def test_registered_ids_and_public_attributes():
     assert len(u.obs_names) == env.observation_space.shape[0] == u.obs_scale.shape[0]
     assert u.action_names == ["damping1", "damping2", "levitate"] and u.dt == 1e-3
     obs, _ = env.reset(seed=0)
-    phys = dict(zip(u.obs_names, obs.astype(float) * u.obs_scale))
     # at the fault the rotor spins at the scene speed and the damper holds support.damping
-    assert phys["rotor_speed"] == pytest.approx(10000 * math.pi / 30, rel=1e-4)
-    assert phys["damping1"] == pytest.approx(u.scene.support.damping, rel=1e-6)
-    assert phys["amb_power"] == 0.0
+    assert phys(env, obs, "rotor_speed") == pytest.approx(u.scene.rotor.speed_rpm * math.pi / 30,
+                                                          rel=1e-4)
+    assert phys(env, obs, "damping1") == pytest.approx(u.scene.support.damping, rel=1e-6)
+    assert phys(env, obs, "amb_power") == 0.0
 
 
 def test_seeding_makes_scenarios_and_trajectories_reproducible():
@@ -61,7 +58,7 @@ def test_seeding_makes_scenarios_and_trajectories_reproducible():
     s3, _ = run(8)
     assert s1 == s2 and np.array_equal(t1, t2)
     assert s1 != s3
-    lo, hi = 0.1, 0.5                                 # documented friction range
+    _, lo, hi = DEFAULT_RANGES["contact.friction"]    # documented friction range
     assert lo <= s1["contact.friction"] <= hi
 
 
@@ -82,29 +79,30 @@ def test_reset_options_fix_the_scenario():
 def test_passive_env_reproduces_the_simulator(mu, whirl):
     """Same scene, same physics: states at the control steps and the KPIs of `rotordrop drop`;
     the paper's whirl threshold (spec §7: between mu 0.25 and 0.5) is seen by both."""
+    episode = 0.15
     env = gym.make("RotorDrop-Passive-v0", overrides={"contact.friction": mu}, samples_per_step=20,
-                   terminate_on_failure=False, episode_time=0.15)
+                   terminate_on_failure=False, episode_time=episode)
     u = env.unwrapped
+    sv = u.scene
     env.reset(seed=0)
     ys, done = [], False
     while not done:
         obs, reward, term, trunc, info = env.step(np.zeros(1, np.float32))
         assert isinstance(reward, float) and type(term) is bool and type(trunc) is bool
-        ys.append(obs.astype(float) * u.obs_scale)
+        ys.append(phys(env, obs, "y1"))
         done = term or trunc
     assert trunc and not term and len(ys) == 150
-    res = simulate(load_scene("paper", {"contact.friction": mu}), t_end=0.25)
-    t = 0.1 + np.arange(1, 151) * 1e-3
+    res = simulate(load_scene("paper", {"contact.friction": mu}), t_end=sv.amb.off_time + episode)
+    t = sv.amb.off_time + np.arange(1, len(ys) + 1) * u.dt      # the control steps after the fault
     k = np.searchsorted(res.t, t - 1e-12)
-    z = -0.28                                          # sensor 1 = AMB1 plane
+    z = sv.positions.amb1                              # sensor 1 = AMB1 plane
     y1 = res.state("y")[k] + z * res.state("b")[k]
-    err = np.abs(np.array(ys)[:, u.obs_names.index("y1")] - y1)
+    err = np.abs(np.array(ys) - y1)
     # first 40 ms: agreement at the integrator's tolerance (the two runs split the time
     # differently: 1 ms control steps against 10 ms chunks)
-    sv = u.scene
     assert err[:40].max() < 50 * sv.solver.rtol * sv.contact.clearance
     m = compute_metrics(res)
-    post = res.t > 0.1
+    post = res.t > sv.amb.off_time
     f_peak = max(res.contact_force(p)[post].max() for p in ("RB1", "RB2"))
     assert info["kpi_peak_contact_force_N"] == pytest.approx(f_peak, rel=0.02)
     d_max = max(np.hypot(*res.orbit(p)[post].T).max() for p in ("RB1", "RB2")) * 1e6

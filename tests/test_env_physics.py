@@ -11,6 +11,8 @@ from physics.amb import actuator_constants, magnet_pair_force, weight_shares
 from physics.model import build_model
 from physics.scene import SceneError
 
+from helpers import phys
+
 ACTUATOR = {"effects.amb": "actuator"}
 
 
@@ -103,11 +105,11 @@ def test_damper_follows_its_command_with_the_first_order_lag():
     c_max = u.scene.support.damping_max
     for _ in range(10):                                # 10 ms = one time constant
         obs = env.step(np.ones(2, np.float32))[0]
-    c = obs[u.obs_names.index("damping1")] * u.obs_scale[u.obs_names.index("damping1")]
+    c = phys(env, obs, "damping1")
     assert c == pytest.approx(c_max - (c_max - c0) / math.e, rel=1e-3)
     for _ in range(10):
         obs = env.step(-np.ones(2, np.float32))[0]
-    c2 = obs[u.obs_names.index("damping2")] * u.obs_scale[u.obs_names.index("damping2")]
+    c2 = phys(env, obs, "damping2")
     c_min = u.scene.support.damping_min
     assert c2 == pytest.approx(c_min + (c - c_min) / math.e, rel=1e-3)
 
@@ -141,14 +143,13 @@ def test_direct_currents_act_after_power_returns_only():
     u = env.unwrapped
     env.reset(seed=0)
     full_lift = np.array([0.0, 1.0, 0.0, 1.0], np.float32)
-    names = u.obs_names
     for k in range(60):
         obs = env.step(full_lift)[0]
-        cur = obs[names.index("i1y")] * u.obs_scale[names.index("i1y")]
+        cur = phys(env, obs, "i1y")
         if k < 49:                                     # power returns at 50 ms
-            assert cur == 0.0 and obs[names.index("amb_power")] == 0.0
+            assert cur == 0.0 and phys(env, obs, "amb_power") == 0.0
         if k == 49:                                    # observed as soon as the next action can use it
-            assert obs[names.index("amb_power")] == 1.0
+            assert phys(env, obs, "amb_power") == 1.0
     assert cur == pytest.approx(u.scene.amb.current_limit)
     # full lifting current from the bottom: the rotor rises off the retainer bearings
-    assert obs[names.index("y1")] * u.obs_scale[names.index("y1")] > -u.scene.contact.clearance
+    assert phys(env, obs, "y1") > -u.scene.contact.clearance

@@ -2,9 +2,9 @@
 
 Extreme scenes of the hard-case box — K_s 5e5…5e9 N/m, C_s 0…1e5 N s/m, μ 0…0.8, 0…30 000 rpm,
 0…100 g unbalance, contact stiffness 1e7…1e10, exponent 1.0…1.5, both slip laws — must end with
-finite values, with the mechanical energy bounded by the energy put in, without step-size
-collapse or running out of steps. Inputs outside the valid ranges must raise the clear
-SceneError and never run.
+finite values, keep the energy balance (and, where friction only dissipates, never lose
+dissipated energy), without step-size collapse or running out of steps. Inputs outside the valid
+ranges must raise the clear SceneError and never run.
 
 CI runs the grid with 0.2 s of drop after the fault (the first impacts, the bounces and the
 whirl onset, where the stiffness is); the full 5 s grid is opt-in:
@@ -13,6 +13,7 @@ whirl onset, where the stiffness is); the full 5 s grid is opt-in:
 """
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 
@@ -24,6 +25,8 @@ from hypothesis import strategies as st
 from physics import IntegrationError, SceneError, load_scene, simulate
 from physics.cli import main as cli_main
 from physics.scene import GROUPS, Scene, parameter_table
+
+from helpers import energy_residual
 
 # ------------------------------------------------------------------------------ the box --
 BOX = {                                            # key: (low, high) of the hard-case box
@@ -70,26 +73,30 @@ CASES = list(_one_factor_extremes()) + list(_combined()) + list(_corners())
 
 # ---------------------------------------------------------------------------- the checks --
 def check_stable(result) -> None:
-    """Finite, energy bounded by the energy put in, and the run reached its end time."""
+    """Finite values and the energy balance kept (spec §1); unless the paper's slip law is on
+    (its friction can do positive work), the dissipated energy does not decrease beyond
+    integration noise, so the mechanical energy stays within the energy put in (up to the
+    integration error). Step-size collapse and an exhausted step budget stop ``simulate`` with
+    an IntegrationError, so a returned result ran to its end time."""
     assert np.isfinite(result.Y).all() and np.isfinite(result.aux).all()
-    e = result.energy()
+    residual, e = energy_residual(result)
     E, D, W = e["mechanical"], e["dissipated"], e["external"]
     scene = result.model.scene
     scale = max(np.abs(E).max(), np.abs(W).max(), np.abs(D).max(),
                 scene.rotor.mass * max(scene.world.gravity, 1.0) * scene.contact.clearance)
-    residual = np.abs(E + D - W - E[0])
     # integration error reaches ~1 % of the drop energy at the default tolerance in the stiffest
     # corners (linear 1e10 N/m contact, undamped support, no spin); an instability grows the
     # energy by orders of magnitude
     assert residual.max() <= 5e-2 * scale, "energy balance violated"
-    # the paper's slip law can feed energy into the motion (its friction may do positive work):
-    # count every decrease of the dissipated energy as energy put in
-    fed = np.concatenate([[0.0], np.cumsum(np.maximum(0.0, -np.diff(D)))])
-    excess = E - (E[0] + W + fed)
-    assert excess.max() <= residual.max() + 1e-9 * scale, "more energy than was put in"
-    # no step-size collapse and no exhausted step budget: simulate() raises IntegrationError
-    # for both, so reaching here means the run ended at t_end
-    assert result.t[-1] == pytest.approx(scene.solver.t_end)
+    if scene.effects.friction != "paper":
+        # every dissipation term has non-negative power, so the dissipated energy may give back
+        # only the balance's own error and the integrator's noise: the dense output of a step
+        # across a sharp onset of dissipation undershoots (up to 1.6e-3 of the scale seen in
+        # soft-contact, non-spinning scenes; 2e-5 on the grid; gone at rtol 1e-7). Friction
+        # doing positive work gives energy back with the balance intact: a sign error of the
+        # kinematic slip would give back its work, 0.11 and 0.023 of the scale in two corners.
+        given_back = np.maximum(0.0, -np.diff(D)).sum()
+        assert given_back <= residual.max() + 5e-3 * scale, "dissipated energy decreased"
 
 
 def _run(overrides: dict, after_fault: float):
@@ -206,7 +213,9 @@ def test_any_valid_scene_is_stable_or_stops_with_a_clear_error(values, switches)
         assert any(f"{g}." in str(exc) for g in GROUPS), str(exc)   # names the keys
         assume(False)
     try:
-        result = simulate(scene, t_end=scene.amb.off_time + 0.02)
+        # 20 ms of drop, within solver.t_end's range (a fault at its very end is not reached)
+        t_max = next(f.metadata["hi"] for f in dataclasses.fields(scene.solver) if f.name == "t_end")
+        result = simulate(scene, t_end=min(scene.amb.off_time + 0.02, t_max))
     except IntegrationError as exc:
         msg = str(exc)
         assert "solver." in msg and ("step budget" in msg or "collapsed" in msg), msg

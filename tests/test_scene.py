@@ -1,10 +1,14 @@
 """Scenes: presets, TOML, dotted overrides and validation errors that name key and range."""
+import json
 import math
+from pathlib import Path
 
 import pytest
 
-from physics import Scene, SceneError, load_scene, parameter_table, preset_names
+from physics import SceneError, load_scene, parameter_table, preset_names
 from physics.scene import scene_from_toml
+
+SPEC_VALUES = Path(__file__).parent / "data" / "spec_values.json"
 
 PUBLIC_KEYS = ["contact.friction", "contact.stiffness", "support.stiffness", "support.damping",
                "unbalance.mass", "rotor.speed_rpm", "amb.off_time", "solver.rtol",
@@ -31,10 +35,16 @@ def test_presets_paper_and_spec_hold_the_paper_base_case():
         assert (s.rotor.mass, s.rotor.speed_rpm, s.contact.clearance) == (97.3, 10000.0, 300e-6)
 
 
+def _typed(values: dict) -> dict:
+    return {k: (type(v).__name__, v) for k, v in values.items()}
+
+
 def test_spec_preset_is_frozen_at_the_spec_values():
-    # every [P]/[A] value of spec §2-4 as written there
-    s = load_scene("spec")
-    assert s.flat() == {**Scene().flat()}
+    """Every [P]/[A] value of spec §2-4 as written there, and solver.rtol = 1e-5 as chosen by the
+    accuracy study (docs/accuracy.md), against a literal snapshot: a changed default changes the
+    ``spec`` preset and fails here. Change tests/data/spec_values.json by hand, with the spec."""
+    frozen = json.loads(SPEC_VALUES.read_text())
+    assert _typed(load_scene("spec").flat()) == _typed(frozen)       # values and types, exactly
 
 
 def test_dotted_overrides_and_string_values_are_typed():
