@@ -3,6 +3,7 @@ damping, AMB re-levitation, and both together. See docs/environments.md for the 
 from __future__ import annotations
 
 import math
+import operator
 
 import gymnasium as gym
 import numpy as np
@@ -299,7 +300,7 @@ class RotorDropEnv(gym.Env):
 
     def _step_info(self, done: bool) -> dict:
         b = self._b
-        info = step_infos(b.out[None], b.M[None], b.C[None], self._relevitate)[0]
+        info = step_info(b.out.tolist(), b.M.tolist(), b.C[K.C_T_FAULT].item(), self._relevitate)
         if done:
             info.update(self.kpis())
         return info
@@ -359,6 +360,7 @@ class RotorDropEnv(gym.Env):
 
 _INFO_KEYS = ("contact_force_N",) + tuple("reward_" + n for n in REWARD_TERMS)
 _INFO_COLS = [K.O_FORCE, *_O_TERMS]
+_info_values = operator.itemgetter(*_INFO_COLS)
 
 
 def peak_kpis(M: np.ndarray) -> dict:
@@ -369,17 +371,20 @@ def peak_kpis(M: np.ndarray) -> dict:
             "kpi_max_displacement_um": M[..., K.M_MAX_DISP] * 1e6}
 
 
-def step_infos(out: np.ndarray, M: np.ndarray, C: np.ndarray, relevitate: bool) -> list[dict]:
-    """The per-step ``info`` dicts of N environments from their (N, ...) kernel arrays."""
-    rows = out[:, _INFO_COLS].tolist()
-    t = (M[:, K.M_T] - C[:, K.C_T_FAULT]).tolist()
-    whirl = (M[:, K.M_WHIRL] > 0.0).tolist()
-    infos = [dict(zip(_INFO_KEYS, r), time_s=te, backward_whirl=w)
-             for r, te, w in zip(rows, t, whirl)]
+def step_info(out: list, M: list, t_fault: float, relevitate: bool) -> dict:
+    """The per-step ``info`` of one environment from its kernel outputs and monitor (as lists:
+    indexing Python lists is the cheapest way to build the dict every step)."""
+    info = dict(zip(_INFO_KEYS, _info_values(out)), time_s=M[K.M_T] - t_fault,
+                backward_whirl=M[K.M_WHIRL] > 0.0)
     if relevitate:
-        for info, rel in zip(infos, (M[:, K.M_RELEV] > 0.0).tolist()):
-            info["relevitated"] = rel
-    return infos
+        info["relevitated"] = M[K.M_RELEV] > 0.0
+    return info
+
+
+def step_infos(out: np.ndarray, M: np.ndarray, C: np.ndarray, relevitate: bool) -> list[dict]:
+    """:func:`step_info` of N environments from their (N, ...) kernel arrays."""
+    return [step_info(o, m, tf, relevitate)
+            for o, m, tf in zip(out.tolist(), M.tolist(), C[:, K.C_T_FAULT].tolist())]
 
 
 def _positive(name: str, value, lo: float, hi: float) -> None:
