@@ -51,6 +51,13 @@ TASKS = {"damping": "RotorDrop-Damping-v0", "relevitate": "RotorDrop-Relevitate-
 BASELINE_KWARGS = {"pid-relevitate": {"command": "continuous"},
                    "builtin-relevitate": {"command": "discrete"},
                    "whirl-brake": {"command": "continuous"}}
+RELEVITATION_ENVS = (TASKS["relevitate"], TASKS["full"])
+
+
+def baseline_env_kwargs(name: str, env_id: str) -> dict:
+    """The env kwargs baseline ``name`` needs in ``env_id``: its re-levitation command
+    (``BASELINE_KWARGS``) in the re-levitation environments, nothing elsewhere."""
+    return dict(BASELINE_KWARGS.get(name, {})) if env_id in RELEVITATION_ENVS else {}
 
 
 @dataclass(frozen=True)
@@ -142,7 +149,7 @@ def _entries(policies: list[LearnedPolicy]) -> list[Entry]:
     for task, env_id in TASKS.items():
         task_policies = [p for p in policies if p.env_id == env_id]
         for name, cls in BASELINES.items():
-            kw = dict(BASELINE_KWARGS.get(name, {})) if task != "damping" else {}
+            kw = baseline_env_kwargs(name, env_id)
             env = make_env(env_id, **kw)
             supported = cls.supports(Plant.from_env(env))
             env.close()

@@ -1,4 +1,4 @@
-"""``rotordrop train | evaluate | benchmark`` (registered into ``physics.cli``).
+"""``rotordrop train | evaluate | benchmark | ride-through`` (registered into ``physics.cli``).
 
 Registration is light: SB3, torch and the environments are imported inside the handlers.
 """
@@ -61,6 +61,27 @@ def cmd_benchmark(args) -> int:
     return 0
 
 
+def cmd_ride_through(args) -> int:
+    from .ride_through import DELAYS, FRICTIONS, QUICK, ride_through, summary_table
+    from .benchmark import PHASES
+    grid = QUICK if args.quick else dict(frictions=FRICTIONS, delays=DELAYS, phases=PHASES)
+    try:
+        report = ride_through(args.out, args.env, args.policy,
+                              frictions=args.friction or grid["frictions"],
+                              delays=[d * 1e-3 for d in args.delay_ms] if args.delay_ms else grid["delays"],
+                              phases=args.phase or grid["phases"], progress=not args.quiet,
+                              plots=not args.no_plots)
+    except (KeyError, ValueError, FileNotFoundError) as exc:
+        print(f"rotordrop ride-through: error: {exc.args[0] if exc.args else exc}", file=sys.stderr)
+        return 2
+    print(f"ride-through time (longest power-return delay with no backward whirl and "
+          f"re-levitation in every phase), {report['env_id']}:")
+    print(summary_table(report))
+    print(f"wrote " + ", ".join(str(args.out + "/" + f) for f in report["files"])
+          + f" in {report['wall_time_s']:.0f} s")
+    return 0
+
+
 def register(sub) -> None:
     p = sub.add_parser("train", help="train an SB3 agent on a rotor-drop environment")
     p.add_argument("--env", required=True, help="environment id, e.g. RotorDrop-Damping-v0")
@@ -109,3 +130,22 @@ def register(sub) -> None:
     p.add_argument("--scenarios", type=int, default=None, help=argparse.SUPPRESS)
     p.add_argument("--episodes", type=int, default=None, help=argparse.SUPPRESS)
     p.set_defaults(func=cmd_benchmark)
+
+    p = sub.add_parser("ride-through", help="how late the AMB power may return for a controller "
+                                            "to stop the whirl: friction x power-return map")
+    p.add_argument("--env", default="RotorDrop-Relevitate-v0",
+                   help="RotorDrop-Relevitate-v0 (damper at the scene's C_s) or RotorDrop-Full-v0")
+    p.add_argument("--policy", action="append", default=None,
+                   help="baseline or shipped policy name, or a path (repeatable; default: every "
+                        "re-levitating baseline and the shipped policies of --env)")
+    p.add_argument("--friction", type=float, action="append", default=None,
+                   help="friction coefficient (repeatable; default 0.30, 0.35, ..., 0.60)")
+    p.add_argument("--delay-ms", type=float, action="append", default=None,
+                   help="power-return delay after the fault [ms] (repeatable; default 0, 10, ..., 100)")
+    p.add_argument("--phase", type=float, action="append", default=None,
+                   help="unbalance phase [deg] (repeatable; default the benchmark's 0, 90, 180, 270)")
+    p.add_argument("--quick", action="store_true", help="3 frictions x 3 delays x 2 phases")
+    p.add_argument("--out", default="out/ride_through", help="output directory")
+    p.add_argument("--no-plots", action="store_true")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=cmd_ride_through)

@@ -9,7 +9,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from .benchmark import monitor_kwargs
+from .benchmark import baseline_env_kwargs, monitor_kwargs
 from .controllers import BASELINES, Passive
 from .policies import resolve
 from .rollout import run_episodes
@@ -39,7 +39,7 @@ def _actor(spec: str, env_id: str | None):
     if spec in BASELINES:
         if env_id is None:
             raise ValueError(f"--env is required for the baseline controller {spec!r}")
-        return (lambda plant: resolve(spec, plant)[0]), env_id, {}, spec
+        return (lambda plant: resolve(spec, plant)[0]), env_id, baseline_env_kwargs(spec, env_id), spec
     policy, trained_on = resolve(spec)
     return policy.bound, env_id or trained_on, dict(policy.env_kwargs), policy.name
 

@@ -164,3 +164,44 @@ def plot_benchmark(report: dict, out: Path) -> list[Path]:
         fig.savefig(paths[-1], dpi=110)
         plt.close(fig)
     return paths
+
+
+def plot_ride_through(report: dict, out: Path) -> Path:
+    """One panel per controller: peak backward-whirl revolutions (worst phase) over friction ×
+    power-return delay, the whirl threshold as a contour, and the passive drop's peak
+    revolutions as the reference strip on top."""
+    plt = _plt()
+    mus = np.asarray(report["frictions"])
+    delays = 1e3 * np.asarray(report["power_return_s"])
+    names = list(report["controllers"])
+    thr = report["whirl_revolutions"]
+    vmax = max(2 * thr, max(np.nanmax(np.asarray(m["peak_whirl_revolutions"], dtype=float))
+                            for m in report["controllers"].values()))
+    fig, axes = plt.subplots(1, len(names), figsize=(4.2 * len(names) + 1, 4.2), squeeze=False,
+                             sharey=True)
+    for ax, name in zip(axes[0], names):
+        m = report["controllers"][name]
+        revs = np.asarray(m["peak_whirl_revolutions"], dtype=float).T       # (delays, frictions)
+        im = ax.pcolormesh(mus, delays, revs, cmap="Reds", vmin=0.0, vmax=vmax, shading="nearest")
+        if len(mus) > 1 and len(delays) > 1:
+            ax.contour(mus, delays, revs, levels=[thr], colors="k", linewidths=1.2)
+        for i, mu in enumerate(mus):
+            for j, d in enumerate(delays):
+                ax.text(mu, d, f"{revs[j, i]:.1f}", ha="center", va="center", fontsize=6,
+                        color="white" if revs[j, i] > 0.6 * vmax else "black")
+        ride = [np.nan if t is None else 1e3 * t for t in m["ride_through_s"]]
+        ax.plot(mus, ride, "o-", color="C0", ms=3)
+        ax.set_title(name)
+        ax.set_xlabel("friction coefficient μ")
+    axes[0, 0].set_ylabel("power back after the fault [ms]")
+    passive = ", ".join(f"{mu:g}: {r:.0f}" for mu, r in
+                        zip(mus, report["passive"]["peak_whirl_revolutions"]))
+    fig.suptitle(f"{report['env_id']}: peak backward-whirl revolutions, worst of "
+                 f"{len(report['phases_deg'])} phases (whirl ≥ {thr:g}: black line); blue: "
+                 f"ride-through time\npassive drop (power never back), μ: revolutions  {passive}",
+                 fontsize=9, y=1.04)
+    fig.colorbar(im, ax=axes[0].tolist(), fraction=0.03)
+    path = Path(out) / "ride_through.png"
+    fig.savefig(path, dpi=110, bbox_inches="tight")
+    plt.close(fig)
+    return path

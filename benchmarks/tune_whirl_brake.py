@@ -20,11 +20,10 @@ import time
 from pathlib import Path
 
 import numpy as np
-from tqdm.auto import tqdm
-
 from agents.benchmark import BASELINE_KWARGS, EVAL_KWARGS, TASKS, Entry, Scenario, episode_kwargs
 from agents.controllers import WhirlBrake
 from agents.rollout import run_episodes
+from agents.search import cross_entropy
 
 NAMES = ("kp", "kd", "kc", "kt", "kr", "ff")
 LOW = np.array([0.0, 0.0, -3.0, -0.5, -1.0, 0.0])
@@ -55,25 +54,17 @@ def main(argv=None):
     ap.add_argument("--out", default="out/tune_whirl_brake")
     a = ap.parse_args(argv)
     rng = np.random.default_rng(a.seed)
-    mean = np.array([WhirlBrake.GAINS[n] for n in NAMES])
-    std = 0.15 * (HIGH - LOW)
-    best = (cost(mean, a.env)[0], mean.copy())
-    history = [dict(iteration=0, best_cost=best[0], gains=dict(zip(NAMES, mean.tolist())))]
     t0 = time.perf_counter()
-    for it in tqdm(range(1, a.iterations + 1), desc="cross-entropy search", unit="gen"):
-        pop = np.clip(mean + std * rng.standard_normal((a.population, len(NAMES))), LOW, HIGH)
-        costs = np.array([cost(x, a.env)[0] for x in pop])
-        elite = pop[np.argsort(costs)[:a.elite]]
-        if costs.min() < best[0]:
-            best = (float(costs.min()), pop[np.argmin(costs)].copy())
-        mean, std = elite.mean(0), elite.std(0) + 0.01 * (HIGH - LOW)
-        history.append(dict(iteration=it, best_cost=best[0], generation_best=float(costs.min()),
-                            gains=dict(zip(NAMES, best[1].tolist()))))
-        tqdm.write(f"gen {it}: best {best[0]:.3f}  " + " ".join(f"{n}={v:.3g}" for n, v in zip(NAMES, best[1])))
-    final, kpis = cost(best[1], a.env)
+    best_cost, best, hist = cross_entropy(
+        lambda x: cost(x, a.env)[0], [WhirlBrake.GAINS[n] for n in NAMES], 0.15 * (HIGH - LOW),
+        LOW, HIGH, a.iterations, a.population, a.elite, rng, min_std=0.01 * (HIGH - LOW))
+    history = [dict(iteration=h["iteration"], best_cost=h["best_cost"],
+                    generation_best=h["generation_best"], gains=dict(zip(NAMES, h["best"].tolist())))
+               for h in hist]
+    final, kpis = cost(best, a.env)
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
-    rec = dict(env=a.env, tuning_set=TUNING_SET, cost=final, gains=dict(zip(NAMES, best[1].tolist())),
+    rec = dict(env=a.env, tuning_set=TUNING_SET, cost=final, gains=dict(zip(NAMES, best.tolist())),
                kpis=kpis, history=history, wall_time_s=time.perf_counter() - t0, seed=a.seed)
     (out / "tune.json").write_text(json.dumps(rec, indent=2))
     print(json.dumps(dict(cost=final, gains=rec["gains"]), indent=1))

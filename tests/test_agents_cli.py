@@ -66,3 +66,55 @@ def test_benchmark_quick_end_to_end(tmp_path):
     assert "| max-damping |" in md and "mu*" in md
     for f in ("score.png", "whirl_map.png", "peak_force.png"):
         assert (out / f).is_file()
+
+
+def test_evaluate_a_current_commanding_baseline_in_the_relevitation_env(tmp_path):
+    """whirl-brake commands currents: evaluate gives the env the command it needs."""
+    out = tmp_path / "ev"
+    assert main(["evaluate", "--policy", "whirl-brake", "--env", "RotorDrop-Relevitate-v0",
+                 "--episodes", "1", "--fixed", "--no-plots", "--no-passive",
+                 "--set", "contact.friction=0.25", "--out", str(out)]) == 0
+    r = json.loads((out / "kpis.json").read_text())
+    assert r["env_kwargs"]["command"] == "continuous"
+    assert r["episodes"][0]["relevitated"]
+
+
+def test_ride_through_times_take_the_unbroken_run_of_safe_delays():
+    import numpy as np
+    from agents.ride_through import ride_through_times
+    delays = (0.0, 0.02, 0.04, 0.06)
+    revs = np.array([[0.1, 0.2, 0.3, 0.4],        # safe throughout
+                     [0.1, 3.2, 0.3, 0.4],        # a whirl at 20 ms: later luck does not count
+                     [3.1, 0.1, 0.1, 0.1],        # whirls even at once
+                     [0.1, 0.2, 0.3, 0.4]])
+    relev = np.ones_like(revs)
+    relev[3, 2] = 0.5                             # one phase not re-levitated at 40 ms
+    assert ride_through_times(revs, relev, delays, 3.0) == [0.06, 0.0, None, 0.02]
+
+
+def test_ride_through_early_power_stops_the_whirl_late_power_does_not(tmp_path):
+    """At mu = 0.5 the passive drop whirls; whirl-brake prevents it when the power is back
+    at once and cannot when it comes back after 100 ms (about 5 revolutions by then)."""
+    out = tmp_path / "rt"
+    assert main(["ride-through", "--policy", "whirl-brake", "--friction", "0.5",
+                 "--delay-ms", "0", "--delay-ms", "100", "--phase", "0", "--quiet",
+                 "--out", str(out)]) == 0
+    r = json.loads((out / "ride_through.json").read_text())
+    m = r["controllers"]["whirl-brake"]
+    (early, late), = m["peak_whirl_revolutions"]
+    assert early < 1.0 and late >= r["whirl_revolutions"]
+    assert m["relevitated"] == [[1.0, 1.0]]
+    assert m["ride_through_s"] == [0.0]
+    assert r["passive"]["backward_whirl"] == [1.0]
+    rows = (out / "ride_through.csv").read_text().splitlines()
+    assert len(rows) == 1 + 2 + 1                 # header, 2 cells, the passive reference
+    assert (out / "ride_through.png").is_file()
+
+
+def test_ride_through_errors_name_the_option(tmp_path, capsys):
+    assert main(["ride-through", "--friction", "-0.1", "--out", str(tmp_path)]) == 2
+    assert "--friction" in capsys.readouterr().err
+    assert main(["ride-through", "--env", "RotorDrop-Damping-v0", "--out", str(tmp_path)]) == 2
+    assert "re-levitation environment" in capsys.readouterr().err
+    assert main(["ride-through", "--policy", "ppo-damping", "--out", str(tmp_path)]) == 2
+    assert "trained on RotorDrop-Damping-v0" in capsys.readouterr().err

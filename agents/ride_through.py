@@ -1,0 +1,170 @@
+"""``rotordrop ride-through``: how late may the AMB power return for a controller to stop the whirl?
+
+Re-levitation can only start when the power is back (spec §5). Until then the rotor is on its
+retainer bearings, and above the passive whirl threshold the backward whirl builds up (about
+2 revolutions in the first 50 ms at μ = 0.48). This map runs a re-levitating controller on a
+grid of friction coefficients × power-return delays (each at several unbalance phases, the
+benchmark's episode settings) and reports per cell the peak backward-whirl revolutions (the
+worst phase), the whirl rate, the peak contact force and the re-levitation rate. Its summary is
+the **ride-through time** per friction: the longest grid delay up to which (every shorter
+delay included) the controller re-levitates without a backward whirl in any phase. The passive
+drop (power never returns) is the reference column.
+
+Outputs: ``ride_through.json`` (grid, per-controller arrays, ride-through times),
+``ride_through.csv`` (one row per controller, friction, delay) and ``ride_through.png``.
+"""
+from __future__ import annotations
+
+import csv
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .benchmark import (PHASES, RELEVITATION_ENVS, TASKS, Entry, Scenario, baseline_env_kwargs,
+                        episode_kwargs)
+from .controllers import BASELINES, Passive
+from .policies import resolve, shipped_names, load_shipped
+from .rollout import run_episodes
+from .score import json_default
+
+FRICTIONS = tuple(round(0.30 + 0.05 * i, 2) for i in range(7))          # 0.30 ... 0.60
+DELAYS = tuple(round(0.01 * i, 2) for i in range(11))                   # 0 ... 100 ms
+QUICK = dict(frictions=(0.35, 0.45, 0.55), delays=(0.0, 0.03, 0.06), phases=(0.0, 180.0))
+FIELDS = ("peak_whirl_revolutions", "backward_whirl", "peak_contact_force_N", "relevitated",
+          "relevitation_time_s")
+
+
+def controllers_for(env_id: str) -> list[str]:
+    """The default controllers of a map: every re-levitating baseline and shipped policy of
+    ``env_id`` (the passive drop is the reference column, not a controller)."""
+    from .plant import Plant, make_env
+    names = []
+    for name, cls in BASELINES.items():
+        if name == Passive.name:
+            continue
+        env = make_env(env_id, **baseline_env_kwargs(name, env_id))
+        plant = Plant.from_env(env)
+        env.close()
+        if cls.supports(plant) and ("currents" in cls.needs or "levitate" in cls.needs):
+            names.append(name)
+    return names + [n for n in shipped_names() if load_shipped(n).env_id == env_id]
+
+
+def _entry(spec: str, env_id: str) -> Entry:
+    task = {v: k for k, v in TASKS.items()}[env_id]
+    if spec in BASELINES:
+        return Entry(spec, task, lambda plant: resolve(spec, plant)[0],
+                     baseline_env_kwargs(spec, env_id))
+    policy, trained_on = resolve(spec)
+    if trained_on != env_id:
+        raise ValueError(f"policy {spec!r} was trained on {trained_on}, not on {env_id}; "
+                         f"pass --env {trained_on}")
+    return Entry(policy.name, task, policy.bound, dict(policy.env_kwargs))
+
+
+def _check_grid(name: str, values, lo: float, hi: float) -> tuple[float, ...]:
+    values = tuple(float(v) for v in values)
+    if not values:
+        raise ValueError(f"{name} needs at least one value")
+    bad = [v for v in values if not (np.isfinite(v) and lo <= v <= hi)]
+    if bad:
+        raise ValueError(f"{name} values {bad} are outside [{lo:g}, {hi:g}]")
+    return tuple(sorted(set(values)))
+
+
+def ride_through_times(peak_revs: np.ndarray, relevitated: np.ndarray, delays, threshold: float):
+    """Per friction (rows), the longest delay d_k such that every delay ≤ d_k re-levitates in
+    every phase with peak revolutions below ``threshold``; None when even the first fails."""
+    ok = (peak_revs < threshold) & (relevitated >= 1.0)
+    out = []
+    for row in ok:
+        n = len(row) if row.all() else int(np.argmin(row))
+        out.append(delays[n - 1] if n > 0 else None)
+    return out
+
+
+def ride_through(out: str | Path, env_id: str = "RotorDrop-Relevitate-v0",
+                 policies: list[str] | None = None, frictions=FRICTIONS, delays=DELAYS,
+                 phases=PHASES, progress: bool = True, plots: bool = True) -> dict:
+    """Run the map (module doc) and write its JSON, CSV and figure into ``out``."""
+    from tqdm.auto import tqdm
+
+    from physics.metrics import WHIRL_MIN_REVOLUTIONS
+    if env_id not in RELEVITATION_ENVS:
+        raise ValueError(f"--env must be a re-levitation environment ({', '.join(RELEVITATION_ENVS)}), "
+                         f"got {env_id!r}")
+    frictions = _check_grid("--friction", frictions, 0.0, 2.0)
+    delays = _check_grid("--delay", delays, 0.0, 10.0)
+    phases = _check_grid("--phase", phases, -360.0, 360.0)
+    entries = [_entry(p, env_id) for p in (policies or controllers_for(env_id))]
+    task = {v: k for k, v in TASKS.items()}[env_id]
+    passive = Entry(Passive.name, task, Passive, {})
+    t0 = time.perf_counter()
+    bar = tqdm(total=len(phases) * len(frictions) * (1 + len(entries) * len(delays)),
+               desc="ride-through map", unit="ep", disable=not progress)
+
+    def cell(entry: Entry, mu: float, delay: float | None) -> dict:
+        sc = Scenario("cell", mu, env_kwargs={} if delay is None else {"power_return_time": delay})
+        kpis = []
+        for ph in phases:
+            kpis += [e.kpis for e in run_episodes(env_id, entry.make, [0], episode_kwargs(entry, sc, ph))]
+            bar.update(1)
+        return dict(peak_whirl_revolutions=max(k["peak_whirl_revolutions"] for k in kpis),
+                    backward_whirl=float(np.mean([bool(k["backward_whirl"]) for k in kpis])),
+                    peak_contact_force_N=max(k["peak_contact_force_N"] for k in kpis),
+                    relevitated=float(np.mean([bool(k["relevitated"]) for k in kpis])),
+                    relevitation_time_s=_mean_or_none([k["relevitation_time_s"] for k in kpis
+                                                       if k["relevitated"]]))
+
+    reference = [cell(passive, mu, None) for mu in frictions]
+    maps, rows = {}, []
+    for entry in entries:
+        grid = [[cell(entry, mu, d) for d in delays] for mu in frictions]
+        arrays = {f: [[c[f] for c in r] for r in grid] for f in FIELDS}
+        revs = np.array(arrays["peak_whirl_revolutions"], dtype=float)
+        relev = np.array(arrays["relevitated"], dtype=float)
+        arrays["ride_through_s"] = ride_through_times(revs, relev, delays, WHIRL_MIN_REVOLUTIONS)
+        maps[entry.name] = arrays
+        rows += [dict(controller=entry.name, friction=mu, power_return_s=d, **c)
+                 for mu, r in zip(frictions, grid) for d, c in zip(delays, r)]
+    bar.close()
+    rows += [dict(controller=Passive.name, friction=mu, power_return_s=None, **c)
+             for mu, c in zip(frictions, reference)]
+    report = dict(env_id=env_id, phases_deg=list(phases), frictions=list(frictions),
+                  power_return_s=list(delays), whirl_revolutions=WHIRL_MIN_REVOLUTIONS,
+                  passive={f: [c[f] for c in reference] for f in FIELDS}, controllers=maps,
+                  wall_time_s=time.perf_counter() - t0)
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "ride_through.json").write_text(json.dumps(report, indent=2, default=json_default))
+    with open(out / "ride_through.csv", "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=["controller", "friction", "power_return_s", *FIELDS])
+        w.writeheader()
+        w.writerows(rows)
+    files = ["ride_through.json", "ride_through.csv"]
+    if plots:
+        from .plots import plot_ride_through
+        files.append(plot_ride_through(report, out).name)
+    report["files"] = files
+    report["out"] = str(out)
+    return report
+
+
+def _mean_or_none(values):
+    return float(np.mean(values)) if values else None
+
+
+def summary_table(report: dict) -> str:
+    """Markdown: ride-through time [ms] per controller (rows) and friction (columns), with the
+    passive drop's whirl rate as the first row; "≥" when the longest delay of the grid held."""
+    mus, longest = report["frictions"], report["power_return_s"][-1]
+    head = "| controller | " + " | ".join(f"μ={m:g}" for m in mus) + " |\n"
+    head += "|---|" + "---:|" * len(mus) + "\n"
+    body = "| passive whirl rate | " + " | ".join(f"{w:.2f}" for w in report["passive"]["backward_whirl"]) + " |\n"
+    for name, m in report["controllers"].items():
+        body += f"| {name} | " + " | ".join(
+            "none" if t is None else ("≥ " if t == longest else "") + f"{1e3 * t:.0f} ms"
+            for t in m["ride_through_s"]) + " |\n"
+    return head + body

@@ -1,0 +1,120 @@
+"""How few backward-whirl revolutions can *any* AMB current sequence reach once the power is back?
+
+An oracle probe of the re-levitation task: for one fixed scenario (friction, unbalance phase,
+power-return delay) a cross-entropy search (agents/search.py) optimises an open-loop correction
+of the AMB currents, piecewise constant over ``--segments`` × ``--steps`` control steps from the
+moment the power returns, added to a baseline controller's currents (default ``whirl-brake``)
+and clipped to the current limit. The correction is allowed the full range [-2, 2], so it can
+override the baseline entirely. The search knows the scenario in advance, which no controller
+does: its peak revolutions are an empirical lower bound for what feedback control can reach
+there. Cost: the peak net backward orbit revolutions of the episode (3 make a whirl).
+
+    python benchmarks/whirl_bound.py --friction 0.48 --friction 0.53 --out out/whirl_bound
+
+prints the baseline's and the best sequence's peak revolutions per scenario and writes
+``whirl_bound.json``.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+
+from agents.benchmark import TASKS, Entry, Scenario, baseline_env_kwargs, episode_kwargs
+from agents.controllers import make_baseline
+from agents.plant import Plant, make_env
+from agents.search import cross_entropy
+from physics.metrics import WHIRL_MIN_REVOLUTIONS
+
+
+class OpenLoopCorrection:
+    """The baseline's currents plus ``theta[k]`` during segment k after the power returns."""
+
+    def __init__(self, plant: Plant, baseline: str, steps: int):
+        self.plant, self.base, self.steps = plant, make_baseline(baseline, plant), steps
+        self.cols = [plant.action_names.index(n) for n in plant.action_names if n.startswith("current")]
+        self.theta = np.zeros((0, len(self.cols)))
+
+    def run(self, env, theta: np.ndarray) -> dict:
+        obs, _ = env.reset(seed=0)
+        start, k_power, k = np.ones(1, dtype=bool), None, 0
+        while True:
+            a, _ = self.base.predict(obs[None, :], episode_start=start)
+            a, start = a[0].copy(), np.zeros(1, dtype=bool)
+            if self.plant.power_available(obs[None, :])[0]:
+                k_power = k if k_power is None else k_power
+                seg = (k - k_power) // self.steps
+                if seg < len(theta):
+                    a[self.cols] = np.clip(a[self.cols] + theta[seg], -1.0, 1.0)
+            obs, _, terminated, truncated, info = env.step(a)
+            k += 1
+            if terminated or truncated:
+                return {k[4:]: v for k, v in info.items() if k.startswith("kpi_")}
+
+
+def bound(env_id: str, baseline: str, friction: float, phase: float, delay: float, segments: int,
+          steps: int, iterations: int, population: int, std: float, seed: int) -> dict:
+    task = {v: k for k, v in TASKS.items()}[env_id]
+    entry = Entry(baseline, task, None, baseline_env_kwargs(baseline, env_id))
+    kw = episode_kwargs(entry, Scenario("bound", friction, env_kwargs={"power_return_time": delay}), phase)
+    env = make_env(env_id, **kw)
+    try:
+        probe = OpenLoopCorrection(Plant.from_env(env), baseline, steps)
+        shape = (segments, len(probe.cols))
+        peak = lambda th: float(probe.run(env, th)["peak_whirl_revolutions"])
+        base_kpis = probe.run(env, np.zeros(shape))
+        best, theta, history = cross_entropy(
+            peak, np.zeros(shape), np.full(shape, std), -2.0, 2.0, iterations, population,
+            max(2, population // 5), np.random.default_rng(seed), min_std=0.05,
+            desc=f"mu={friction:g} phase={phase:g}")
+        best_kpis = probe.run(env, theta)
+    finally:
+        env.close()
+    return dict(friction=friction, phase_deg=phase, power_return_s=delay,
+                baseline_peak_revolutions=base_kpis["peak_whirl_revolutions"],
+                best_peak_revolutions=best_kpis["peak_whirl_revolutions"],
+                best_backward_whirl=bool(best_kpis["backward_whirl"]),
+                best_peak_contact_force_N=best_kpis["peak_contact_force_N"],
+                history=[h["best_cost"] for h in history], correction=theta.tolist())
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--env", default="RotorDrop-Relevitate-v0", choices=(TASKS["relevitate"], TASKS["full"]))
+    ap.add_argument("--baseline", default="whirl-brake")
+    ap.add_argument("--friction", type=float, action="append", default=None,
+                    help="repeatable; default 0.48 and 0.53 (the benchmark's mu* + 0.10, + 0.15)")
+    ap.add_argument("--phase", type=float, action="append", default=None,
+                    help="unbalance phase [deg], repeatable; default 0 and 180")
+    ap.add_argument("--delay-ms", type=float, default=50.0, help="power-return delay [ms]")
+    ap.add_argument("--segments", type=int, default=16)
+    ap.add_argument("--steps", type=int, default=2, help="control steps per segment")
+    ap.add_argument("--iterations", type=int, default=25)
+    ap.add_argument("--population", type=int, default=32)
+    ap.add_argument("--std", type=float, default=0.5, help="initial search spread (current limit = 1)")
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--out", default="out/whirl_bound")
+    a = ap.parse_args(argv)
+    t0 = time.perf_counter()
+    rows = [bound(a.env, a.baseline, mu, ph, a.delay_ms * 1e-3, a.segments, a.steps, a.iterations,
+                  a.population, a.std, a.seed)
+            for mu in (a.friction or [0.48, 0.53]) for ph in (a.phase or [0.0, 180.0])]
+    out = Path(a.out)
+    out.mkdir(parents=True, exist_ok=True)
+    rec = dict(env=a.env, baseline=a.baseline, settings=vars(a), whirl_revolutions=WHIRL_MIN_REVOLUTIONS,
+               rows=rows, wall_time_s=time.perf_counter() - t0)
+    (out / "whirl_bound.json").write_text(json.dumps(rec, indent=2))
+    print(f"{a.env}, power back at {a.delay_ms:g} ms, open-loop correction of {a.baseline} over "
+          f"{a.segments * a.steps} control steps ({a.iterations} x {a.population} episodes per scenario)")
+    print(f"{'mu':>6}{'phase':>7}  {a.baseline + ' revs':>22}{'best revs':>11}{'whirl':>7}")
+    for r in rows:
+        print(f"{r['friction']:6.2f}{r['phase_deg']:7.0f}  {r['baseline_peak_revolutions']:22.2f}"
+              f"{r['best_peak_revolutions']:11.2f}{r['best_backward_whirl']!s:>7}")
+    print(f"wrote {out / 'whirl_bound.json'} in {rec['wall_time_s']:.0f} s")
+
+
+if __name__ == "__main__":
+    main()
