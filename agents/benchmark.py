@@ -14,8 +14,8 @@
    Each scenario runs once per unbalance phase (``PHASES``): the episodes are deterministic.
 3. **Tasks.** ``damping`` (``RotorDrop-Damping-v0``), ``relevitate``
    (``RotorDrop-Relevitate-v0``) and ``full`` (``RotorDrop-Full-v0``, both channels): every
-   baseline that has its channels in the task (``BASELINE_KWARGS`` picks the re-levitation
-   command), the passive reference with the AMBs left off, learned policies with the command
+   baseline (and user controller, ``--policy module:Class``) that has its channels in the task
+   (:func:`controller_env_kwargs` picks the re-levitation command its channels need), the passive reference with the AMBs left off, learned policies with the command
    they were trained with.
    Episodes last ``EPISODE_TIME`` and are not cut short at the stator (``terminate_on_failure =
    False``) so that whirl is measured as ``rotordrop drop`` measures it.
@@ -33,7 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .controllers import BASELINES, Passive
+from .controllers import BASELINES, Passive, command_for, controller_class, make_controller
 from .policies import LearnedPolicy, load_shipped, shipped_names
 from .rollout import run_episodes
 from .score import fmt_or_dash, json_default, overall_score, row_cost, summarize
@@ -47,17 +47,15 @@ THRESHOLD_GRID = tuple(round(0.10 + 0.02 * i, 2) for i in range(21))     # 0.10 
 WHIRL_MARGINS = (0.05, 0.10, 0.15)
 TASKS = {"damping": "RotorDrop-Damping-v0", "relevitate": "RotorDrop-Relevitate-v0",
          "full": "RotorDrop-Full-v0"}
-#: env kwargs of the baselines (the passive reference keeps the AMBs off)
-BASELINE_KWARGS = {"pid-relevitate": {"command": "continuous"},
-                   "builtin-relevitate": {"command": "discrete"},
-                   "whirl-brake": {"command": "continuous"}}
 RELEVITATION_ENVS = (TASKS["relevitate"], TASKS["full"])
 
 
-def baseline_env_kwargs(name: str, env_id: str) -> dict:
-    """The env kwargs baseline ``name`` needs in ``env_id``: its re-levitation command
-    (``BASELINE_KWARGS``) in the re-levitation environments, nothing elsewhere."""
-    return dict(BASELINE_KWARGS.get(name, {})) if env_id in RELEVITATION_ENVS else {}
+def controller_env_kwargs(cls, env_id: str) -> dict:
+    """The env kwargs a controller class needs in ``env_id``: the re-levitation command of its
+    channels (``controllers.command_for``) in the re-levitation environments, else nothing
+    (the passive reference keeps the AMBs off)."""
+    command = command_for(cls)
+    return {"command": command} if command and env_id in RELEVITATION_ENVS else {}
 
 
 @dataclass(frozen=True)
@@ -143,18 +141,20 @@ class Entry:
     env_kwargs: dict
 
 
-def _entries(policies: list[LearnedPolicy]) -> list[Entry]:
+def _entries(policies: list[LearnedPolicy], controllers=()) -> list[Entry]:
+    """Every controller class (the baselines, then ``controllers``) in each task that has its
+    channels, and every policy in the task it was trained for."""
     from .plant import Plant, make_env
     out = []
     for task, env_id in TASKS.items():
         task_policies = [p for p in policies if p.env_id == env_id]
-        for name, cls in BASELINES.items():
-            kw = baseline_env_kwargs(name, env_id)
+        for cls in [*BASELINES.values(), *controllers]:
+            kw = controller_env_kwargs(cls, env_id)
             env = make_env(env_id, **kw)
             supported = cls.supports(Plant.from_env(env))
             env.close()
             if supported:
-                out.append(Entry(name, task, cls, kw))
+                out.append(Entry(cls.name, task, lambda plant, c=cls: make_controller(c, plant), kw))
         for p in task_policies:
             out.append(Entry(p.name, task, p.bound, dict(p.env_kwargs)))
     return out
@@ -193,14 +193,19 @@ def benchmark(out: str | Path, quick: bool = False, policies: list[str] | None =
     if episodes is not None:
         phases = PHASES[:max(1, min(episodes, len(PHASES)))]
     loaded = [load_shipped(n) for n in shipped_names()]
+    custom = []
     for spec in policies or []:
-        if spec in shipped_names():
+        if spec in shipped_names() or spec in BASELINES:
             continue                                   # already in
+        cls = controller_class(spec)
+        if cls is not None:
+            custom.append(cls)
+            continue
         pol = LearnedPolicy.load(spec)
         if any(pol.name == p.name for p in loaded):     # e.g. a new run of a shipped policy
             pol.name = f"{pol.name}@{Path(spec).name}"
         loaded.append(pol)
-    entries = _entries(loaded)
+    entries = _entries(loaded, custom)
 
     sweep_phases = PHASES if episodes is None else phases     # --quick: the full threshold sweep
     bar = tqdm(total=len(THRESHOLD_GRID) * len(sweep_phases), desc="passive threshold", unit="ep",

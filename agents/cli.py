@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 
 
 def _env_kwargs(args) -> dict:
@@ -56,8 +57,12 @@ def cmd_evaluate(args) -> int:
 
 def cmd_benchmark(args) -> int:
     from .benchmark import benchmark
-    benchmark(args.out, quick=args.quick, policies=args.policy, max_scenarios=args.scenarios,
-              episodes=args.episodes, progress=not args.quiet, plots=not args.no_plots)
+    try:
+        benchmark(args.out, quick=args.quick, policies=args.policy, max_scenarios=args.scenarios,
+                  episodes=args.episodes, progress=not args.quiet, plots=not args.no_plots)
+    except (KeyError, ValueError, FileNotFoundError) as exc:
+        print(f"rotordrop benchmark: error: {exc.args[0] if exc.args else exc}", file=sys.stderr)
+        return 2
     return 0
 
 
@@ -77,7 +82,7 @@ def cmd_ride_through(args) -> int:
     print(f"ride-through time (longest power-return delay with no backward whirl and "
           f"re-levitation in every phase), {report['env_id']}:")
     print(summary_table(report))
-    print(f"wrote " + ", ".join(str(args.out + "/" + f) for f in report["files"])
+    print("wrote " + ", ".join(str(Path(args.out) / f) for f in report["files"])
           + f" in {report['wall_time_s']:.0f} s")
     return 0
 
@@ -104,8 +109,9 @@ def register(sub) -> None:
 
     p = sub.add_parser("evaluate", help="KPIs and plots of a policy or baseline controller")
     p.add_argument("--policy", required=True,
-                   help="baseline name (passive, max-damping, whirl-switch, pid-relevitate), shipped "
-                        "policy name (e.g. ppo-damping) or path to a training directory / model zip")
+                   help="baseline name (passive, max-damping, whirl-switch, pid-relevitate, ...), shipped "
+                        "policy name (e.g. ppo-damping), path to a training directory / model zip, "
+                        "or your own controller class as package.module:Class or file.py:Class")
     p.add_argument("--env", default=None, help="environment id (default: the one the policy was "
                                                "trained on; required for baselines)")
     p.add_argument("--episodes", type=int, default=10)
@@ -123,7 +129,9 @@ def register(sub) -> None:
     p = sub.add_parser("benchmark", help="every baseline and shipped policy on a fixed scenario suite")
     p.add_argument("--quick", action="store_true", help="a reduced suite that runs in a few minutes")
     p.add_argument("--policy", action="append", default=None,
-                   help="extra policies to include (path or shipped name; repeatable)")
+                   help="extra policies or controllers to include (repeatable): a training "
+                        "directory or model .zip, or your own controller class as "
+                        "package.module:Class or file.py:Class (see docs/agents.md)")
     p.add_argument("--out", default="out/benchmark", help="output directory")
     p.add_argument("--no-plots", action="store_true")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -136,8 +144,9 @@ def register(sub) -> None:
     p.add_argument("--env", default="RotorDrop-Relevitate-v0",
                    help="RotorDrop-Relevitate-v0 (damper at the scene's C_s) or RotorDrop-Full-v0")
     p.add_argument("--policy", action="append", default=None,
-                   help="baseline or shipped policy name, or a path (repeatable; default: every "
-                        "re-levitating baseline and the shipped policies of --env)")
+                   help="baseline or shipped policy name, a path, or a controller class "
+                        "module:Class / file.py:Class (repeatable; default: every re-levitating "
+                        "baseline and the shipped policies of --env)")
     p.add_argument("--friction", type=float, action="append", default=None,
                    help="friction coefficient (repeatable; default 0.30, 0.35, ..., 0.60)")
     p.add_argument("--delay-ms", type=float, action="append", default=None,

@@ -276,11 +276,69 @@ BASELINES: dict[str, type[Controller]] = {c.name: c for c in (
     Passive, MaxDamping, WhirlSwitch, PidRelevitate, BuiltinRelevitate, WhirlBrake)}
 
 
+def command_for(cls: type[Controller]) -> str | None:
+    """The re-levitation command (env kwarg ``command``) a controller's channels need:
+    ``continuous`` for ``currents``, ``discrete`` for ``levitate``, None otherwise."""
+    return "continuous" if "currents" in cls.needs else "discrete" if "levitate" in cls.needs else None
+
+
+def is_controller_spec(spec: str) -> bool:
+    """``module:Class`` or ``file.py:Class`` (a user's controller), not a path on disk."""
+    from pathlib import Path
+    return ":" in spec and not Path(spec).exists()
+
+
+def load_controller(spec: str) -> type[Controller]:
+    """A user's controller class from ``package.module:Class`` or ``path/to/file.py:Class``.
+
+    It must subclass :class:`Controller` (set ``name`` and ``needs``, return channel values
+    from ``commands(obs)``); the benchmark, ``evaluate`` and ``ride-through`` then treat it
+    like a baseline."""
+    import importlib
+    import importlib.util
+    from pathlib import Path
+    target, _, attr = spec.rpartition(":")
+    if not target or not attr.isidentifier():
+        raise ValueError(f"controller {spec!r}: expected package.module:Class or file.py:Class")
+    if target.endswith(".py"):
+        path = Path(target)
+        if not path.is_file():
+            raise FileNotFoundError(f"controller {spec!r}: no file {path}")
+        module_spec = importlib.util.spec_from_file_location(f"rotordrop_user_{path.stem}", path)
+        module = importlib.util.module_from_spec(module_spec)
+        module_spec.loader.exec_module(module)
+    else:
+        try:
+            module = importlib.import_module(target)
+        except ImportError as exc:
+            raise ValueError(f"controller {spec!r}: cannot import {target!r} ({exc})") from None
+    cls = getattr(module, attr, None)
+    if not (isinstance(cls, type) and issubclass(cls, Controller)):
+        raise ValueError(f"controller {spec!r}: {attr!r} in {target} is not a subclass of "
+                         f"agents.controllers.Controller")
+    if cls.name in BASELINES:
+        raise ValueError(f"controller {spec!r}: its name {cls.name!r} is a baseline's; give it its own")
+    return cls
+
+
+def controller_class(spec: str) -> type[Controller] | None:
+    """The controller class of a baseline name or a ``module:Class`` spec; None for anything
+    else (a learned policy)."""
+    if spec in BASELINES:
+        return BASELINES[spec]
+    return load_controller(spec) if is_controller_spec(spec) else None
+
+
+def make_controller(cls: type[Controller], plant: Plant) -> Controller:
+    """``cls(plant)`` after checking that the environment has the channels it needs."""
+    if not cls.supports(plant):
+        raise ValueError(f"controller {cls.name!r} needs action channels {cls.needs}, which "
+                         f"{plant.env_id} does not have (it has {', '.join(plant.channels)})")
+    return cls(plant)
+
+
 def make_baseline(name: str, plant: Plant) -> Controller:
     if name not in BASELINES:
         raise KeyError(f"unknown baseline controller {name!r}; known: {', '.join(BASELINES)}")
-    cls = BASELINES[name]
-    if not cls.supports(plant):
-        raise ValueError(f"controller {name!r} needs action channels {cls.needs}, which "
-                         f"{plant.env_id} does not have (it has {', '.join(plant.channels)})")
-    return cls(plant)
+    return make_controller(BASELINES[name], plant)
+

@@ -9,8 +9,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from .benchmark import baseline_env_kwargs, monitor_kwargs
-from .controllers import BASELINES, Passive
+from .benchmark import controller_env_kwargs, monitor_kwargs
+from .controllers import Passive, controller_class, make_controller
 from .policies import resolve
 from .rollout import run_episodes
 from .score import fmt_or_dash, json_default, summarize
@@ -36,10 +36,11 @@ def _merge_kwargs(base: dict, user: dict, randomize: bool) -> dict:
 
 def _actor(spec: str, env_id: str | None):
     """(make_actor(plant), env id, env kwargs of the policy, display name)."""
-    if spec in BASELINES:
+    cls = controller_class(spec)
+    if cls is not None:
         if env_id is None:
-            raise ValueError(f"--env is required for the baseline controller {spec!r}")
-        return (lambda plant: resolve(spec, plant)[0]), env_id, baseline_env_kwargs(spec, env_id), spec
+            raise ValueError(f"--env is required for the controller {spec!r}")
+        return (lambda plant: make_controller(cls, plant)), env_id, controller_env_kwargs(cls, env_id), cls.name
     policy, trained_on = resolve(spec)
     return policy.bound, env_id or trained_on, dict(policy.env_kwargs), policy.name
 

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .controllers import BASELINES, make_baseline
+from .controllers import BASELINES, controller_class, make_baseline, make_controller
 from .plant import Plant
 from .hyperparams import ALGOS as ALGO_NAMES
 from .residual import RESIDUAL_SCALE, residual_action
@@ -130,10 +130,9 @@ def resolve(spec: str, plant: Plant | None = None):
 
     Baselines need the ``plant`` of the environment they will drive.
     """
-    if spec in BASELINES:
-        if plant is None:
-            return None, None
-        return make_baseline(spec, plant), None
+    cls = controller_class(spec)
+    if cls is not None:
+        return (make_controller(cls, plant) if plant is not None else None), None
     if spec in shipped_names():
         pol = load_shipped(spec)
         return (pol.bound(plant) if plant is not None else pol), pol.env_id
@@ -141,7 +140,8 @@ def resolve(spec: str, plant: Plant | None = None):
         pol = LearnedPolicy.load(spec)
         return (pol.bound(plant) if plant is not None else pol), pol.env_id
     raise KeyError(f"--policy {spec!r} is not a baseline ({', '.join(BASELINES)}), a shipped "
-                   f"policy ({', '.join(shipped_names()) or 'none shipped'}) or an existing path")
+                   f"policy ({', '.join(shipped_names()) or 'none shipped'}), an existing path or "
+                   f"a controller class (package.module:Class, file.py:Class)")
 
 
 def ship_policy(run_dir: str | Path, name: str, which: str = "final", dest: Path | None = None,

@@ -22,10 +22,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .benchmark import (PHASES, RELEVITATION_ENVS, TASKS, Entry, Scenario, baseline_env_kwargs,
+from .benchmark import (PHASES, RELEVITATION_ENVS, TASKS, Entry, Scenario, controller_env_kwargs,
                         episode_kwargs)
-from .controllers import BASELINES, Passive
-from .policies import resolve, shipped_names, load_shipped
+from .controllers import BASELINES, Passive, command_for, controller_class, make_controller
+from .policies import load_shipped, resolve, shipped_names
 from .rollout import run_episodes
 from .score import json_default
 
@@ -39,24 +39,16 @@ FIELDS = ("peak_whirl_revolutions", "backward_whirl", "peak_contact_force_N", "r
 def controllers_for(env_id: str) -> list[str]:
     """The default controllers of a map: every re-levitating baseline and shipped policy of
     ``env_id`` (the passive drop is the reference column, not a controller)."""
-    from .plant import Plant, make_env
-    names = []
-    for name, cls in BASELINES.items():
-        if name == Passive.name:
-            continue
-        env = make_env(env_id, **baseline_env_kwargs(name, env_id))
-        plant = Plant.from_env(env)
-        env.close()
-        if cls.supports(plant) and ("currents" in cls.needs or "levitate" in cls.needs):
-            names.append(name)
+    names = [name for name, cls in BASELINES.items() if command_for(cls) is not None]
     return names + [n for n in shipped_names() if load_shipped(n).env_id == env_id]
 
 
 def _entry(spec: str, env_id: str) -> Entry:
     task = {v: k for k, v in TASKS.items()}[env_id]
-    if spec in BASELINES:
-        return Entry(spec, task, lambda plant: resolve(spec, plant)[0],
-                     baseline_env_kwargs(spec, env_id))
+    cls = controller_class(spec)
+    if cls is not None:
+        return Entry(cls.name, task, lambda plant: make_controller(cls, plant),
+                     controller_env_kwargs(cls, env_id))
     policy, trained_on = resolve(spec)
     if trained_on != env_id:
         raise ValueError(f"policy {spec!r} was trained on {trained_on}, not on {env_id}; "

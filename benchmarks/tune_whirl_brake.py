@@ -20,7 +20,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-from agents.benchmark import BASELINE_KWARGS, EVAL_KWARGS, TASKS, Entry, Scenario, episode_kwargs
+from agents.benchmark import EVAL_KWARGS, TASKS, Entry, Scenario, controller_env_kwargs, episode_kwargs
 from agents.controllers import WhirlBrake
 from agents.rollout import run_episodes
 from agents.search import cross_entropy
@@ -35,7 +35,7 @@ def cost(theta: np.ndarray, env_id: str) -> tuple[float, list[dict]]:
     gains = dict(zip(NAMES, map(float, theta)))
     task = next(t for t, e in TASKS.items() if e == env_id)
     entry = Entry(WhirlBrake.name, task, lambda p: WhirlBrake(p, **gains),
-                  BASELINE_KWARGS[WhirlBrake.name])
+                  controller_env_kwargs(WhirlBrake, env_id))
     kpis = [run_episodes(env_id, entry.make, [0], episode_kwargs(entry, Scenario("tune", mu), ph))[0].kpis
             for mu, ph in TUNING_SET]
     c = [k["peak_whirl_revolutions"] + 2.0 * k["backward_whirl"]

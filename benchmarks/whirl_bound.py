@@ -23,8 +23,8 @@ from pathlib import Path
 
 import numpy as np
 
-from agents.benchmark import TASKS, Entry, Scenario, baseline_env_kwargs, episode_kwargs
-from agents.controllers import make_baseline
+from agents.benchmark import TASKS, Entry, Scenario, controller_env_kwargs, episode_kwargs
+from agents.controllers import controller_class, make_controller
 from agents.plant import Plant, make_env
 from agents.search import cross_entropy
 from physics.metrics import WHIRL_MIN_REVOLUTIONS
@@ -34,7 +34,7 @@ class OpenLoopCorrection:
     """The baseline's currents plus ``theta[k]`` during segment k after the power returns."""
 
     def __init__(self, plant: Plant, baseline: str, steps: int):
-        self.plant, self.base, self.steps = plant, make_baseline(baseline, plant), steps
+        self.plant, self.base, self.steps = plant, make_controller(controller_class(baseline), plant), steps
         self.cols = [plant.action_names.index(n) for n in plant.action_names if n.startswith("current")]
         self.theta = np.zeros((0, len(self.cols)))
 
@@ -58,7 +58,7 @@ class OpenLoopCorrection:
 def bound(env_id: str, baseline: str, friction: float, phase: float, delay: float, segments: int,
           steps: int, iterations: int, population: int, std: float, seed: int) -> dict:
     task = {v: k for k, v in TASKS.items()}[env_id]
-    entry = Entry(baseline, task, None, baseline_env_kwargs(baseline, env_id))
+    entry = Entry(baseline, task, None, controller_env_kwargs(controller_class(baseline), env_id))
     kw = episode_kwargs(entry, Scenario("bound", friction, env_kwargs={"power_return_time": delay}), phase)
     env = make_env(env_id, **kw)
     try:

@@ -118,3 +118,46 @@ def test_ride_through_errors_name_the_option(tmp_path, capsys):
     assert "re-levitation environment" in capsys.readouterr().err
     assert main(["ride-through", "--policy", "ppo-damping", "--out", str(tmp_path)]) == 2
     assert "trained on RotorDrop-Damping-v0" in capsys.readouterr().err
+
+
+USER_CONTROLLER = '''
+import numpy as np
+from agents.controllers import Controller
+
+
+class MidDamping(Controller):
+    """Constant damping halfway between C_min and C_max."""
+    name = "mid-damping"
+    needs = ("damping",)
+
+    def commands(self, obs):
+        return {"damping": np.zeros((len(obs), 2))}
+
+
+class NotAController:
+    pass
+'''
+
+
+def test_a_users_controller_class_is_evaluated_and_benchmarked_like_a_baseline(tmp_path, capsys):
+    from agents.benchmark import _entries
+    from agents.controllers import load_controller
+    path = tmp_path / "my_controllers.py"
+    path.write_text(USER_CONTROLLER)
+    spec = f"{path}:MidDamping"
+    out = tmp_path / "ev"
+    assert main(["evaluate", "--policy", spec, "--env", "RotorDrop-Damping-v0", "--episodes", "1",
+                 "--fixed", "--no-plots", "--set", "contact.friction=0.1", "--out", str(out)]) == 0
+    r = json.loads((out / "kpis.json").read_text())
+    assert r["policy"] == "mid-damping"
+    # a damper between C_s = 5000 and C_max = 27 900 N s/m: first impact softer than passive
+    assert r["episodes"][0]["peak_contact_force_N"] < r["passive_episodes"][0]["peak_contact_force_N"]
+    tasks = {e.task for e in _entries([], [load_controller(spec)]) if e.name == "mid-damping"}
+    assert tasks == {"damping", "full"}                  # not in relevitate: it has no damper
+    for bad, words in ((f"{path}:NotAController", "not a subclass"),
+                       (f"{path}:Missing", "not a subclass"),
+                       ("no_such_module_xyz:Ctrl", "cannot import"),
+                       (f"{tmp_path}/absent.py:Ctrl", "no file")):
+        assert main(["evaluate", "--policy", bad, "--env", "RotorDrop-Damping-v0",
+                     "--out", str(tmp_path / "x")]) == 2
+        assert words in capsys.readouterr().err
