@@ -148,3 +148,53 @@ def _check_report(out, a):
                                   for r in a["reproduce"])
     assert all(r["command"] in text for r in a["reproduce"])
     assert math.isfinite(a["wall_time_s"])
+
+
+def test_parametric_sweep_sees_the_whirl_and_its_forces(tmp_path, capsys):
+    """At mu = 0.1 the rotor rests, at mu = 0.6 it whirls in every member with contact forces
+    far above resting (spec §7: about twice, here more at the peak)."""
+    out = tmp_path / "sw"
+    assert cli_main(["study", "sweep", "--vary", "contact.friction=0.1,0.6", "--members", "2",
+                     "--jobs", "1", "--quiet", "--out", str(out)]) == 0
+    r = json.loads((out / "sweep.json").read_text())
+    rest, whirl = r["cells"]
+    assert (rest["contact.friction"], whirl["contact.friction"]) == (0.1, 0.6)
+    assert rest["whirl_probability"] == 0.0 and whirl["whirl_probability"] == 1.0
+    assert whirl["peak_contact_force_N"]["min"] > 2.0 * rest["peak_contact_force_N"]["max"]
+    assert whirl["whirl_revolutions"]["min"] >= 3.0 > rest["whirl_revolutions"]["max"]
+    assert len(r["runs"]) == 4 and all(run["ok"] for run in r["runs"])
+    # members differ by the ensemble keys only, and each run says how to repeat it
+    angles = {run["overrides"]["unbalance.angle_deg"] for run in r["runs"]}
+    assert len(angles) == 2
+    assert all("--set contact.friction=" in run["command"] for run in r["runs"])
+    assert len((out / "sweep.csv").read_text().splitlines()) == 3
+    assert (out / "sweep.png").is_file()
+    assert "| 0.6 | 1.00 |" in capsys.readouterr().out
+
+
+def test_parametric_sweep_grid_values_and_errors():
+    from physics.scene import SceneError
+    from physics.study.parametric import make_axes, parse_vary, plan_runs
+    assert parse_vary("contact.friction=0.3:0.5:0.1") == ("contact.friction", ["0.3", "0.4", "0.5"])
+    axes = make_axes("paper", {}, ["support.damping=2790,1e5", "effects.friction=paper,kinematic"])
+    assert axes[0].values == (2790.0, 1e5) and axes[1].values == ("paper", "kinematic")
+    assert len(plan_runs("paper", {}, axes, 3, 0)) == 2 * 2 * 3
+    for bad, words in ((["contact.friction=0.2,1.5"], "contact.friction"),       # out of range
+                       (["contact.nope=1"], "unknown parameter key"),
+                       (["contact.friction=0.5:0.1:0.1"], "LO <= HI"),
+                       (["a.b=1", "c.d=2", "e.f=3"], "1 or 2 keys")):
+        with pytest.raises(SceneError, match=words):
+            make_axes("paper", {}, bad)
+    with pytest.raises(SceneError, match="both varied"):
+        make_axes("paper", {"contact.friction": 0.2}, ["contact.friction=0.3"])
+
+
+def test_parametric_sweep_reports_failed_drops(tmp_path):
+    """A step budget too small to finish: every drop fails, and the cells say so."""
+    out = tmp_path / "sw"
+    assert cli_main(["study", "sweep", "--vary", "contact.friction=0.2", "--members", "2",
+                     "--set", "solver.max_steps=100", "--jobs", "1", "--quiet", "--no-plots",
+                     "--out", str(out)]) == 0
+    cell, = json.loads((out / "sweep.json").read_text())["cells"]
+    assert cell["failed"] == 2 and cell["whirl_probability"] is None
+    assert "solver.max_steps" in cell["errors"][0]

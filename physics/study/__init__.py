@@ -2,7 +2,9 @@
 
 ``rotordrop study paper [--quick] [--jobs N] [--scene S] [--set K=V] --out DIR`` runs the three
 studies of Kärkkäinen, Sopanen & Mikkola §V (friction, support stiffness, support damping), the
-claims table and the sensitivity to every assumed parameter. Registration is light: the heavy
+claims table and the sensitivity to every assumed parameter. ``rotordrop study sweep --vary
+KEY=VALUES [--vary KEY=VALUES] [--members N]`` is a parameter study of the passive drop over one
+or two scene keys (:mod:`physics.study.parametric`). Registration is light: the heavy
 modules are imported by the handler.
 """
 from __future__ import annotations
@@ -21,6 +23,21 @@ def register(subparsers) -> None:
     q.add_argument("--quiet", action="store_true", help="no progress bar")
     q.set_defaults(func=cmd_study_paper)
 
+    q = sub.add_parser("sweep", help="a parameter study of the passive drop over 1 or 2 scene keys, "
+                                     "an ensemble of drops per cell")
+    add_scene_args(q)
+    q.add_argument("--vary", action="append", default=[], metavar="KEY=VALUES", required=True,
+                   help="a scene key and its values: KEY=V1,V2,... or KEY=LO:HI:STEP (1 or 2 times), "
+                        "e.g. --vary support.damping=2790,27900,1e5 --vary contact.friction=0.3:0.6:0.05")
+    q.add_argument("--members", type=int, default=8,
+                   help="drops per cell, unbalance angle and fault time perturbed (default 8)")
+    q.add_argument("--seed", type=int, default=0, help="seed of the ensemble perturbations")
+    q.add_argument("--out", default="out/sweep", help="output directory")
+    q.add_argument("--jobs", type=int, default=None, help="worker processes (default: all cores)")
+    q.add_argument("--no-plots", action="store_true")
+    q.add_argument("--quiet", action="store_true", help="no progress bar")
+    q.set_defaults(func=cmd_study_sweep)
+
 
 def cmd_study_paper(args) -> int:
     from ..cli import overrides_from_args
@@ -28,4 +45,22 @@ def cmd_study_paper(args) -> int:
     summary = run_paper_study(args.scene, overrides_from_args(args), args.out, quick=args.quick,
                               jobs=args.jobs, progress=not args.quiet)
     print(summary)
+    return 0
+
+
+def cmd_study_sweep(args) -> int:
+    from ..cli import overrides_from_args
+    from .parametric import ENSEMBLE_KEYS, run_parametric, summary_table
+    report = run_parametric(args.scene, overrides_from_args(args), args.vary, args.out,
+                            members=args.members, seed=args.seed, jobs=args.jobs,
+                            progress=not args.quiet, plots=not args.no_plots)
+    print(summary_table(report))
+    if report["members"] < args.members:
+        print(f"note: --set/--vary fix {' and '.join(ENSEMBLE_KEYS)}, the keys that make the "
+              f"ensemble, so each cell is {report['members']} drop, not {args.members}")
+    if report["failed"]:
+        print(f"{report['failed']} drops failed; their errors are in the table's cells and in "
+              f"sweep.json (runs[].error)")
+    print("wrote " + ", ".join(f"{args.out}/{f}" for f in report["files"])
+          + f" in {report['wall_time_s']:.0f} s")
     return 0

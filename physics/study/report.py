@@ -285,3 +285,65 @@ def write_report(a: dict, out: Path, figures: dict[str, list[str]], meta: dict) 
     path = out / "report.md"
     path.write_text("\n".join(L) + "\n")
     return path
+
+
+def plot_parametric(report: dict, axes, out: Path) -> str:
+    """``rotordrop study sweep``: whirl probability, peak contact force and maximum displacement
+    over the varied keys (1 key: curves with the members' range; 2 keys: annotated maps)."""
+    cells = report["cells"]
+    panels = [("whirl_probability", "whirl probability"),
+              ("peak_contact_force_N", "peak contact force [N]"),
+              ("max_displacement_um", "max displacement [µm]")]
+
+    def value(c, key, stat="median"):
+        v = c[key]
+        return np.nan if v is None else (v if key == "whirl_probability" else v[stat])
+
+    def ticks(axis):
+        return (np.asarray(axis.values, float), None) if axis.numeric else (
+            np.arange(len(axis.values)), [str(v) for v in axis.values])
+
+    title = f"{report['scene']}: {report['members']} drops per cell"
+    if len(axes) == 1:
+        a = axes[0]
+        x, labels = ticks(a)
+        fig, axs = plt.subplots(1, 3, figsize=(13, 3.8), constrained_layout=True)
+        for ax, (key, label) in zip(axs, panels):
+            ax.plot(x, [value(c, key) for c in cells], "o-", ms=4)
+            if key != "whirl_probability":
+                ax.fill_between(x, [value(c, key, "min") for c in cells],
+                                [value(c, key, "max") for c in cells], alpha=0.25, label="members' range")
+                ax.legend(fontsize=7)
+            ax.set_xlabel(a.key)
+            ax.set_ylabel(label + ("" if key == "whirl_probability" else " (median)"))
+            if labels:
+                ax.set_xticks(x, labels)
+            elif a.numeric and min(x) > 0 and max(x) / min(x) > 50:
+                ax.set_xscale("log")
+            ax.grid(alpha=0.3)
+        fig.suptitle(title, fontsize=10)
+    else:
+        (a, b), n_b = axes, len(axes[1].values)
+        fig, axs = plt.subplots(3, 1, figsize=(max(6.0, 3.0 + 0.9 * len(a.values)),
+                                               3 * (1.4 + 0.35 * n_b)), constrained_layout=True)
+        for ax, (key, label) in zip(axs, panels):
+            M = np.array([value(c, key) for c in cells], float).reshape(len(a.values), n_b).T
+            im = ax.imshow(M, origin="lower", aspect="auto", cmap="Reds",
+                           vmin=0.0 if key == "whirl_probability" else None,
+                           vmax=1.0 if key == "whirl_probability" else None)
+            vmax = np.nanmax(M) if np.isfinite(M).any() else 1.0
+            for j in range(M.shape[0]):
+                for i in range(M.shape[1]):
+                    ax.text(i, j, "-" if np.isnan(M[j, i]) else f"{M[j, i]:.2f}" if
+                            key == "whirl_probability" else f"{M[j, i]:.0f}", ha="center",
+                            va="center", fontsize=6, color="white" if M[j, i] > 0.6 * vmax else "black")
+            ax.set_xticks(range(len(a.values)), [f"{v:g}" if isinstance(v, float) else str(v)
+                                                 for v in a.values], rotation=45, fontsize=7)
+            ax.set_yticks(range(n_b), [f"{v:g}" if isinstance(v, float) else str(v) for v in b.values],
+                          fontsize=7)
+            ax.set_xlabel(a.key)
+            ax.set_ylabel(b.key)
+            ax.set_title(label + ("" if key == "whirl_probability" else ", median"), fontsize=9)
+            fig.colorbar(im, ax=ax, fraction=0.05)
+        fig.suptitle(title, fontsize=10)
+    return _save(fig, out / "sweep.png")

@@ -1,0 +1,179 @@
+"""``rotordrop study sweep``: a parameter study of the passive drop over one or two scene keys.
+
+For retainer-bearing design: how do whirl, contact force and displacement change with, say,
+the support damping and the friction coefficient? Every grid cell is an ensemble of
+``members`` equally plausible drops (unbalance angle and fault time perturbed as in the paper
+study, :mod:`physics.study.ensemble`), because near the whirl threshold one drop per cell is a
+coin toss. Per cell: whirl probability, whirl revolutions, peak contact force and maximum
+displacement (worst retainer plane; median and range over the members), and the runs that
+failed, with their errors (never dropped). Every run can be repeated with the ``rotordrop drop``
+command stored next to it.
+
+Values: ``KEY=V1,V2,...`` (numbers or choices, e.g. ``effects.friction=paper,kinematic``) or
+``KEY=LO:HI:STEP`` (inclusive numeric range).
+"""
+from __future__ import annotations
+
+import csv
+import json
+import math
+import time
+from dataclasses import dataclass
+from itertools import product
+from pathlib import Path
+
+import numpy as np
+
+from ..metrics import worst_plane
+from ..scene import SceneError, load_scene
+from ..sweep import Outcome, Run, default_jobs, run_sweep
+from .ensemble import perturbations
+
+ENSEMBLE_KEYS = ("unbalance.angle_deg", "amb.off_time")
+MAX_KEYS = 2
+MAX_RUNS = 20000
+PLANE_KPIS = {"whirl_revolutions": "whirl revolutions", "peak_contact_force_N": "peak contact force [N]",
+              "max_displacement_um": "max displacement [µm]"}
+
+
+@dataclass(frozen=True)
+class Axis:
+    key: str
+    values: tuple           # as typed by the scene (floats, ints, strings)
+
+    @property
+    def numeric(self) -> bool:
+        return all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in self.values)
+
+
+def parse_vary(text: str) -> tuple[str, list[str]]:
+    """``"contact.friction=0.3:0.5:0.05"`` or ``"support.damping=2790,27900"`` -> key, raw values."""
+    if "=" not in text:
+        raise SceneError(f"--vary expects KEY=V1,V2,... or KEY=LO:HI:STEP, got {text!r}")
+    key, spec = (s.strip() for s in text.split("=", 1))
+    if ":" in spec:
+        parts = spec.split(":")
+        try:
+            lo, hi, step = (float(p) for p in parts)
+        except ValueError:
+            raise SceneError(f"--vary {key}: LO:HI:STEP needs three numbers, got {spec!r}") from None
+        if not (math.isfinite(lo) and math.isfinite(hi) and step > 0 and hi >= lo):
+            raise SceneError(f"--vary {key}: LO:HI:STEP needs finite LO <= HI and STEP > 0, got {spec!r}")
+        n = int(math.floor((hi - lo) / step + 1e-9)) + 1
+        if n > 1000:
+            raise SceneError(f"--vary {key}: {n} values; at most 1000 per key")
+        return key, [repr(round(lo + i * step, 12)) for i in range(n)]
+    values = [v.strip() for v in spec.split(",") if v.strip()]
+    if not values:
+        raise SceneError(f"--vary {key}: no values in {spec!r}")
+    return key, values
+
+
+def make_axes(source: str, overrides: dict, vary: list[str]) -> list[Axis]:
+    """Validated axes: every value is coerced and range-checked by the scene now, before any
+    run starts (a bad value names the key and its allowed range)."""
+    if not 1 <= len(vary) <= MAX_KEYS:
+        raise SceneError(f"study sweep varies 1 or {MAX_KEYS} keys (--vary), got {len(vary)}")
+    axes = []
+    for text in vary:
+        key, raw = parse_vary(text)
+        if key in overrides:
+            raise SceneError(f"{key} is both varied (--vary) and fixed (--set); keep one")
+        if any(a.key == key for a in axes):
+            raise SceneError(f"--vary {key} is given twice")
+        values = tuple(dict.fromkeys(load_scene(source, {**overrides, key: v}).get(key) for v in raw))
+        axes.append(Axis(key, values))
+    return axes
+
+
+def plan_runs(source: str, overrides: dict, axes: list[Axis], members: int, seed: int) -> list[Run]:
+    """Cells (the product of the axes) × ensemble members, as :class:`~physics.sweep.Run`."""
+    if members < 1:
+        raise SceneError(f"--members must be >= 1, got {members}")
+    fixed = set(overrides) | {a.key for a in axes}
+    base = load_scene(source, overrides)
+    pert = [{k: v for k, v in p.items() if k not in fixed}
+            for p in perturbations(members, base.get("amb.off_time"), seed)]
+    if all(not p for p in pert):
+        pert = [{}]                   # the user fixed every ensemble key: one drop per cell
+    n = len(pert) * math.prod(len(a.values) for a in axes)
+    if n > MAX_RUNS:
+        raise SceneError(f"study sweep would simulate {n} drops; at most {MAX_RUNS} "
+                         f"(fewer values or --members)")
+    runs = []
+    for cell in product(*(a.values for a in axes)):
+        point = dict(zip((a.key for a in axes), cell))
+        for m, p in enumerate(pert):
+            runs.append(Run.of(source, {**overrides, **point, **p}, member=m, **point))
+    return runs
+
+
+def summarize_cell(outcomes: list[Outcome]) -> dict:
+    """Whirl probability and the median / min / max of each plane KPI over the members that ran."""
+    ok = [o for o in outcomes if o.ok]
+    out = dict(members=len(outcomes), failed=len(outcomes) - len(ok),
+               errors=sorted({o.error.splitlines()[0] for o in outcomes if not o.ok}),
+               whirl_probability=float(np.mean([o.metrics["backward_whirl"] for o in ok])) if ok else None)
+    for key in PLANE_KPIS:
+        vals = np.array([worst_plane(o.metrics, key) for o in ok])
+        out[key] = dict(median=float(np.median(vals)), min=float(vals.min()),
+                        max=float(vals.max())) if ok else None
+    return out
+
+
+def run_parametric(source: str, overrides: dict, vary: list[str], out_dir, members: int = 8,
+                   seed: int = 0, jobs: int | None = None, progress: bool = True,
+                   plots: bool = True) -> dict:
+    """Plan, simulate and summarise the sweep; write ``sweep.json``, ``sweep.csv``, ``sweep.png``."""
+    axes = make_axes(source, overrides, vary)
+    runs = plan_runs(source, overrides, axes, members, seed)
+    t0 = time.perf_counter()
+    outcomes = run_sweep(runs, jobs=jobs, desc="study sweep", progress=progress)
+    per_cell = len(runs) // math.prod(len(a.values) for a in axes)
+    cells = []
+    for i, cell in enumerate(product(*(a.values for a in axes))):
+        chunk = outcomes[i * per_cell:(i + 1) * per_cell]
+        cells.append(dict(zip((a.key for a in axes), cell), **summarize_cell(chunk)))
+    report = dict(scene=source, overrides=overrides, axes={a.key: list(a.values) for a in axes},
+                  members=per_cell, seed=seed, ensemble_keys=[k for k in ENSEMBLE_KEYS
+                                                              if k in runs[0].settings],
+                  cells=cells, runs=[o.to_dict() for o in outcomes],
+                  failed=sum(not o.ok for o in outcomes), jobs=jobs or default_jobs(),
+                  wall_time_s=time.perf_counter() - t0)
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "sweep.json").write_text(json.dumps(report, indent=1))
+    write_csv(report, out / "sweep.csv")
+    report["files"] = ["sweep.json", "sweep.csv"]
+    if plots:
+        from .report import plot_parametric
+        report["files"].append(plot_parametric(report, axes, out))
+    return report
+
+
+def write_csv(report: dict, path: Path) -> None:
+    keys = list(report["axes"])
+    fields = keys + ["members", "failed", "whirl_probability"] + [
+        f"{k}_{s}" for k in PLANE_KPIS for s in ("median", "min", "max")]
+    with open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(fields)
+        for c in report["cells"]:
+            w.writerow([c[k] for k in keys] + [c["members"], c["failed"], c["whirl_probability"]]
+                       + [None if c[k] is None else c[k][s] for k in PLANE_KPIS
+                          for s in ("median", "min", "max")])
+
+
+def summary_table(report: dict) -> str:
+    """Markdown: one row per cell."""
+    keys = list(report["axes"])
+    head = ("| " + " | ".join(keys) + " | whirl prob. | peak force median (max) [N] | "
+            "max disp. median (max) [µm] | failed |\n|" + "---|" * (len(keys) + 4) + "\n")
+    rows = []
+    for c in report["cells"]:
+        f, d = c["peak_contact_force_N"], c["max_displacement_um"]
+        rows.append("| " + " | ".join(f"{c[k]:g}" if isinstance(c[k], float) else str(c[k]) for k in keys)
+                    + (f" | {c['whirl_probability']:.2f} | {f['median']:.0f} ({f['max']:.0f}) | "
+                       f"{d['median']:.0f} ({d['max']:.0f})" if f else " | - | - | -")
+                    + f" | {c['failed']} |")
+    return head + "\n".join(rows) + "\n"
