@@ -9,6 +9,10 @@ override the baseline entirely. The search knows the scenario in advance, which 
 does: its peak revolutions are an empirical lower bound for what feedback control can reach
 there. Cost: the peak net backward orbit revolutions of the episode (3 make a whirl).
 
+As a cross-check that needs no search, the script also runs the baseline with its law in the
+outer half of the clearance replaced by a saturated push (full current) at a fixed angle to the
+orbit radius (0° outwards, 90° along a forward orbit, 180° to the centre), for 12 angles.
+
     python benchmarks/whirl_bound.py --friction 0.48 --friction 0.53 --out out/whirl_bound
 
 prints the baseline's and the best sequence's peak revolutions per scenario and writes
@@ -55,6 +59,32 @@ class OpenLoopCorrection:
                 return {k[4:]: v for k, v in info.items() if k.startswith("kpi_")}
 
 
+def push_sweep(env, plant: Plant, baseline: str, angles=range(0, 360, 30)) -> dict:
+    """Peak revolutions per push angle [deg] (see the module doc)."""
+    from agents.controllers import _rot90
+    base = make_controller(controller_class(baseline), plant)
+    cols = [plant.action_names.index(n) for n in plant.action_names if n.startswith("current")]
+    out = {}
+    for phi in angles:
+        c, s = np.cos(np.radians(phi)), np.sin(np.radians(phi))
+        obs, _ = env.reset(seed=0)
+        start = np.ones(1, dtype=bool)
+        while True:
+            a, _ = base.predict(obs[None, :], episode_start=start)
+            a, start = a[0].copy(), np.zeros(1, dtype=bool)
+            pos = plant.positions(obs[None, :]) / plant.clearance
+            r = np.repeat(np.hypot(pos[:, 0::2], pos[:, 1::2]), 2, axis=1)
+            unit = pos / np.maximum(r, 1e-9)
+            push = c * unit + s * plant.spin_sign(obs[None, :])[:, None] * _rot90(unit)
+            outer = (r > 0.5)[0] & plant.power_available(obs[None, :])[0]
+            a[cols] = np.where(outer, np.clip(push[0], -1.0, 1.0), a[cols])
+            obs, _, terminated, truncated, info = env.step(a)
+            if terminated or truncated:
+                break
+        out[int(phi)] = float(info["kpi_peak_whirl_revolutions"])
+    return out
+
+
 def bound(env_id: str, baseline: str, friction: float, phase: float, delay: float, segments: int,
           steps: int, iterations: int, population: int, std: float, seed: int) -> dict:
     task = {v: k for k, v in TASKS.items()}[env_id]
@@ -71,6 +101,7 @@ def bound(env_id: str, baseline: str, friction: float, phase: float, delay: floa
             max(2, population // 5), np.random.default_rng(seed), min_std=0.05,
             desc=f"mu={friction:g} phase={phase:g}")
         best_kpis = probe.run(env, theta)
+        pushes = push_sweep(env, probe.plant, baseline)
     finally:
         env.close()
     return dict(friction=friction, phase_deg=phase, power_return_s=delay,
@@ -78,7 +109,9 @@ def bound(env_id: str, baseline: str, friction: float, phase: float, delay: floa
                 best_peak_revolutions=best_kpis["peak_whirl_revolutions"],
                 best_backward_whirl=bool(best_kpis["backward_whirl"]),
                 best_peak_contact_force_N=best_kpis["peak_contact_force_N"],
-                history=[h["best_cost"] for h in history], correction=theta.tolist())
+                best_push_deg=min(pushes, key=pushes.get), best_push_revolutions=min(pushes.values()),
+                push_revolutions=pushes, history=[h["best_cost"] for h in history],
+                correction=theta.tolist())
 
 
 def main(argv=None):
@@ -109,10 +142,12 @@ def main(argv=None):
     (out / "whirl_bound.json").write_text(json.dumps(rec, indent=2))
     print(f"{a.env}, power back at {a.delay_ms:g} ms, open-loop correction of {a.baseline} over "
           f"{a.segments * a.steps} control steps ({a.iterations} x {a.population} episodes per scenario)")
-    print(f"{'mu':>6}{'phase':>7}  {a.baseline + ' revs':>22}{'best revs':>11}{'whirl':>7}")
+    print(f"{'mu':>6}{'phase':>7}  {a.baseline + ' revs':>22}{'best revs':>11}{'whirl':>7}"
+          f"{'best push':>17}")
     for r in rows:
         print(f"{r['friction']:6.2f}{r['phase_deg']:7.0f}  {r['baseline_peak_revolutions']:22.2f}"
-              f"{r['best_peak_revolutions']:11.2f}{r['best_backward_whirl']!s:>7}")
+              f"{r['best_peak_revolutions']:11.2f}{r['best_backward_whirl']!s:>7}"
+              f"{r['best_push_revolutions']:8.2f} at {r['best_push_deg']:3d}°")
     print(f"wrote {out / 'whirl_bound.json'} in {rec['wall_time_s']:.0f} s")
 
 
