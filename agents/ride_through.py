@@ -56,13 +56,14 @@ def _entry(spec: str, env_id: str) -> Entry:
     return Entry(policy.name, task, policy.bound, dict(policy.env_kwargs))
 
 
-def _check_grid(name: str, values, lo: float, hi: float) -> tuple[float, ...]:
+def _check_grid(name: str, values, lo: float, hi: float, shown: float = 1.0) -> tuple[float, ...]:
+    """Sorted unique grid values, each in [lo, hi]; errors show values × ``shown`` (the CLI's unit)."""
     values = tuple(float(v) for v in values)
     if not values:
         raise ValueError(f"{name} needs at least one value")
-    bad = [v for v in values if not (np.isfinite(v) and lo <= v <= hi)]
+    bad = [round(v * shown, 9) for v in values if not (np.isfinite(v) and lo <= v <= hi)]
     if bad:
-        raise ValueError(f"{name} values {bad} are outside [{lo:g}, {hi:g}]")
+        raise ValueError(f"{name} values {bad} are outside [{lo * shown:g}, {hi * shown:g}]")
     return tuple(sorted(set(values)))
 
 
@@ -88,7 +89,7 @@ def ride_through(out: str | Path, env_id: str = "RotorDrop-Relevitate-v0",
         raise ValueError(f"--env must be a re-levitation environment ({', '.join(RELEVITATION_ENVS)}), "
                          f"got {env_id!r}")
     frictions = _check_grid("--friction", frictions, 0.0, 2.0)
-    delays = _check_grid("--delay", delays, 0.0, 10.0)
+    delays = _check_grid("--delay-ms", delays, 0.0, 10.0, shown=1e3)
     phases = _check_grid("--phase", phases, -360.0, 360.0)
     entries = [_entry(p, env_id) for p in (policies or controllers_for(env_id))]
     task = {v: k for k, v in TASKS.items()}[env_id]

@@ -114,6 +114,8 @@ def test_ride_through_early_power_stops_the_whirl_late_power_does_not(tmp_path):
 def test_ride_through_errors_name_the_option(tmp_path, capsys):
     assert main(["ride-through", "--friction", "-0.1", "--out", str(tmp_path)]) == 2
     assert "--friction" in capsys.readouterr().err
+    assert main(["ride-through", "--delay-ms", "-5", "--out", str(tmp_path)]) == 2
+    assert "--delay-ms values [-5.0]" in capsys.readouterr().err        # in the unit typed
     assert main(["ride-through", "--env", "RotorDrop-Damping-v0", "--out", str(tmp_path)]) == 2
     assert "re-levitation environment" in capsys.readouterr().err
     assert main(["ride-through", "--policy", "ppo-damping", "--out", str(tmp_path)]) == 2
