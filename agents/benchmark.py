@@ -94,7 +94,10 @@ def passive_threshold(phases=PHASES, grid=THRESHOLD_GRID, progress=None) -> dict
                      "phases at every grid point")
 
 
-def scenario_suite(threshold: float | None, quick: bool = False) -> list[Scenario]:
+def scenario_suite(threshold: float | None, quick: bool = False,
+                   power_return: float | None = None) -> list[Scenario]:
+    """The suite (module doc); ``power_return`` [s] replaces the environments' default power
+    return (50 ms) in every re-levitation scenario that does not set its own."""
     ref = threshold if threshold is not None else THRESHOLD_GRID[-1]
     whirl = [round(ref + m, 2) for m in WHIRL_MARGINS]
     mu = round(ref + WHIRL_MARGINS[0], 2)
@@ -110,6 +113,9 @@ def scenario_suite(threshold: float | None, quick: bool = False) -> list[Scenari
               Scenario("kinematic friction", mu, {"effects.friction": "kinematic"}),
               Scenario("power back at 0.15 s", mu, env_kwargs={"power_return_time": 0.15},
                        tasks=relev)]
+    if power_return is not None:
+        suite = [Scenario(s.name, s.friction, s.overrides, s.group,
+                          {"power_return_time": power_return, **s.env_kwargs}, s.tasks) for s in suite]
     suite = [Scenario(s.name, s.friction, s.overrides, _group(s), s.env_kwargs, s.tasks) for s in suite]
     if quick:
         keep = (0, 2, 3, 5, 9)
@@ -183,8 +189,11 @@ def episode_kwargs(entry: Entry, scenario: Scenario, phase: float) -> dict:
 
 def benchmark(out: str | Path, quick: bool = False, policies: list[str] | None = None,
               max_scenarios: int | None = None, episodes: int | None = None,
-              progress: bool = True, plots: bool = True) -> dict:
-    """Run the suite and write benchmark.json, leaderboard.md and the plots into ``out``."""
+              progress: bool = True, plots: bool = True, power_return: float | None = None) -> dict:
+    """Run the suite and write benchmark.json, leaderboard.md and the plots into ``out``;
+    ``power_return`` [s]: see :func:`scenario_suite`."""
+    if power_return is not None and not 0.0 <= power_return <= 10.0:
+        raise ValueError(f"--power-return-ms = {1e3 * power_return:g} must be in [0, 10000]")
     from tqdm.auto import tqdm
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -212,7 +221,7 @@ def benchmark(out: str | Path, quick: bool = False, policies: list[str] | None =
                disable=not progress)
     sweep = passive_threshold(sweep_phases, THRESHOLD_GRID, bar)
     bar.close()
-    scenarios = scenario_suite(sweep["threshold"], quick)
+    scenarios = scenario_suite(sweep["threshold"], quick, power_return)
     if max_scenarios is not None:
         scenarios = scenarios[:max(1, max_scenarios)]
 
@@ -223,7 +232,9 @@ def benchmark(out: str | Path, quick: bool = False, policies: list[str] | None =
         rows += suite_rows(entry, scenarios, phases, bar)
     bar.close()
     board = leaderboard(rows, scenarios, sweep["threshold"])
+    from rotordrop_env.env import DEFAULT_POWER_RETURN
     report = dict(quick=quick, episode_time_s=EPISODE_TIME, phases_deg=list(phases),
+                  power_return_s=DEFAULT_POWER_RETURN if power_return is None else power_return,
                   threshold_sweep=sweep, passive_threshold=sweep["threshold"],
                   scenarios=[dict(name=s.name, friction=s.friction, overrides=s.overrides,
                                   group=s.group, env_kwargs=s.env_kwargs, tasks=list(s.tasks))
@@ -349,7 +360,9 @@ def leaderboard_markdown(report: dict) -> str:
     thr = report["passive_threshold"]
     lines = [f"# rotordrop benchmark{' (quick)' if report['quick'] else ''}", "",
              f"Passive whirl threshold mu* = {fmt_or_dash(thr, 'g')} (paper scene, {len(report['phases_deg'])} "
-             f"unbalance phases, {report['episode_time_s']:g} s after the fault). "
+             f"unbalance phases, {report['episode_time_s']:g} s after the fault; re-levitation "
+             f"tasks: power back {1e3 * report['power_return_s']:g} ms after the fault unless "
+             f"the scenario says otherwise). "
              f"Score: 100 (1 - sum J / sum J_passive), see docs/agents.md.", ""]
     for task in dict.fromkeys(e["task"] for e in report["leaderboard"]):
         lines += [f"## {task}", "",

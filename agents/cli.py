@@ -59,7 +59,8 @@ def cmd_benchmark(args) -> int:
     from .benchmark import benchmark
     try:
         benchmark(args.out, quick=args.quick, policies=args.policy, max_scenarios=args.scenarios,
-                  episodes=args.episodes, progress=not args.quiet, plots=not args.no_plots)
+                  episodes=args.episodes, progress=not args.quiet, plots=not args.no_plots,
+                  power_return=None if args.power_return_ms is None else 1e-3 * args.power_return_ms)
     except (KeyError, ValueError, FileNotFoundError) as exc:
         print(f"rotordrop benchmark: error: {exc.args[0] if exc.args else exc}", file=sys.stderr)
         return 2
@@ -132,6 +133,9 @@ def register(sub) -> None:
                    help="extra policies or controllers to include (repeatable): a training "
                         "directory or model .zip, or your own controller class as "
                         "package.module:Class or file.py:Class (see docs/agents.md)")
+    p.add_argument("--power-return-ms", type=float, default=None,
+                   help="power-return delay of the re-levitation tasks [ms] (default: the "
+                        "environments' 50 ms; the 'power back at 0.15 s' scenario keeps its own)")
     p.add_argument("--out", default="out/benchmark", help="output directory")
     p.add_argument("--no-plots", action="store_true")
     p.add_argument("--quiet", action="store_true", help="no progress bar")

@@ -163,3 +163,12 @@ def test_a_users_controller_class_is_evaluated_and_benchmarked_like_a_baseline(t
         assert main(["evaluate", "--policy", bad, "--env", "RotorDrop-Damping-v0",
                      "--out", str(tmp_path / "x")]) == 2
         assert words in capsys.readouterr().err
+
+
+def test_benchmark_power_return_applies_to_every_scenario_without_its_own():
+    from agents.benchmark import scenario_suite
+    suite = scenario_suite(0.38, power_return=0.04)
+    late = [s for s in suite if s.name == "power back at 0.15 s"]
+    assert late and late[0].env_kwargs == {"power_return_time": 0.15}
+    assert all(s.env_kwargs == {"power_return_time": 0.04} for s in suite if s not in late)
+    assert all(s.env_kwargs == {} for s in scenario_suite(0.38) if s.name != late[0].name)
