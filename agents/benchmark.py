@@ -50,6 +50,15 @@ TASKS = {"damping": "RotorDrop-Damping-v0", "relevitate": "RotorDrop-Relevitate-
 RELEVITATION_ENVS = (TASKS["relevitate"], TASKS["full"])
 
 
+def task_of(env_id: str) -> str:
+    """The benchmark task (key of ``TASKS``) of an environment id."""
+    for task, task_env in TASKS.items():
+        if task_env == env_id:
+            return task
+    raise ValueError(f"{env_id!r} is not the environment of a benchmark task "
+                     f"({', '.join(TASKS.values())})")
+
+
 def controller_env_kwargs(cls, env_id: str) -> dict:
     """The env kwargs a controller class needs in ``env_id``: the re-levitation command of its
     channels (``controllers.command_for``) in the re-levitation environments, else nothing
@@ -63,7 +72,7 @@ class Scenario:
     name: str
     friction: float
     overrides: dict = field(default_factory=dict)
-    group: str = "in-distribution"
+    group: str = "in-distribution"                      # in the re-levitation tasks (_group)
     env_kwargs: dict = field(default_factory=dict)      # relevitation envs only
     tasks: tuple[str, ...] = tuple(TASKS)
 
@@ -123,11 +132,14 @@ def scenario_suite(threshold: float | None, quick: bool = False,
     return suite
 
 
-def _group(sc: Scenario) -> str:
+def _group(sc: Scenario, task: str | None = None) -> str:
     """``in-distribution`` when every value lies inside the environments' default
-    randomisation ranges (what the shipped policies were trained on), else out of it."""
+    randomisation ranges (what the shipped policies were trained on), else out of it. The
+    scenario's env kwargs (power return) do not count in the ``damping`` task, which does not
+    use them (:func:`episode_kwargs`)."""
     from rotordrop_env.scenario import DEFAULT_RANGES
-    values = {"contact.friction": sc.friction, **sc.overrides, **sc.env_kwargs}
+    values = {"contact.friction": sc.friction, **sc.overrides,
+              **(sc.env_kwargs if task != "damping" else {})}
     for key, v in values.items():
         if key in DEFAULT_RANGES:
             _, lo, hi = DEFAULT_RANGES[key]
@@ -164,6 +176,17 @@ def _entries(policies: list[LearnedPolicy], controllers=()) -> list[Entry]:
         for p in task_policies:
             out.append(Entry(p.name, task, p.bound, dict(p.env_kwargs)))
     return out
+
+
+def check_unique_names(entries: list[Entry]) -> list[Entry]:
+    """``entries``, after checking that no two of a task share a name (the reports key the
+    controllers by name)."""
+    keys = [(e.task, e.name) for e in entries]
+    twice = sorted({name for task, name in keys if keys.count((task, name)) > 1})
+    if twice:
+        raise ValueError(f"--policy: two controllers are named {', '.join(twice)}; give each "
+                         f"its own name")
+    return entries
 
 
 def monitor_kwargs(kw: dict) -> dict:
@@ -203,7 +226,7 @@ def benchmark(out: str | Path, quick: bool = False, policies: list[str] | None =
         phases = PHASES[:max(1, min(episodes, len(PHASES)))]
     loaded = [load_shipped(n) for n in shipped_names()]
     custom = []
-    for spec in policies or []:
+    for spec in dict.fromkeys(policies or []):
         if spec in shipped_names() or spec in BASELINES:
             continue                                   # already in
         cls = controller_class(spec)
@@ -214,7 +237,7 @@ def benchmark(out: str | Path, quick: bool = False, policies: list[str] | None =
         if any(pol.name == p.name for p in loaded):     # e.g. a new run of a shipped policy
             pol.name = f"{pol.name}@{Path(spec).name}"
         loaded.append(pol)
-    entries = _entries(loaded, custom)
+    entries = check_unique_names(_entries(loaded, custom))
 
     sweep_phases = PHASES if episodes is None else phases     # --quick: the full threshold sweep
     bar = tqdm(total=len(THRESHOLD_GRID) * len(sweep_phases), desc="passive threshold", unit="ep",
@@ -295,7 +318,7 @@ def _row(entry: Entry, sc: Scenario, eps) -> dict:
     s = summarize(eps)
     k = [e.kpis for e in eps]
     return dict(controller=entry.name, task=entry.task, env_id=TASKS[entry.task], scenario=sc.name,
-                group=sc.group, friction=sc.friction,
+                group=_group(sc, entry.task), friction=sc.friction,
                 backward_whirl=s["backward_whirl_rate"],
                 whirl_revolutions=float(np.mean([d["whirl_revolutions"] for d in k])),
                 peak_whirl_revolutions=float(np.mean([d["peak_whirl_revolutions"] for d in k])),

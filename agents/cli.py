@@ -114,7 +114,8 @@ def register(sub) -> None:
                         "policy name (e.g. ppo-damping), path to a training directory / model zip, "
                         "or your own controller class as package.module:Class or file.py:Class")
     p.add_argument("--env", default=None, help="environment id (default: the one the policy was "
-                                               "trained on; required for baselines)")
+                                               "trained on; required for controller classes and "
+                                               "baselines)")
     p.add_argument("--episodes", type=int, default=10)
     p.add_argument("--seed", type=int, default=0, help="episode i uses seed + i")
     p.add_argument("--scene", default=None, help="scene preset or TOML (default: the env's)")

@@ -289,30 +289,45 @@ def is_controller_spec(spec: str) -> bool:
 
 
 def load_controller(spec: str) -> type[Controller]:
-    """A user's controller class from ``package.module:Class`` or ``path/to/file.py:Class``.
+    """A user's controller class from ``package.module:Class`` (importable, or in the current
+    directory) or ``path/to/file.py:Class``.
 
     It must subclass :class:`Controller` (set ``name`` and ``needs``, return channel values
     from ``commands(obs)``); the benchmark, ``evaluate`` and ``ride-through`` then treat it
     like a baseline."""
     import importlib
     import importlib.util
+    import sys
     from pathlib import Path
     target, _, attr = spec.rpartition(":")
     if not target or not attr.isidentifier():
         raise ValueError(f"controller {spec!r}: expected package.module:Class or file.py:Class")
-    if target.endswith(".py"):
-        path = Path(target)
-        if not path.is_file():
-            raise FileNotFoundError(f"controller {spec!r}: no file {path}")
-        module_spec = importlib.util.spec_from_file_location(f"rotordrop_user_{path.stem}", path)
-        module = importlib.util.module_from_spec(module_spec)
-        module_spec.loader.exec_module(module)
-    else:
-        try:
-            module = importlib.import_module(target)
-        except ImportError as exc:
-            raise ValueError(f"controller {spec!r}: cannot import {target!r} ({exc})") from None
-    cls = getattr(module, attr, None)
+    try:
+        if target.endswith(".py"):
+            path = Path(target)
+            if not path.is_file():
+                raise FileNotFoundError(f"controller {spec!r}: no file {path}")
+            module_spec = importlib.util.spec_from_file_location(f"rotordrop_user_{path.stem}", path)
+            module = importlib.util.module_from_spec(module_spec)
+            sys.modules[module_spec.name] = module      # as an import would (dataclasses need it)
+            try:
+                module_spec.loader.exec_module(module)
+            except BaseException:
+                del sys.modules[module_spec.name]
+                raise
+        else:
+            cwd = str(Path.cwd())               # modules next to the user, as python -m finds them
+            sys.path.insert(0, cwd)
+            try:
+                module = importlib.import_module(target)
+            finally:
+                sys.path.remove(cwd)
+    except (ImportError, SyntaxError) as exc:
+        raise ValueError(f"controller {spec!r}: cannot import {target!r} "
+                         f"({type(exc).__name__}: {exc})") from None
+    if not hasattr(module, attr):
+        raise ValueError(f"controller {spec!r}: {target} has no {attr!r}")
+    cls = getattr(module, attr)
     if not (isinstance(cls, type) and issubclass(cls, Controller)):
         raise ValueError(f"controller {spec!r}: {attr!r} in {target} is not a subclass of "
                          f"agents.controllers.Controller")
@@ -341,4 +356,3 @@ def make_baseline(name: str, plant: Plant) -> Controller:
     if name not in BASELINES:
         raise KeyError(f"unknown baseline controller {name!r}; known: {', '.join(BASELINES)}")
     return make_controller(BASELINES[name], plant)
-

@@ -168,8 +168,8 @@ def plot_benchmark(report: dict, out: Path) -> list[Path]:
 
 def plot_ride_through(report: dict, out: Path) -> Path:
     """One panel per controller: peak backward-whirl revolutions (worst phase) over friction ×
-    power-return delay, the whirl threshold as a contour, and the passive drop's peak
-    revolutions as the reference strip on top."""
+    power-return delay, the whirl threshold as a contour (grids of at least 2 × 2), the
+    ride-through time in blue, and the passive drop's peak revolutions in the title."""
     plt = _plt()
     mus = np.asarray(report["frictions"])
     delays = 1e3 * np.asarray(report["power_return_s"])
@@ -177,13 +177,15 @@ def plot_ride_through(report: dict, out: Path) -> Path:
     thr = report["whirl_revolutions"]
     vmax = max(2 * thr, max(np.nanmax(np.asarray(m["peak_whirl_revolutions"], dtype=float))
                             for m in report["controllers"].values()))
+    contour = len(mus) > 1 and len(delays) > 1
     fig, axes = plt.subplots(1, len(names), figsize=(4.2 * len(names) + 1, 4.2), squeeze=False,
                              sharey=True)
     for ax, name in zip(axes[0], names):
         m = report["controllers"][name]
         revs = np.asarray(m["peak_whirl_revolutions"], dtype=float).T       # (delays, frictions)
-        im = ax.pcolormesh(mus, delays, revs, cmap="Reds", vmin=0.0, vmax=vmax, shading="nearest")
-        if len(mus) > 1 and len(delays) > 1:
+        im = ax.pcolormesh(_cell_edges(mus, 0.05), _cell_edges(delays, 10.0), revs, cmap="Reds",
+                           vmin=0.0, vmax=vmax)
+        if contour:
             ax.contour(mus, delays, revs, levels=[thr], colors="k", linewidths=1.2)
         for i, mu in enumerate(mus):
             for j, d in enumerate(delays):
@@ -197,11 +199,21 @@ def plot_ride_through(report: dict, out: Path) -> Path:
     passive = ", ".join(f"{mu:g}: {r:.0f}" for mu, r in
                         zip(mus, report["passive"]["peak_whirl_revolutions"]))
     fig.suptitle(f"{report['env_id']}: peak backward-whirl revolutions, worst of "
-                 f"{len(report['phases_deg'])} phases (whirl ≥ {thr:g}: black line); blue: "
-                 f"ride-through time\npassive drop (power never back), μ: revolutions  {passive}",
+                 f"{len(report['phases_deg'])} phases (whirl ≥ {thr:g}"
+                 f"{': black line' if contour else ''}); blue: ride-through time\npassive drop (power never back), μ: revolutions  {passive}",
                  fontsize=9, y=1.04)
     fig.colorbar(im, ax=axes[0].tolist(), fraction=0.03)
     path = Path(out) / "ride_through.png"
     fig.savefig(path, dpi=110, bbox_inches="tight")
     plt.close(fig)
     return path
+
+
+def _cell_edges(centres, width: float) -> np.ndarray:
+    """Edges of the cells around sorted grid values (midway between neighbours, the end cells
+    as wide as their neighbours); a single value gets a cell ``width`` wide."""
+    c = np.asarray(centres, dtype=float)
+    if len(c) == 1:
+        return c[0] + np.array([-0.5, 0.5]) * width
+    mid = 0.5 * (c[1:] + c[:-1])
+    return np.concatenate([[2 * c[0] - mid[0]], mid, [2 * c[-1] - mid[-1]]])

@@ -126,9 +126,10 @@ def load_shipped(name: str) -> LearnedPolicy:
 
 
 def resolve(spec: str, plant: Plant | None = None):
-    """A baseline name, a shipped policy name or a path -> (controller-or-policy, env_id | None).
+    """A baseline name, a controller class spec (``module:Class``, ``file.py:Class``), a shipped
+    policy name or a path -> (controller-or-policy, env_id | None).
 
-    Baselines need the ``plant`` of the environment they will drive.
+    Controllers need the ``plant`` of the environment they will drive (without it: None).
     """
     cls = controller_class(spec)
     if cls is not None:

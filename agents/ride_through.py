@@ -22,8 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .benchmark import (PHASES, RELEVITATION_ENVS, TASKS, Entry, Scenario, controller_env_kwargs,
-                        episode_kwargs)
+from .benchmark import (PHASES, RELEVITATION_ENVS, Entry, Scenario, check_unique_names,
+                        controller_env_kwargs, episode_kwargs, task_of)
 from .controllers import BASELINES, Passive, command_for, controller_class, make_controller
 from .policies import load_shipped, resolve, shipped_names
 from .rollout import run_episodes
@@ -44,7 +44,7 @@ def controllers_for(env_id: str) -> list[str]:
 
 
 def _entry(spec: str, env_id: str) -> Entry:
-    task = {v: k for k, v in TASKS.items()}[env_id]
+    task = task_of(env_id)
     cls = controller_class(spec)
     if cls is not None:
         return Entry(cls.name, task, lambda plant: make_controller(cls, plant),
@@ -91,9 +91,9 @@ def ride_through(out: str | Path, env_id: str = "RotorDrop-Relevitate-v0",
     frictions = _check_grid("--friction", frictions, 0.0, 2.0)
     delays = _check_grid("--delay-ms", delays, 0.0, 10.0, shown=1e3)
     phases = _check_grid("--phase", phases, -360.0, 360.0)
-    entries = [_entry(p, env_id) for p in (policies or controllers_for(env_id))]
-    task = {v: k for k, v in TASKS.items()}[env_id]
-    passive = Entry(Passive.name, task, Passive, {})
+    entries = check_unique_names([_entry(p, env_id)
+                                  for p in dict.fromkeys(policies or controllers_for(env_id))])
+    passive = Entry(Passive.name, task_of(env_id), Passive, {})
     t0 = time.perf_counter()
     bar = tqdm(total=len(phases) * len(frictions) * (1 + len(entries) * len(delays)),
                desc="ride-through map", unit="ep", disable=not progress)

@@ -14,10 +14,13 @@ def cross_entropy(cost: Callable[[np.ndarray], float], mean, std, low, high, ite
     """Minimise ``cost`` over the box [low, high] (arrays of ``mean``'s shape).
 
     Each generation samples ``population`` candidates from N(mean, std²) (clipped to the box),
-    refits mean and std to the ``elite`` best, and floors std at ``min_std``. Returns
+    refits mean and std to the ``elite`` best, and adds ``min_std`` to the refitted std (so the
+    search never collapses below it). Returns
     ``(best cost, best candidate, history)``; ``history[i]`` holds the best cost so far, the
     generation's best cost and the best candidate after generation i (i = 0: ``mean``)."""
     from tqdm.auto import tqdm
+    if not 1 <= elite <= population:
+        raise ValueError(f"elite = {elite} must be in [1, population = {population}]")
     mean, std = np.asarray(mean, dtype=float).copy(), np.asarray(std, dtype=float).copy()
     low, high = np.broadcast_to(low, mean.shape), np.broadcast_to(high, mean.shape)
     best = (float(cost(mean)), mean.copy())

@@ -20,7 +20,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-from agents.benchmark import EVAL_KWARGS, TASKS, Entry, Scenario, controller_env_kwargs, episode_kwargs
+from agents.benchmark import EVAL_KWARGS, Entry, Scenario, controller_env_kwargs, episode_kwargs, task_of
 from agents.controllers import WhirlBrake
 from agents.rollout import run_episodes
 from agents.search import cross_entropy
@@ -33,8 +33,7 @@ TUNING_SET = [(mu, ph) for mu in (0.45, 0.50, 0.55) for ph in (45.0, 225.0)] + [
 
 def cost(theta: np.ndarray, env_id: str) -> tuple[float, list[dict]]:
     gains = dict(zip(NAMES, map(float, theta)))
-    task = next(t for t, e in TASKS.items() if e == env_id)
-    entry = Entry(WhirlBrake.name, task, lambda p: WhirlBrake(p, **gains),
+    entry = Entry(WhirlBrake.name, task_of(env_id), lambda p: WhirlBrake(p, **gains),
                   controller_env_kwargs(WhirlBrake, env_id))
     kpis = [run_episodes(env_id, entry.make, [0], episode_kwargs(entry, Scenario("tune", mu), ph))[0].kpis
             for mu, ph in TUNING_SET]
@@ -55,7 +54,7 @@ def main(argv=None):
     a = ap.parse_args(argv)
     rng = np.random.default_rng(a.seed)
     t0 = time.perf_counter()
-    best_cost, best, hist = cross_entropy(
+    _, best, hist = cross_entropy(
         lambda x: cost(x, a.env)[0], [WhirlBrake.GAINS[n] for n in NAMES], 0.15 * (HIGH - LOW),
         LOW, HIGH, a.iterations, a.population, a.elite, rng, min_std=0.01 * (HIGH - LOW))
     history = [dict(iteration=h["iteration"], best_cost=h["best_cost"],

@@ -27,83 +27,91 @@ from pathlib import Path
 
 import numpy as np
 
-from agents.benchmark import TASKS, Entry, Scenario, controller_env_kwargs, episode_kwargs
-from agents.controllers import controller_class, make_controller
-from agents.plant import Plant, make_env
+from agents.benchmark import (RELEVITATION_ENVS, Entry, Scenario, controller_env_kwargs,
+                              episode_kwargs, task_of)
+from agents.controllers import _rot90, command_for, controller_class, make_controller
+from agents.plant import Plant
+from agents.rollout import run_episodes
 from agents.search import cross_entropy
 from physics.metrics import WHIRL_MIN_REVOLUTIONS
+from rotordrop_env.layout import CURRENT_ACTIONS
 
 
-class OpenLoopCorrection:
-    """The baseline's currents plus ``theta[k]`` during segment k after the power returns."""
+class CurrentOverride:
+    """An actor (SB3 ``predict``, one environment): the baseline controller, its AMB currents
+    replaced by ``override(obs, currents)`` once the power is back; ``self.k`` counts the
+    control steps since then."""
 
-    def __init__(self, plant: Plant, baseline: str, steps: int):
-        self.plant, self.base, self.steps = plant, make_controller(controller_class(baseline), plant), steps
-        self.cols = [plant.action_names.index(n) for n in plant.action_names if n.startswith("current")]
-        self.theta = np.zeros((0, len(self.cols)))
+    def __init__(self, plant: Plant, baseline: str):
+        self.plant, self.base = plant, make_controller(controller_class(baseline), plant)
+        self.cols = [plant.action_names.index(n) for n in CURRENT_ACTIONS]
+        self.k = -1
 
-    def run(self, env, theta: np.ndarray) -> dict:
-        obs, _ = env.reset(seed=0)
-        start, k_power, k = np.ones(1, dtype=bool), None, 0
-        while True:
-            a, _ = self.base.predict(obs[None, :], episode_start=start)
-            a, start = a[0].copy(), np.zeros(1, dtype=bool)
-            if self.plant.power_available(obs[None, :])[0]:
-                k_power = k if k_power is None else k_power
-                seg = (k - k_power) // self.steps
-                if seg < len(theta):
-                    a[self.cols] = np.clip(a[self.cols] + theta[seg], -1.0, 1.0)
-            obs, _, terminated, truncated, info = env.step(a)
-            k += 1
-            if terminated or truncated:
-                return {k[4:]: v for k, v in info.items() if k.startswith("kpi_")}
+    def override(self, obs: np.ndarray, currents: np.ndarray) -> np.ndarray:
+        return currents
+
+    def predict(self, obs, state=None, episode_start=None, deterministic=True):
+        a, _ = self.base.predict(obs, episode_start=episode_start)
+        if episode_start is not None and np.any(episode_start):
+            self.k = -1
+        if self.plant.power_available(obs)[0]:
+            self.k += 1
+            a = a.copy()
+            a[0, self.cols] = self.override(obs, a[0, self.cols])
+        return a, state
 
 
-def push_sweep(env, plant: Plant, baseline: str, angles=range(0, 360, 30)) -> dict:
-    """Peak revolutions per push angle [deg] (see the module doc)."""
-    from agents.controllers import _rot90
-    base = make_controller(controller_class(baseline), plant)
-    cols = [plant.action_names.index(n) for n in plant.action_names if n.startswith("current")]
-    out = {}
-    for phi in angles:
-        c, s = np.cos(np.radians(phi)), np.sin(np.radians(phi))
-        obs, _ = env.reset(seed=0)
-        start = np.ones(1, dtype=bool)
-        while True:
-            a, _ = base.predict(obs[None, :], episode_start=start)
-            a, start = a[0].copy(), np.zeros(1, dtype=bool)
-            pos = plant.positions(obs[None, :]) / plant.clearance
-            r = np.repeat(np.hypot(pos[:, 0::2], pos[:, 1::2]), 2, axis=1)
-            unit = pos / np.maximum(r, 1e-9)
-            push = c * unit + s * plant.spin_sign(obs[None, :])[:, None] * _rot90(unit)
-            outer = (r > 0.5)[0] & plant.power_available(obs[None, :])[0]
-            a[cols] = np.where(outer, np.clip(push[0], -1.0, 1.0), a[cols])
-            obs, _, terminated, truncated, info = env.step(a)
-            if terminated or truncated:
-                break
-        out[int(phi)] = float(info["kpi_peak_whirl_revolutions"])
-    return out
+class OpenLoopCorrection(CurrentOverride):
+    """The baseline's currents plus ``theta[i]`` during segment i (``steps`` control steps each)
+    after the power returns, clipped to the current limit."""
+
+    def __init__(self, plant: Plant, baseline: str, steps: int, theta: np.ndarray):
+        super().__init__(plant, baseline)
+        self.steps, self.theta = steps, theta
+
+    def override(self, obs, currents):
+        seg = self.k // self.steps
+        return np.clip(currents + self.theta[seg], -1.0, 1.0) if seg < len(self.theta) else currents
+
+
+class SaturatedPush(CurrentOverride):
+    """The baseline with its law in the outer half of the clearance replaced by a push of unit
+    length at ``angle_deg`` to the orbit radius (module doc)."""
+
+    def __init__(self, plant: Plant, baseline: str, angle_deg: float):
+        super().__init__(plant, baseline)
+        self.c, self.s = np.cos(np.radians(angle_deg)), np.sin(np.radians(angle_deg))
+
+    def override(self, obs, currents):
+        p = self.plant
+        pos = p.positions(obs) / p.clearance
+        r = np.repeat(np.hypot(pos[:, 0::2], pos[:, 1::2]), 2, axis=1)
+        unit = pos / np.maximum(r, 1e-9)
+        push = self.c * unit + self.s * p.spin_sign(obs)[:, None] * _rot90(unit)
+        return np.where(r[0] > 0.5, np.clip(push[0], -1.0, 1.0), currents)
 
 
 def bound(env_id: str, baseline: str, friction: float, phase: float, delay: float, segments: int,
           steps: int, iterations: int, population: int, std: float, seed: int) -> dict:
-    task = {v: k for k, v in TASKS.items()}[env_id]
-    entry = Entry(baseline, task, None, controller_env_kwargs(controller_class(baseline), env_id))
+    entry = Entry(baseline, task_of(env_id), None,
+                  controller_env_kwargs(controller_class(baseline), env_id))
     kw = episode_kwargs(entry, Scenario("bound", friction, env_kwargs={"power_return_time": delay}), phase)
-    env = make_env(env_id, **kw)
-    try:
-        probe = OpenLoopCorrection(Plant.from_env(env), baseline, steps)
-        shape = (segments, len(probe.cols))
-        peak = lambda th: float(probe.run(env, th)["peak_whirl_revolutions"])
-        base_kpis = probe.run(env, np.zeros(shape))
-        best, theta, history = cross_entropy(
-            peak, np.zeros(shape), np.full(shape, std), -2.0, 2.0, iterations, population,
-            max(2, population // 5), np.random.default_rng(seed), min_std=0.05,
-            desc=f"mu={friction:g} phase={phase:g}")
-        best_kpis = probe.run(env, theta)
-        pushes = push_sweep(env, probe.plant, baseline)
-    finally:
-        env.close()
+
+    def kpis(make_actor) -> dict:
+        return run_episodes(env_id, make_actor, [0], kw)[0].kpis
+
+    def correction(theta):
+        return kpis(lambda plant: OpenLoopCorrection(plant, baseline, steps, theta))
+
+    shape = (segments, len(CURRENT_ACTIONS))
+    base_kpis = correction(np.zeros(shape))
+    _, theta, history = cross_entropy(
+        lambda th: float(correction(th)["peak_whirl_revolutions"]), np.zeros(shape),
+        np.full(shape, std), -2.0, 2.0, iterations, population, min(population, max(2, population // 5)),
+        np.random.default_rng(seed), min_std=0.05, desc=f"mu={friction:g} phase={phase:g}")
+    best_kpis = correction(theta)
+    pushes = {phi: float(kpis(lambda plant: SaturatedPush(plant, baseline, phi))["peak_whirl_revolutions"])
+              for phi in range(0, 360, 30)}
     return dict(friction=friction, phase_deg=phase, power_return_s=delay,
                 baseline_peak_revolutions=base_kpis["peak_whirl_revolutions"],
                 best_peak_revolutions=best_kpis["peak_whirl_revolutions"],
@@ -116,8 +124,10 @@ def bound(env_id: str, baseline: str, friction: float, phase: float, delay: floa
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--env", default="RotorDrop-Relevitate-v0", choices=(TASKS["relevitate"], TASKS["full"]))
-    ap.add_argument("--baseline", default="whirl-brake")
+    ap.add_argument("--env", default="RotorDrop-Relevitate-v0", choices=RELEVITATION_ENVS)
+    ap.add_argument("--baseline", default="whirl-brake",
+                    help="a controller that commands the AMB currents: baseline name, "
+                         "module:Class or file.py:Class")
     ap.add_argument("--friction", type=float, action="append", default=None,
                     help="repeatable; default 0.48 and 0.53 (the benchmark's mu* + 0.10, + 0.15)")
     ap.add_argument("--phase", type=float, action="append", default=None,
@@ -131,6 +141,13 @@ def main(argv=None):
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", default="out/whirl_bound")
     a = ap.parse_args(argv)
+    try:
+        cls = controller_class(a.baseline)
+    except (ValueError, FileNotFoundError) as exc:
+        ap.error(str(exc))
+    if cls is None or command_for(cls) != "continuous":
+        ap.error(f"--baseline {a.baseline!r} must be a controller that commands the AMB currents "
+                 f"(needs 'currents'), e.g. whirl-brake or pid-relevitate")
     t0 = time.perf_counter()
     rows = [bound(a.env, a.baseline, mu, ph, a.delay_ms * 1e-3, a.segments, a.steps, a.iterations,
                   a.population, a.std, a.seed)
@@ -143,7 +160,7 @@ def main(argv=None):
     print(f"{a.env}, power back at {a.delay_ms:g} ms, open-loop correction of {a.baseline} over "
           f"{a.segments * a.steps} control steps ({a.iterations} x {a.population} episodes per scenario)")
     print(f"{'mu':>6}{'phase':>7}  {a.baseline + ' revs':>22}{'best revs':>11}{'whirl':>7}"
-          f"{'best push':>17}")
+          f"{'best push':>16}")
     for r in rows:
         print(f"{r['friction']:6.2f}{r['phase_deg']:7.0f}  {r['baseline_peak_revolutions']:22.2f}"
               f"{r['best_peak_revolutions']:11.2f}{r['best_backward_whirl']!s:>7}"

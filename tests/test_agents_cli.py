@@ -120,11 +120,28 @@ def test_ride_through_errors_name_the_option(tmp_path, capsys):
     assert "re-levitation environment" in capsys.readouterr().err
     assert main(["ride-through", "--policy", "ppo-damping", "--out", str(tmp_path)]) == 2
     assert "trained on RotorDrop-Damping-v0" in capsys.readouterr().err
+    assert main(["ride-through", "--policy", "agents.plots:_plt", "--out", str(tmp_path)]) == 2
+    assert "not a subclass" in capsys.readouterr().err
+
+
+def test_ride_through_cells_of_single_value_grids_have_a_width():
+    from agents.plots import _cell_edges
+    assert _cell_edges([0.5], 0.05) == pytest.approx([0.475, 0.525])
+    assert _cell_edges([0.0, 40.0, 100.0], 10.0) == pytest.approx([-20.0, 20.0, 70.0, 130.0])
 
 
 USER_CONTROLLER = '''
+from __future__ import annotations
+
+from dataclasses import dataclass
+
 import numpy as np
 from agents.controllers import Controller
+
+
+@dataclass
+class Level:                    # a dataclass needs its module in sys.modules while it is made
+    value: float = 0.0
 
 
 class MidDamping(Controller):
@@ -133,7 +150,11 @@ class MidDamping(Controller):
     needs = ("damping",)
 
     def commands(self, obs):
-        return {"damping": np.zeros((len(obs), 2))}
+        return {"damping": np.full((len(obs), 2), Level().value)}
+
+
+class SameName(MidDamping):
+    """Another class that keeps the name mid-damping."""
 
 
 class NotAController:
@@ -141,7 +162,8 @@ class NotAController:
 '''
 
 
-def test_a_users_controller_class_is_evaluated_and_benchmarked_like_a_baseline(tmp_path, capsys):
+def test_a_users_controller_class_is_evaluated_and_benchmarked_like_a_baseline(tmp_path, capsys,
+                                                                               monkeypatch):
     from agents.benchmark import _entries
     from agents.controllers import load_controller
     path = tmp_path / "my_controllers.py"
@@ -156,8 +178,13 @@ def test_a_users_controller_class_is_evaluated_and_benchmarked_like_a_baseline(t
     assert r["episodes"][0]["peak_contact_force_N"] < r["passive_episodes"][0]["peak_contact_force_N"]
     tasks = {e.task for e in _entries([], [load_controller(spec)]) if e.name == "mid-damping"}
     assert tasks == {"damping", "full"}                  # not in relevitate: it has no damper
+    monkeypatch.chdir(tmp_path)                          # module:Class finds modules next to you
+    assert load_controller("my_controllers:MidDamping").name == "mid-damping"
+    assert main(["ride-through", "--policy", spec, "--policy", f"{path}:SameName",
+                 "--out", str(tmp_path / "rt")]) == 2
+    assert "two controllers are named mid-damping" in capsys.readouterr().err
     for bad, words in ((f"{path}:NotAController", "not a subclass"),
-                       (f"{path}:Missing", "not a subclass"),
+                       (f"{path}:Missing", "has no 'Missing'"),
                        ("no_such_module_xyz:Ctrl", "cannot import"),
                        (f"{tmp_path}/absent.py:Ctrl", "no file")):
         assert main(["evaluate", "--policy", bad, "--env", "RotorDrop-Damping-v0",
@@ -166,9 +193,13 @@ def test_a_users_controller_class_is_evaluated_and_benchmarked_like_a_baseline(t
 
 
 def test_benchmark_power_return_applies_to_every_scenario_without_its_own():
-    from agents.benchmark import scenario_suite
+    from agents.benchmark import _group, scenario_suite
     suite = scenario_suite(0.38, power_return=0.04)
     late = [s for s in suite if s.name == "power back at 0.15 s"]
     assert late and late[0].env_kwargs == {"power_return_time": 0.15}
     assert all(s.env_kwargs == {"power_return_time": 0.04} for s in suite if s not in late)
     assert all(s.env_kwargs == {} for s in scenario_suite(0.38) if s.name != late[0].name)
+    # a power return outside the training range makes a scenario out-of-distribution only in
+    # the tasks that have a power return
+    first = scenario_suite(0.38, power_return=0.0)[0]
+    assert _group(first) == "out-of-distribution" and _group(first, "damping") == "in-distribution"

@@ -174,27 +174,51 @@ def test_parametric_sweep_sees_the_whirl_and_its_forces(tmp_path, capsys):
 
 def test_parametric_sweep_grid_values_and_errors():
     from physics.scene import SceneError
-    from physics.study.parametric import make_axes, parse_vary, plan_runs
+    from physics.study.parametric import ensemble_keys, make_axes, parse_vary, plan_runs
     assert parse_vary("contact.friction=0.3:0.5:0.1") == ("contact.friction", ["0.3", "0.4", "0.5"])
+    # ranges step in decimals: tiny values keep their scale, a range through zero hits 0 exactly
+    assert make_axes("paper", {}, ["solver.min_step=1e-14:3e-14:1e-14"])[0].values == (1e-14, 2e-14, 3e-14)
+    assert make_axes("paper", {}, ["positions.rb1=-0.1:0.1:0.1"])[0].values == (-0.1, 0.0, 0.1)
+    assert make_axes("paper", {}, ["bearing.balls=8:12:2"])[0].values == (8, 10, 12)
     axes = make_axes("paper", {}, ["support.damping=2790,1e5", "effects.friction=paper,kinematic"])
     assert axes[0].values == (2790.0, 1e5) and axes[1].values == ("paper", "kinematic")
     assert len(plan_runs("paper", {}, axes, 3, 0)) == 2 * 2 * 3
-    for bad, words in ((["contact.friction=0.2,1.5"], "contact.friction"),       # out of range
+    for bad, words in ((["contact.friction=0.2,1.5"], r"contact.friction = 1.5 .*\[0, 1\]"),
                        (["contact.nope=1"], "unknown parameter key"),
-                       (["contact.friction=0.5:0.1:0.1"], "LO <= HI"),
+                       (["contact.friction=0.5:0.1:0.1"], "contact.friction: .*LO <= HI"),
+                       (["contact.friction=0:1:inf"], "contact.friction: .*STEP > 0"),
+                       (["contact.friction=0:1:1e-320"], "contact.friction: more than 1000 values"),
+                       (["contact.friction=0:1:0.0001"], "contact.friction: more than 1000 values"),
+                       (["contact.friction=,"], "contact.friction: no values"),
+                       (["bearing.balls=8:9:0.5"], r"bearing.balls = '8.5' .*\[3, 100\]"),
+                       (["contact.friction=0.2", "contact.friction=0.3"], "contact.friction is given twice"),
                        (["a.b=1", "c.d=2", "e.f=3"], "1 or 2 keys")):
         with pytest.raises(SceneError, match=words):
             make_axes("paper", {}, bad)
     with pytest.raises(SceneError, match="both varied"):
         make_axes("paper", {"contact.friction": 0.2}, ["contact.friction=0.3"])
+    # an ensemble key fixed by --set or --vary is neither perturbed nor reported as perturbed
+    fixed = {"amb.off_time": 0.12}
+    angle = make_axes("paper", fixed, ["unbalance.angle_deg=0,90"])
+    assert ensemble_keys(fixed, angle) == [] and ensemble_keys(fixed, axes) == ["unbalance.angle_deg"]
+    runs = plan_runs("paper", fixed, angle, 3, 0)
+    assert [r.settings for r in runs] == [{"amb.off_time": 0.12, "unbalance.angle_deg": a}
+                                          for a in (0.0, 90.0)]
 
 
 def test_parametric_sweep_reports_failed_drops(tmp_path):
-    """A step budget too small to finish: every drop fails, and the cells say so."""
+    """A step budget too small to finish: every drop fails, and the cells, the CSV and the plot
+    say so."""
     out = tmp_path / "sw"
     assert cli_main(["study", "sweep", "--vary", "contact.friction=0.2", "--members", "2",
-                     "--set", "solver.max_steps=100", "--jobs", "1", "--quiet", "--no-plots",
+                     "--set", "solver.max_steps=100", "--jobs", "1", "--quiet",
                      "--out", str(out)]) == 0
-    cell, = json.loads((out / "sweep.json").read_text())["cells"]
+    r = json.loads((out / "sweep.json").read_text())
+    cell, = r["cells"]
     assert cell["failed"] == 2 and cell["whirl_probability"] is None
+    assert cell["peak_contact_force_N"] is None
     assert "solver.max_steps" in cell["errors"][0]
+    assert len(r["runs"]) == 2 and not any(run["ok"] for run in r["runs"])
+    assert all("--set solver.max_steps=100" in run["command"] for run in r["runs"])
+    assert (out / "sweep.csv").read_text().splitlines()[1] == "0.2,2,2" + "," * 10
+    assert (out / "sweep.png").is_file()

@@ -34,7 +34,7 @@ def register(subparsers) -> None:
     q.add_argument("--seed", type=int, default=0, help="seed of the ensemble perturbations")
     q.add_argument("--out", default="out/sweep", help="output directory")
     q.add_argument("--jobs", type=int, default=None, help="worker processes (default: all cores)")
-    q.add_argument("--no-plots", action="store_true")
+    q.add_argument("--no-plots", action="store_true", help="no sweep.png")
     q.add_argument("--quiet", action="store_true", help="no progress bar")
     q.set_defaults(func=cmd_study_sweep)
 
@@ -59,8 +59,8 @@ def cmd_study_sweep(args) -> int:
         print(f"note: --set/--vary fix {' and '.join(ENSEMBLE_KEYS)}, the keys that make the "
               f"ensemble, so each cell is {report['members']} drop, not {args.members}")
     if report["failed"]:
-        print(f"{report['failed']} drops failed; their errors are in the table's cells and in "
-              f"sweep.json (runs[].error)")
+        print(f"{report['failed']} drops failed (column 'failed'; the statistics are over the drops "
+              f"that ran); their errors are in sweep.json (cells[].errors, runs[].error)")
     print("wrote " + ", ".join(f"{args.out}/{f}" for f in report["files"])
           + f" in {report['wall_time_s']:.0f} s")
     return 0

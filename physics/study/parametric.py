@@ -19,6 +19,7 @@ import json
 import math
 import time
 from dataclasses import dataclass
+from decimal import Decimal, InvalidOperation
 from itertools import product
 from pathlib import Path
 
@@ -31,6 +32,7 @@ from .ensemble import perturbations
 
 ENSEMBLE_KEYS = ("unbalance.angle_deg", "amb.off_time")
 MAX_KEYS = 2
+MAX_VALUES = 1000       # per key
 MAX_RUNS = 20000
 PLANE_KPIS = {"whirl_revolutions": "whirl revolutions", "peak_contact_force_N": "peak contact force [N]",
               "max_displacement_um": "max displacement [µm]"}
@@ -47,26 +49,34 @@ class Axis:
 
 
 def parse_vary(text: str) -> tuple[str, list[str]]:
-    """``"contact.friction=0.3:0.5:0.05"`` or ``"support.damping=2790,27900"`` -> key, raw values."""
+    """``"contact.friction=0.3:0.5:0.05"`` or ``"support.damping=2790,27900"`` -> key, raw values.
+
+    A range is stepped in decimal arithmetic, so its values are the decimals the user would type
+    (``0.2:0.5:0.1`` is 0.2, 0.3, 0.4, 0.5; ``1e-14:3e-14:1e-14`` keeps its scale)."""
     if "=" not in text:
         raise SceneError(f"--vary expects KEY=V1,V2,... or KEY=LO:HI:STEP, got {text!r}")
     key, spec = (s.strip() for s in text.split("=", 1))
     if ":" in spec:
-        parts = spec.split(":")
         try:
-            lo, hi, step = (float(p) for p in parts)
-        except ValueError:
+            lo, hi, step = (Decimal(p.strip()) for p in spec.split(":"))
+        except (InvalidOperation, ValueError):
             raise SceneError(f"--vary {key}: LO:HI:STEP needs three numbers, got {spec!r}") from None
-        if not (math.isfinite(lo) and math.isfinite(hi) and step > 0 and hi >= lo):
+        if not (all(d.is_finite() for d in (lo, hi, step)) and step > 0 and hi >= lo):
             raise SceneError(f"--vary {key}: LO:HI:STEP needs finite LO <= HI and STEP > 0, got {spec!r}")
-        n = int(math.floor((hi - lo) / step + 1e-9)) + 1
-        if n > 1000:
-            raise SceneError(f"--vary {key}: {n} values; at most 1000 per key")
-        return key, [repr(round(lo + i * step, 12)) for i in range(n)]
-    values = [v.strip() for v in spec.split(",") if v.strip()]
+        values = [str(lo + i * step) for i in range(int(min((hi - lo) / step, MAX_VALUES)) + 1)]
+    else:
+        values = [v.strip() for v in spec.split(",") if v.strip()]
     if not values:
         raise SceneError(f"--vary {key}: no values in {spec!r}")
+    if len(values) > MAX_VALUES:
+        raise SceneError(f"--vary {key}: more than {MAX_VALUES} values in {spec!r}; "
+                         f"at most {MAX_VALUES} per key")
     return key, values
+
+
+def value_label(value) -> str:
+    """A grid value as the table and the plot show it (``2790``, ``1e+05``, ``kinematic``)."""
+    return f"{value:g}" if isinstance(value, float) else str(value)
 
 
 def make_axes(source: str, overrides: dict, vary: list[str]) -> list[Axis]:
@@ -86,15 +96,20 @@ def make_axes(source: str, overrides: dict, vary: list[str]) -> list[Axis]:
     return axes
 
 
+def ensemble_keys(overrides: dict, axes: list[Axis]) -> list[str]:
+    """The ensemble keys the members perturb: those neither fixed (--set) nor varied (--vary)."""
+    fixed = set(overrides) | {a.key for a in axes}
+    return [k for k in ENSEMBLE_KEYS if k not in fixed]
+
+
 def plan_runs(source: str, overrides: dict, axes: list[Axis], members: int, seed: int) -> list[Run]:
     """Cells (the product of the axes) × ensemble members, as :class:`~physics.sweep.Run`."""
     if members < 1:
         raise SceneError(f"--members must be >= 1, got {members}")
-    fixed = set(overrides) | {a.key for a in axes}
+    keys = ensemble_keys(overrides, axes)
     base = load_scene(source, overrides)
-    pert = [{k: v for k, v in p.items() if k not in fixed}
-            for p in perturbations(members, base.get("amb.off_time"), seed)]
-    if all(not p for p in pert):
+    pert = [{k: p[k] for k in keys} for p in perturbations(members, base.get("amb.off_time"), seed)]
+    if not keys:
         pert = [{}]                   # the user fixed every ensemble key: one drop per cell
     n = len(pert) * math.prod(len(a.values) for a in axes)
     if n > MAX_RUNS:
@@ -135,8 +150,7 @@ def run_parametric(source: str, overrides: dict, vary: list[str], out_dir, membe
         chunk = outcomes[i * per_cell:(i + 1) * per_cell]
         cells.append(dict(zip((a.key for a in axes), cell), **summarize_cell(chunk)))
     report = dict(scene=source, overrides=overrides, axes={a.key: list(a.values) for a in axes},
-                  members=per_cell, seed=seed, ensemble_keys=[k for k in ENSEMBLE_KEYS
-                                                              if k in runs[0].settings],
+                  members=per_cell, seed=seed, ensemble_keys=ensemble_keys(overrides, axes),
                   cells=cells, runs=[o.to_dict() for o in outcomes],
                   failed=sum(not o.ok for o in outcomes), jobs=jobs or default_jobs(),
                   wall_time_s=time.perf_counter() - t0)
@@ -172,7 +186,7 @@ def summary_table(report: dict) -> str:
     rows = []
     for c in report["cells"]:
         f, d = c["peak_contact_force_N"], c["max_displacement_um"]
-        rows.append("| " + " | ".join(f"{c[k]:g}" if isinstance(c[k], float) else str(c[k]) for k in keys)
+        rows.append("| " + " | ".join(value_label(c[k]) for k in keys)
                     + (f" | {c['whirl_probability']:.2f} | {f['median']:.0f} ({f['max']:.0f}) | "
                        f"{d['median']:.0f} ({d['max']:.0f})" if f else " | - | - | -")
                     + f" | {c['failed']} |")

@@ -13,6 +13,7 @@ from ..plots import RPM, orbit_panel, save_figure  # noqa: E402
 from ..results import Result  # noqa: E402
 from .claims import PAPER_SOFT_Y_UM, PAPER_THRESHOLD  # noqa: E402
 from .paper import BASE, SOFT  # noqa: E402
+from .parametric import PLANE_KPIS, value_label  # noqa: E402
 
 PLANE = "RB1"           # the paper's figures are at retainer bearing 1
 
@@ -289,61 +290,83 @@ def write_report(a: dict, out: Path, figures: dict[str, list[str]], meta: dict) 
 
 def plot_parametric(report: dict, axes, out: Path) -> str:
     """``rotordrop study sweep``: whirl probability, peak contact force and maximum displacement
-    over the varied keys (1 key: curves with the members' range; 2 keys: annotated maps)."""
+    over the varied keys (1 key: curves with the members' range; 2 keys: annotated maps). Cells
+    with failed drops are marked (an x on the curves, "k failed" in the maps); a statistic over
+    no drop that ran is left out ("-")."""
     cells = report["cells"]
-    panels = [("whirl_probability", "whirl probability"),
-              ("peak_contact_force_N", "peak contact force [N]"),
-              ("max_displacement_um", "max displacement [µm]")]
+    panels = [("whirl_probability", "whirl probability")] + [
+        (key, PLANE_KPIS[key]) for key in ("peak_contact_force_N", "max_displacement_um")]
+    failed = np.array([c["failed"] for c in cells])
 
     def value(c, key, stat="median"):
         v = c[key]
         return np.nan if v is None else (v if key == "whirl_probability" else v[stat])
 
-    def ticks(axis):
-        return (np.asarray(axis.values, float), None) if axis.numeric else (
-            np.arange(len(axis.values)), [str(v) for v in axis.values])
+    def column(key, stat="median"):
+        return np.array([value(c, key, stat) for c in cells], float)
 
-    title = f"{report['scene']}: {report['members']} drops per cell"
+    def ticks(axis, most=30):
+        """Positions (indices) and labels of the ticks of a map or choice axis, at most ``most``."""
+        step = -(-len(axis.values) // most)
+        return range(0, len(axis.values), step), [value_label(v) for v in axis.values[::step]]
+
+    title = f"{report['scene']}: {report['members']} drops per cell" + (
+        f", {failed.sum()} failed (marked)" if failed.any() else "")
     if len(axes) == 1:
         a = axes[0]
-        x, labels = ticks(a)
+        x = np.asarray(a.values, float) if a.numeric else np.arange(len(a.values))
         fig, axs = plt.subplots(1, 3, figsize=(13, 3.8), constrained_layout=True)
         for ax, (key, label) in zip(axs, panels):
-            ax.plot(x, [value(c, key) for c in cells], "o-", ms=4)
-            if key != "whirl_probability":
-                ax.fill_between(x, [value(c, key, "min") for c in cells],
-                                [value(c, key, "max") for c in cells], alpha=0.25, label="members' range")
+            y = column(key)
+            ax.plot(x, y, "o-" if a.numeric else "o", ms=4)
+            if key == "whirl_probability":
+                ax.set_ylim(-0.05, 1.05)
+            elif a.numeric and len(x) > 1:
+                ax.fill_between(x, column(key, "min"), column(key, "max"), alpha=0.25,
+                                label="members' range")
+            else:                        # a band needs neighbours: whiskers for choices or one value
+                ax.errorbar(x, y, yerr=[y - column(key, "min"), column(key, "max") - y], fmt="none",
+                            capsize=4, label="members' range")
+            if failed.any():             # at the bottom, also where no drop of the cell ran
+                ax.plot(x[failed > 0], np.full(np.count_nonzero(failed), 0.03), "x", color="C3",
+                        transform=ax.get_xaxis_transform(), label="cell with failed drops")
+            if ax.get_legend_handles_labels()[0]:
                 ax.legend(fontsize=7)
             ax.set_xlabel(a.key)
             ax.set_ylabel(label + ("" if key == "whirl_probability" else " (median)"))
-            if labels:
-                ax.set_xticks(x, labels)
-            elif a.numeric and min(x) > 0 and max(x) / min(x) > 50:
+            if not a.numeric:
+                ax.set_xticks(*ticks(a))
+            elif min(x) > 0 and max(x) / min(x) > 50:
                 ax.set_xscale("log")
             ax.grid(alpha=0.3)
         fig.suptitle(title, fontsize=10)
     else:
-        (a, b), n_b = axes, len(axes[1].values)
-        fig, axs = plt.subplots(3, 1, figsize=(max(6.0, 3.0 + 0.9 * len(a.values)),
-                                               3 * (1.4 + 0.35 * n_b)), constrained_layout=True)
+        (a, b), n_a, n_b = axes, len(axes[0].values), len(axes[1].values)
+        annotate = max(n_a, n_b) <= 30          # beyond that the numbers would not fit their cells
+        fig, axs = plt.subplots(3, 1, figsize=(min(16.0, max(6.0, 3.0 + 0.9 * n_a)),
+                                               3 * min(6.0, 1.4 + 0.35 * n_b)), constrained_layout=True)
+        F = failed.reshape(n_a, n_b).T
         for ax, (key, label) in zip(axs, panels):
-            M = np.array([value(c, key) for c in cells], float).reshape(len(a.values), n_b).T
+            M = column(key).reshape(n_a, n_b).T
             im = ax.imshow(M, origin="lower", aspect="auto", cmap="Reds",
                            vmin=0.0 if key == "whirl_probability" else None,
                            vmax=1.0 if key == "whirl_probability" else None)
-            vmax = np.nanmax(M) if np.isfinite(M).any() else 1.0
-            for j in range(M.shape[0]):
-                for i in range(M.shape[1]):
-                    ax.text(i, j, "-" if np.isnan(M[j, i]) else f"{M[j, i]:.2f}" if
-                            key == "whirl_probability" else f"{M[j, i]:.0f}", ha="center",
-                            va="center", fontsize=6, color="white" if M[j, i] > 0.6 * vmax else "black")
-            ax.set_xticks(range(len(a.values)), [f"{v:g}" if isinstance(v, float) else str(v)
-                                                 for v in a.values], rotation=45, fontsize=7)
-            ax.set_yticks(range(n_b), [f"{v:g}" if isinstance(v, float) else str(v) for v in b.values],
-                          fontsize=7)
+            fig.colorbar(im, ax=ax, fraction=0.05)      # first: it settles the colour limits
+            if annotate:
+                for j, i in np.ndindex(M.shape):
+                    text = ("-" if np.isnan(M[j, i]) else f"{M[j, i]:.2f}" if key == "whirl_probability"
+                            else f"{M[j, i]:.0f}") + (f"\n{F[j, i]} failed" if F[j, i] else "")
+                    dark = np.isfinite(M[j, i]) and im.norm(M[j, i]) > 0.6
+                    ax.text(i, j, text, ha="center", va="center", fontsize=6,
+                            color="white" if dark else "black")
+            elif F.any():
+                jj, ii = np.nonzero(F)
+                ax.plot(ii, jj, "x", color="C0", ms=4, label="cell with failed drops")
+                ax.legend(fontsize=7)
+            ax.set_xticks(*ticks(a), rotation=45, fontsize=7)
+            ax.set_yticks(*ticks(b), fontsize=7)
             ax.set_xlabel(a.key)
             ax.set_ylabel(b.key)
             ax.set_title(label + ("" if key == "whirl_probability" else ", median"), fontsize=9)
-            fig.colorbar(im, ax=ax, fraction=0.05)
         fig.suptitle(title, fontsize=10)
     return _save(fig, out / "sweep.png")
