@@ -72,12 +72,15 @@ def summary_table(m: dict) -> str:
              f"first contact {fc * 1e3:.2f} ms after the fault" if fc is not None else "no contact",
              f"final rotor speed {m['final_rotor_speed_rpm']:.0f} rpm",
              f"{'plane':6}{'max disp [µm]':>15}{'peak F_r [N]':>14}{'whirl':>7}{'f_whirl [Hz]':>14}"
-             f"{'sleeve [rpm]':>14}"]
+             f"{'sleeve [rpm]':>14}{'bearing s0':>12}{'friction heat [J]':>19}"]
     for p, v in m["planes"].items():
-        f = v["whirl_frequency_hz"]
+        f, s0 = v["whirl_frequency_hz"], v["static_safety_factor"]
         lines.append(f"{p:6}{v['max_displacement_um']:15.1f}{v['peak_contact_force_N']:14.0f}"
                      f"{'yes' if v['backward_whirl'] else 'no':>7}{f'{f:.1f}' if f else '-':>14}"
-                     f"{v['final_sleeve_speed_rpm']:14.0f}")
+                     f"{v['final_sleeve_speed_rpm']:14.0f}{f'{s0:.1f}' if s0 else '-':>12}"
+                     f"{v['friction_heat_J']:19.0f}")
+    lines.append("bearing s0: static safety factor C_0 / peak bearing load (ISO 76); friction heat: "
+                 "generated at the rotor-sleeve contact after the fault")
     return "\n".join(lines)
 
 

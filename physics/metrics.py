@@ -61,6 +61,23 @@ def whirl(result: Result, plane: str, after: float) -> dict:
                 whirl_sampling_aliased=aliased)
 
 
+def retainer_loading(result: Result, plane: str, post: np.ndarray) -> dict:
+    """Retainer-bearing design numbers after the fault: the peak radial bearing load and the
+    static safety factor s_0 = C_0 / P_0 (ISO 76, P_0 = the peak radial load; below about 1
+    the races deform permanently), the friction heat generated at the rotor-sleeve contact
+    (∫ F_mu v_slip dt, trapezoidal rule over the output samples) and the highest sleeve speed."""
+    t = result.t[post]
+    load = result.bearing_load(plane)[post]
+    peak = float(load.max()) if len(load) else 0.0
+    heat = result.friction_power(plane)[post]
+    ws = result.sleeve_speed(plane)[post]
+    return dict(peak_bearing_load_N=peak,
+                static_safety_factor=(result.model.scene.bearing.static_load_rating / peak
+                                      if peak > 0.0 else None),
+                friction_heat_J=float(np.sum(0.5 * (heat[1:] + heat[:-1]) * np.diff(t))),
+                max_sleeve_speed_rpm=float(np.abs(ws).max() * RPM) if len(ws) else 0.0)
+
+
 def compute_metrics(result: Result) -> dict:
     """The numbers written to metrics.json (SI, with µm and rpm at the edges)."""
     t_fault = result.t_fault if result.t_fault is not None else result.t[-1]
@@ -81,6 +98,7 @@ def compute_metrics(result: Result) -> dict:
                      max_y_displacement_um=float(np.abs(o[:, 1]).max() * 1e6) if len(o) else 0.0,
                      peak_contact_force_N=float(f.max()) if len(f) else 0.0,
                      final_sleeve_speed_rpm=float(result.sleeve_speed(p)[-1] * RPM))
+        entry.update(retainer_loading(result, p, post))
         entry.update(whirl(result, p, t_fault))
         out["planes"][p] = entry
     out["backward_whirl"] = any(out["planes"][p]["backward_whirl"] for p in PLANES)

@@ -67,7 +67,7 @@ U_AMB_POWER, U_CS1, U_CS2, U_AMB_DIRECT, U_ICMD, U_T_ON, U_REF0, N_U = 0, 1, 2, 
 
 # ------------------------------------------------------------------- diagnostics aux --
 # per plane k at aux[k*N_AUX_PLANE + j]
-(A_FR, A_FMU, A_DELTA, A_LOAD, A_WS, A_DRAG, N_AUX_PLANE) = range(7)
+(A_FR, A_FMU, A_DELTA, A_LOAD, A_WS, A_DRAG, A_PFRIC, N_AUX_PLANE) = range(8)
 N_AUX = 2 * N_AUX_PLANE
 
 PLANES = ("RB1", "RB2")
@@ -338,6 +338,7 @@ def rhs(t, y, P, I, U, dy, aux):
         rel_vx, rel_vy = pvx - svx, pvy - svy
         f_r = 0.0
         f_mu = 0.0
+        p_fric = 0.0                             # power dissipated by the contact friction
         if delta > 0.0:
             ddelta = nx * rel_vx + ny * rel_vy
             f_r, f_el = normal_force(delta, ddelta, P[P_KC], P[P_EC], P[P_CMAX], P[P_DC])
@@ -350,7 +351,7 @@ def rhs(t, y, P, I, U, dy, aux):
                     f_mu = friction_force(P[P_MU], f_r, W - ws, P[P_WL])
                 else:
                     f_mu = friction_force(P[P_MU], f_r, et + W * P[P_RJ] - ws * P[P_RS], P[P_VL])
-                p_diss += f_mu * (et + W * P[P_RJ] - ws * P[P_RS])
+                p_fric = f_mu * (et + W * P[P_RJ] - ws * P[P_RS])
             else:
                 # massless-sleeve limit: the sleeve rolls at w* and passes on only the drag torque
                 if fric == FRIC_PAPER:
@@ -365,7 +366,9 @@ def rhs(t, y, P, I, U, dy, aux):
                                                  P[P_M1_COEF], P[P_MSEAL]) / P[P_RS]
                 f_mu = sgn * min(P[P_MU] * f_r, drag)
                 ws = w_roll * min(1.0, P[P_MU] * f_r / drag) if drag > 0.0 else w_roll
-                p_diss += f_mu * (et + W * P[P_RJ])
+                p_fric = f_mu * (et + W * P[P_RJ] - ws * P[P_RS])
+                p_diss += f_mu * ws * P[P_RS]     # the bearing drag the rolling sleeve passes on
+        p_diss += p_fric
         # forces on the rotor at this plane: -F_r n - F_mu t, spin torque -r F_mu
         cfx = f_r * nx + f_mu * tx               # force on the sleeve side
         cfy = f_r * ny + f_mu * ty
@@ -451,6 +454,7 @@ def rhs(t, y, P, I, U, dy, aux):
         aux[o + A_LOAD] = load
         aux[o + A_WS] = ws
         aux[o + A_DRAG] = drag_t
+        aux[o + A_PFRIC] = p_fric
 
     # rotor equations of motion
     dy[I[S_X]] = vx

@@ -5,8 +5,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .model import (A_DELTA, A_DRAG, A_FMU, A_FR, A_LOAD, A_WS, I_PLANES, J_HX, J_SX, N_AUX_PLANE,
-                    N_PLANE_IDX, P_Z_RB1, PLANES, S_EDISS, S_W, S_WEXT, S_X, Model, energies)
+from .model import (A_DELTA, A_DRAG, A_FMU, A_FR, A_LOAD, A_PFRIC, A_WS, I_PLANES, J_HX, J_SX,
+                    N_AUX_PLANE, N_PLANE_IDX, P_Z_RB1, PLANES, S_EDISS, S_W, S_WEXT, S_X, Model, energies)
 
 
 @dataclass
@@ -93,6 +93,11 @@ class Result:
 
     def drag_torque(self, plane: str) -> np.ndarray:
         return self._aux(plane, A_DRAG)
+
+    def friction_power(self, plane: str) -> np.ndarray:
+        """Power dissipated by the rotor-sleeve contact friction, F_mu times the slip speed [W]
+        (the heat generated at the retainer's inner surface)."""
+        return self._aux(plane, A_PFRIC)
 
     # -- energy audit ---------------------------------------------------------------------
     def energy(self) -> dict[str, np.ndarray]:

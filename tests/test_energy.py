@@ -42,3 +42,57 @@ def test_kinematic_slip_friction_only_dissipates_while_paper_slip_can_feed_the_w
     assert np.all(np.diff(kin) >= -1e-6 * kin[-1])          # dense-output interpolation noise
     pap = simulate(load_scene("paper", {"contact.friction": 0.5}), t_end=0.4).energy()["dissipated"]
     assert np.diff(pap).min() < 0.0
+
+
+ONLY_CONTACT_FRICTION = {"support.damping": 0.0, "contact.damping": 0.0, "bearing.damping": 0.0,
+                         "effects.bearing_friction": False}
+
+
+@pytest.mark.parametrize("overrides", [{"contact.friction": 0.25},
+                                       {"contact.friction": 0.5, "effects.friction": "kinematic"}])
+def test_friction_heat_is_all_the_energy_lost_when_friction_is_the_only_loss(overrides):
+    """The retainer design metric friction_heat_J (∫ F_mu v_slip dt from the output samples)
+    against the energy audit's exact quadrature, with every other loss switched off."""
+    from physics.metrics import compute_metrics
+    r = simulate(load_scene("paper", {**ONLY_CONTACT_FRICTION, **overrides}), t_end=0.5)
+    m = compute_metrics(r)
+    lost = r.energy()["dissipated"]
+    i = np.searchsorted(r.t, r.t_fault)
+    heat = sum(m["planes"][p]["friction_heat_J"] for p in ("RB1", "RB2"))
+    assert m["backward_whirl"]                       # without damping both whirl: heavy sliding
+    assert heat == pytest.approx(lost[-1] - lost[i], rel=5e-3)
+
+
+def test_sleeve_spin_up_turns_half_the_friction_work_into_heat():
+    """A sleeve spun up from rest by a sliding contact: the friction heat equals the sleeve's
+    final kinetic energy ½ J_s ω_s² (the classic clutch result), here to 2 % (the rotor slows
+    slightly and the journal's orbit adds slip)."""
+    from physics.metrics import compute_metrics
+    scene = load_scene("paper", {"contact.friction": 0.25, "effects.bearing_friction": False,
+                                 "effects.friction": "kinematic"})
+    r = simulate(scene)
+    m = compute_metrics(r)
+    assert not m["backward_whirl"]
+    for p in ("RB1", "RB2"):
+        ws = r.sleeve_speed(p)[-1]
+        assert ws > 0.9 * r.rotor_speed[-1]                             # spun up
+        assert m["planes"][p]["friction_heat_J"] == pytest.approx(
+            0.5 * scene.sleeve.spin_inertia * ws ** 2, rel=0.02)
+
+
+def test_static_safety_factor_is_the_load_rating_over_the_peak_bearing_load():
+    """s_0 = C_0 / P_0 (ISO 76); a whirl at least halves it (its loads are about twice the
+    resting ones, spec §7) and the peak bearing load exceeds the static weight share."""
+    from physics.metrics import compute_metrics
+    rest = compute_metrics(simulate(load_scene("paper", {"contact.friction": 0.1}), t_end=0.4))
+    whirl = compute_metrics(simulate(load_scene("paper", {"contact.friction": 0.6}), t_end=0.4))
+    scene = load_scene("paper")
+    weight_share = 0.5 * scene.rotor.mass * scene.world.gravity
+    for m in (rest, whirl):
+        for e in m["planes"].values():
+            assert e["static_safety_factor"] == pytest.approx(
+                scene.bearing.static_load_rating / e["peak_bearing_load_N"])
+            assert e["peak_bearing_load_N"] > weight_share
+    assert not rest["backward_whirl"] and whirl["backward_whirl"]
+    assert (whirl["planes"]["RB1"]["static_safety_factor"]
+            < 0.5 * rest["planes"]["RB1"]["static_safety_factor"])

@@ -4,8 +4,8 @@ For retainer-bearing design: how do whirl, contact force and displacement change
 the support damping and the friction coefficient? Every grid cell is an ensemble of
 ``members`` equally plausible drops (unbalance angle and fault time perturbed as in the paper
 study, :mod:`physics.study.ensemble`), because near the whirl threshold one drop per cell is a
-coin toss. Per cell: whirl probability, whirl revolutions, peak contact force and maximum
-displacement (worst retainer plane; median and range over the members), and the runs that
+coin toss. Per cell: whirl probability, whirl revolutions, peak contact force, maximum
+displacement, peak retainer-bearing load and contact friction heat (worst retainer plane; median and range over the members), and the runs that
 failed, with their errors (never dropped). Every run can be repeated with the ``rotordrop drop``
 command stored next to it.
 
@@ -35,7 +35,9 @@ MAX_KEYS = 2
 MAX_VALUES = 1000       # per key
 MAX_RUNS = 20000
 PLANE_KPIS = {"whirl_revolutions": "whirl revolutions", "peak_contact_force_N": "peak contact force [N]",
-              "max_displacement_um": "max displacement [µm]"}
+              "max_displacement_um": "max displacement [µm]",
+              "peak_bearing_load_N": "peak retainer-bearing load [N]",
+              "friction_heat_J": "contact friction heat [J]"}
 
 
 @dataclass(frozen=True)
