@@ -119,5 +119,6 @@ class Result:
                          f"{p}_housing_y": h[:, 1], f"{p}_contact_force": self.contact_force(p),
                          f"{p}_friction_force": self.friction_force(p),
                          f"{p}_sleeve_speed": self.sleeve_speed(p),
-                         f"{p}_bearing_load": self.bearing_load(p)})
+                         f"{p}_bearing_load": self.bearing_load(p),
+                         f"{p}_friction_power": self.friction_power(p)})
         np.savez_compressed(path, states=self.Y, state_names=np.array(self.model.names), **cols)

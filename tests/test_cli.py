@@ -4,6 +4,7 @@ import subprocess
 import sys
 
 import numpy as np
+import pytest
 
 from physics.cli import main
 
@@ -26,6 +27,12 @@ def test_drop_writes_metrics_timeseries_and_plots(tmp_path, capsys):
         assert (out / png).stat().st_size > 10_000
     ts = np.load(out / "timeseries.npz")
     assert ts["t"][-1] == 0.2 and ts["RB1_contact_force"].max() == m["planes"]["RB1"]["peak_contact_force_N"]
+    post = ts["t"] >= m["t_fault_s"]                  # the retainer metrics come from the same series
+    assert ts["RB1_bearing_load"][post].max() == m["planes"]["RB1"]["peak_bearing_load_N"]
+    p, t = ts["RB1_friction_power"][post], ts["t"][post]
+    assert m["planes"]["RB1"]["friction_heat_J"] == pytest.approx(
+        float(np.sum(0.5 * (p[1:] + p[:-1]) * np.diff(t))), rel=1e-12)
+    assert m["planes"]["RB1"]["friction_heat_J"] > 0.0
     assert "contact.friction" not in capsys.readouterr().err
     assert "friction = 0.1" in (out / "scene.toml").read_text()
 
