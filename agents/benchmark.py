@@ -178,6 +178,18 @@ def _entries(policies: list[LearnedPolicy], controllers=()) -> list[Entry]:
     return out
 
 
+def run_label(spec: str) -> str:
+    """A short label of a policy path that tells runs apart: the run directory, with ``/best``
+    for its best model (``runs/a/best/best_model.zip`` -> ``a/best``, ``runs/a/model.zip`` and
+    ``runs/a`` -> ``a``, ``x/ppo-7.zip`` -> ``ppo-7``)."""
+    path = Path(spec)
+    if path.suffix != ".zip":
+        return path.name
+    if path.name == "best_model.zip" and path.parent.name == "best":
+        return f"{path.parent.parent.name}/best"
+    return path.parent.name if path.name == "model.zip" else path.stem
+
+
 def check_unique_names(entries: list[Entry]) -> list[Entry]:
     """``entries``, after checking that no two of a task share a name (the reports key the
     controllers by name)."""
@@ -235,7 +247,7 @@ def benchmark(out: str | Path, quick: bool = False, policies: list[str] | None =
             continue
         pol = LearnedPolicy.load(spec)
         if any(pol.name == p.name for p in loaded):     # e.g. a new run of a shipped policy
-            pol.name = f"{pol.name}@{Path(spec).name}"
+            pol.name = f"{pol.name}@{run_label(spec)}"
         loaded.append(pol)
     entries = check_unique_names(_entries(loaded, custom))
 

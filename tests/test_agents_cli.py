@@ -203,3 +203,11 @@ def test_benchmark_power_return_applies_to_every_scenario_without_its_own():
     # the tasks that have a power return
     first = scenario_suite(0.38, power_return=0.0)[0]
     assert _group(first) == "out-of-distribution" and _group(first, "damping") == "in-distribution"
+
+
+def test_runs_of_one_policy_get_labels_that_tell_them_apart():
+    from agents.benchmark import run_label
+    assert run_label("runs/s1/best/best_model.zip") == "s1/best"
+    assert run_label("runs/s2/best/best_model.zip") == "s2/best"
+    assert run_label("runs/s1/model.zip") == run_label("runs/s1") == run_label("runs/s1/") == "s1"
+    assert run_label("x/ppo-7.zip") == "ppo-7"
