@@ -16,6 +16,11 @@ def _env_kwargs(args) -> dict:
         kw["scene"] = args.scene
     if getattr(args, "overrides", None):
         kw["overrides"] = {k: _number(v) for k, v in map(parse_assignment, args.overrides)}
+    ms = getattr(args, "power_return_ms", None)
+    if ms is not None:
+        if not 0.0 <= ms <= 1e5:
+            raise ValueError(f"--power-return-ms = {ms:g} must be in [0, 100000] ms")
+        kw["power_return_time"] = 1e-3 * ms
     return kw
 
 
@@ -126,6 +131,9 @@ def register(sub) -> None:
     p.add_argument("--no-passive", action="store_true", help="skip the passive reference runs")
     p.add_argument("--fixed", action="store_true",
                    help="no scenario randomisation: every episode runs the given scene")
+    p.add_argument("--power-return-ms", type=float, default=None,
+                   help="re-levitation environments: power back this long after the fault [ms] "
+                        "(default: the env's 50 ms, or randomised without --fixed)")
     p.set_defaults(func=cmd_evaluate)
 
     p = sub.add_parser("benchmark", help="every baseline and shipped policy on a fixed scenario suite")

@@ -17,8 +17,9 @@ from .score import fmt_or_dash, json_default, summarize
 
 
 def _merge_kwargs(base: dict, user: dict, randomize: bool) -> dict:
-    """Env kwargs: the policy's training kwargs, then the user's; scene keys the user sets are
-    taken out of the randomisation so that they stay at the given value."""
+    """Env kwargs: the policy's training kwargs, then the user's; scene keys (and the power
+    return) the user sets are taken out of the randomisation so that they stay at the given
+    value."""
     kw = dict(base)
     for k, v in user.items():
         if k == "overrides":
@@ -28,9 +29,9 @@ def _merge_kwargs(base: dict, user: dict, randomize: bool) -> dict:
     kw["randomize"] = randomize
     kw.setdefault("terminate_on_failure", False)
     kw.update(monitor_kwargs(kw))              # KPI sampling every 0.2 ms at any control step
-    if randomize and kw.get("overrides"):
-        kw["randomization"] = {**(kw.get("randomization") or {}),
-                               **{k: None for k in kw["overrides"]}}
+    fixed = [*(kw.get("overrides") or {}), *(["power_return_time"] if "power_return_time" in user else [])]
+    if randomize and fixed:
+        kw["randomization"] = {**(kw.get("randomization") or {}), **{k: None for k in fixed}}
     return kw
 
 

@@ -211,3 +211,22 @@ def test_runs_of_one_policy_get_labels_that_tell_them_apart():
     assert run_label("runs/s2/best/best_model.zip") == "s2/best"
     assert run_label("runs/s1/model.zip") == run_label("runs/s1") == run_label("runs/s1/") == "s1"
     assert run_label("x/ppo-7.zip") == "ppo-7"
+
+
+def test_evaluate_at_a_given_power_return(tmp_path, capsys):
+    """--power-return-ms fixes the delay (also out of the randomisation); power back at once
+    re-levitates sooner than the default 50 ms."""
+    times = {}
+    for ms in ("0", "50"):
+        out = tmp_path / ms
+        assert main(["evaluate", "--policy", "whirl-brake", "--env", "RotorDrop-Relevitate-v0",
+                     "--episodes", "1", "--no-plots", "--no-passive", "--power-return-ms", ms,
+                     "--set", "contact.friction=0.25", "--out", str(out)]) == 0
+        r = json.loads((out / "kpis.json").read_text())
+        assert r["env_kwargs"]["power_return_time"] == float(ms) * 1e-3
+        assert r["env_kwargs"]["randomization"]["power_return_time"] is None
+        times[ms] = r["episodes"][0]["relevitation_time_s"]
+    assert times["0"] < times["50"] - 0.03
+    assert main(["evaluate", "--policy", "max-damping", "--env", "RotorDrop-Damping-v0",
+                 "--power-return-ms", "30", "--out", str(tmp_path / "x")]) == 2
+    assert "re-levitation environments only" in capsys.readouterr().err
