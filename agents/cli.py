@@ -1,4 +1,4 @@
-"""``rotordrop train | evaluate | benchmark | ride-through`` (registered into ``physics.cli``).
+"""``rotordrop train | evaluate | benchmark | tune | ride-through`` (registered into ``physics.cli``).
 
 Registration is light: SB3, torch and the environments are imported inside the handlers.
 """
@@ -93,6 +93,22 @@ def cmd_ride_through(args) -> int:
     return 0
 
 
+def cmd_tune(args) -> int:
+    from .tune import tune
+    try:
+        r = tune(args.policy, args.env, args.gain, args.out, iterations=args.iterations,
+                 population=args.population, elite=args.elite, seed=args.seed,
+                 progress=not args.quiet, plots=not args.no_plots)
+    except (KeyError, ValueError, FileNotFoundError) as exc:
+        print(f"rotordrop tune: error: {exc.args[0] if exc.args else exc}", file=sys.stderr)
+        return 2
+    print(f"{r['controller']} on {r['env_id']}: validation score {r['start_validation_score']:.2f} "
+          f"(start) -> {r['validation_score']:.2f} in {r['wall_time_s']:.0f} s")
+    print("gains: " + ", ".join(f"{k}={v:.4g}" for k, v in r["gains"].items()))
+    print("wrote " + ", ".join(str(Path(args.out) / f) for f in r["files"]))
+    return 0
+
+
 def register(sub) -> None:
     p = sub.add_parser("train", help="train an SB3 agent on a rotor-drop environment")
     p.add_argument("--env", required=True, help="environment id, e.g. RotorDrop-Damping-v0")
@@ -151,6 +167,24 @@ def register(sub) -> None:
     p.add_argument("--scenarios", type=int, default=None, help=argparse.SUPPRESS)
     p.add_argument("--episodes", type=int, default=None, help=argparse.SUPPRESS)
     p.set_defaults(func=cmd_benchmark)
+
+    p = sub.add_parser("tune", help="tune a controller's gains for the benchmark score on the "
+                                    "validation suite (scenarios the benchmark does not use)")
+    p.add_argument("--policy", required=True,
+                   help="controller class: a baseline name, package.module:Class or file.py:Class; "
+                        "its constructor takes the gains as keyword arguments")
+    p.add_argument("--env", required=True, help="RotorDrop-Damping-v0, RotorDrop-Relevitate-v0 "
+                                                "or RotorDrop-Full-v0")
+    p.add_argument("--gain", action="append", default=[], metavar="NAME=LO:HI",
+                   help="a gain and its search range (repeatable), e.g. --gain kp=0:30")
+    p.add_argument("--iterations", type=int, default=12, help="generations (default 12)")
+    p.add_argument("--population", type=int, default=24, help="candidates per generation")
+    p.add_argument("--elite", type=int, default=6, help="best candidates the next generation is fitted to")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--out", default="out/tune", help="output directory")
+    p.add_argument("--no-plots", action="store_true")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=cmd_tune)
 
     p = sub.add_parser("ride-through", help="how late the AMB power may return for a controller "
                                             "to stop the whirl: friction x power-return map")

@@ -217,3 +217,23 @@ def _cell_edges(centres, width: float) -> np.ndarray:
         return c[0] + np.array([-0.5, 0.5]) * width
     mid = 0.5 * (c[1:] + c[:-1])
     return np.concatenate([[2 * c[0] - mid[0]], mid, [2 * c[-1] - mid[-1]]])
+
+
+def plot_tuning(report: dict, out: Path) -> Path:
+    """``rotordrop tune``: best validation score so far and each generation's best."""
+    plt = _plt()
+    h = report["history"]
+    it = [r["iteration"] for r in h]
+    fig, ax = plt.subplots(figsize=(6.5, 3.8), constrained_layout=True)
+    ax.plot(it, [r["best_validation_score"] for r in h], "o-", label="best so far")
+    ax.plot(it[1:], [r["generation_best"] for r in h[1:]], ".", color="0.5", label="generation best")
+    ax.set_xlabel("generation (0 = start gains)")
+    ax.set_ylabel("validation score (passive = 0)")
+    ax.set_title(f"{report['controller']} on {report['env_id']}: "
+                 + ", ".join(f"{k} = {v:.3g}" for k, v in report["gains"].items()), fontsize=9)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    path = Path(out) / "tune.png"
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

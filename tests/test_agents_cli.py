@@ -230,3 +230,56 @@ def test_evaluate_at_a_given_power_return(tmp_path, capsys):
     assert main(["evaluate", "--policy", "max-damping", "--env", "RotorDrop-Damping-v0",
                  "--power-return-ms", "30", "--out", str(tmp_path / "x")]) == 2
     assert "re-levitation environments only" in capsys.readouterr().err
+
+
+LEVEL_CONTROLLER = '''
+import numpy as np
+from agents.controllers import Controller
+
+
+class Level(Controller):
+    """Constant damper command ``level`` in [-1, 1] (-1 = C_min, +1 = C_max)."""
+    name = "level-damping"
+    needs = ("damping",)
+    GAINS = {"level": 0.0}
+
+    def __init__(self, plant, level=0.0):
+        super().__init__(plant)
+        self.level = level
+
+    def commands(self, obs):
+        return {"damping": np.full((len(obs), 2), self.level)}
+'''
+
+
+def test_tune_moves_a_damper_level_towards_more_damping(tmp_path, capsys):
+    """Between C_min and C_max more damping scores better (it holds the whirl off longer), so
+    the search must raise the level from its start at mid-range; the reported validation score
+    is what the validator gives for the reported gains."""
+    from agents.benchmark import Validator
+    from agents.controllers import load_controller
+    path = tmp_path / "level.py"
+    path.write_text(LEVEL_CONTROLLER)
+    spec = f"{path}:Level"
+    out = tmp_path / "tune"
+    assert main(["tune", "--policy", spec, "--env", "RotorDrop-Damping-v0", "--gain", "level=-1:1",
+                 "--iterations", "3", "--population", "6", "--elite", "2", "--quiet",
+                 "--out", str(out)]) == 0
+    r = json.loads((out / "tune.json").read_text())
+    assert r["start"] == {"level": 0.0}
+    assert r["gains"]["level"] > 0.1
+    assert r["validation_score"] > r["start_validation_score"]
+    cls = load_controller(spec)
+    again, _ = Validator("RotorDrop-Damping-v0").score(
+        lambda plant: cls(plant, level=r["gains"]["level"]), {})
+    assert again == pytest.approx(r["validation_score"], rel=1e-12)
+    assert (out / "tune.png").is_file()
+    for bad, words in ((["--gain", "level=1:-1"], "LO < HI"),
+                       (["--gain", "gamma=0:1"], "does not take the gains"),
+                       ([], "--gain is required")):
+        assert main(["tune", "--policy", spec, "--env", "RotorDrop-Damping-v0", *bad,
+                     "--out", str(tmp_path / "x")]) == 2
+        assert words in capsys.readouterr().err
+    assert main(["tune", "--policy", "ppo-damping", "--env", "RotorDrop-Damping-v0",
+                 "--gain", "a=0:1", "--out", str(tmp_path / "x")]) == 2
+    assert "not a learned policy" in capsys.readouterr().err

@@ -1,0 +1,120 @@
+"""``rotordrop tune``: tune a controller's gains for the benchmark score, on scenarios the
+benchmark does not use.
+
+A control engineer's controller class (``package.module:Class`` or ``file.py:Class``, or a
+baseline) takes its gains as constructor keyword arguments (``Class(plant, kp=..., kd=...)``,
+like :class:`agents.controllers.WhirlBrake`). A cross-entropy search (:mod:`agents.search`)
+over the given ranges maximises the controller's **validation score**: the benchmark score
+(:mod:`agents.score`) on the validation suite of the task (frictions 0.2/0.36/0.41/0.46/0.51 at
+unbalance phases 45°/225°, :class:`agents.benchmark.Validator`), which shares no scenario with
+the benchmark, so that ``rotordrop benchmark`` afterwards still measures the tuned controller on
+unseen cases. The search starts from the class's ``GAINS`` defaults where it has them (else the
+middle of each range).
+
+Outputs: ``tune.json`` (gains, validation score before and after, per-scenario rows, the search
+history) and ``tune.png`` (best validation score per generation).
+"""
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .benchmark import TASKS, Validator, controller_env_kwargs
+from .controllers import Controller, controller_class, make_controller
+from .score import json_default
+from .search import cross_entropy
+
+
+def parse_gain(text: str) -> tuple[str, float, float]:
+    """``"kp=0:30"`` -> ``("kp", 0.0, 30.0)``."""
+    name, _, rng = text.partition("=")
+    parts = rng.split(":")
+    try:
+        lo, hi = (float(p) for p in parts)
+    except ValueError:
+        raise ValueError(f"--gain expects NAME=LO:HI, got {text!r}") from None
+    if not name.strip().isidentifier() or not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
+        raise ValueError(f"--gain {text!r}: needs a name and finite LO < HI")
+    return name.strip(), lo, hi
+
+
+def _controller(spec: str, env_id: str) -> type[Controller]:
+    cls = controller_class(spec)
+    if cls is None:
+        raise ValueError(f"--policy {spec!r}: tune needs a controller class (a baseline name, "
+                         f"package.module:Class or file.py:Class), not a learned policy")
+    if env_id not in TASKS.values():
+        raise ValueError(f"--env must be one of {', '.join(TASKS.values())}, got {env_id!r}")
+    return cls
+
+
+def _check_gains(cls: type[Controller], env_id: str, names: list[str]) -> dict:
+    """Build the controller once with its default gains to fail early, naming what is wrong."""
+    from .plant import Plant, make_env
+    kw = controller_env_kwargs(cls, env_id)
+    env = make_env(env_id, **kw)
+    try:
+        plant = Plant.from_env(env)
+        make_controller(cls, plant)                      # channel check, clear message
+        defaults = getattr(cls, "GAINS", {})
+        try:
+            cls(plant, **{n: defaults.get(n, 0.0) for n in names})
+        except TypeError as exc:
+            raise ValueError(f"{cls.name} does not take the gains {names} as keyword arguments "
+                             f"({exc})") from None
+    finally:
+        env.close()
+    return kw
+
+
+def tune(spec: str, env_id: str, gains: list[str], out, iterations: int = 12,
+         population: int = 24, elite: int = 6, seed: int = 0, progress: bool = True,
+         plots: bool = True) -> dict:
+    """Run the search (module doc) and write ``tune.json`` / ``tune.png`` into ``out``."""
+    if not gains:
+        raise ValueError("--gain is required (NAME=LO:HI, repeatable)")
+    ranges = [parse_gain(g) for g in gains]
+    names = [n for n, _, _ in ranges]
+    if len(set(names)) != len(names):
+        raise ValueError(f"--gain names must differ, got {names}")
+    for what, v, lo in (("--iterations", iterations, 0), ("--population", population, 1),
+                        ("--elite", elite, 1)):
+        if v < lo:
+            raise ValueError(f"{what} must be >= {lo}, got {v}")
+    cls = _controller(spec, env_id)
+    env_kwargs = _check_gains(cls, env_id, names)
+    low = np.array([lo for _, lo, _ in ranges])
+    high = np.array([hi for _, _, hi in ranges])
+    defaults = getattr(cls, "GAINS", {})
+    start = np.clip([defaults.get(n, 0.5 * (lo + hi)) for n, lo, hi in ranges], low, high)
+    validator = Validator(env_id)
+
+    def score(theta) -> tuple[float, list[dict]]:
+        g = dict(zip(names, map(float, theta)))
+        return validator.score(lambda plant: cls(plant, **g), env_kwargs)
+
+    t0 = time.perf_counter()
+    best_cost, best, history = cross_entropy(
+        lambda th: -score(th)[0], start, 0.15 * (high - low), low, high, iterations, population,
+        elite, np.random.default_rng(seed), min_std=0.01 * (high - low), progress=progress,
+        desc=f"tuning {cls.name}")
+    final, rows = score(best)
+    report = dict(controller=cls.name, spec=spec, env_id=env_id, ranges={n: [lo, hi] for n, lo, hi in ranges},
+                  start=dict(zip(names, start.tolist())), start_validation_score=-history[0]["best_cost"],
+                  gains=dict(zip(names, best.tolist())), validation_score=final, rows=rows,
+                  history=[dict(iteration=h["iteration"], best_validation_score=-h["best_cost"],
+                                generation_best=-h["generation_best"],
+                                gains=dict(zip(names, h["best"].tolist()))) for h in history],
+                  search=dict(iterations=iterations, population=population, elite=elite, seed=seed),
+                  wall_time_s=time.perf_counter() - t0)
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "tune.json").write_text(json.dumps(report, indent=2, default=json_default))
+    report["files"] = ["tune.json"]
+    if plots:
+        from .plots import plot_tuning
+        report["files"].append(plot_tuning(report, out).name)
+    return report
