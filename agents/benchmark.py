@@ -27,6 +27,7 @@ leaderboard), ``leaderboard.md``, ``score.png``, ``whirl_map.png``, ``peak_force
 from __future__ import annotations
 
 import json
+import os
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -181,8 +182,9 @@ def _entries(policies: list[LearnedPolicy], controllers=()) -> list[Entry]:
 def run_label(spec: str) -> str:
     """A short label of a policy path that tells runs apart: the run directory, with ``/best``
     for its best model (``runs/a/best/best_model.zip`` -> ``a/best``, ``runs/a/model.zip`` and
-    ``runs/a`` -> ``a``, ``x/ppo-7.zip`` -> ``ppo-7``)."""
-    path = Path(spec)
+    ``runs/a`` -> ``a``, ``x/ppo-7.zip`` -> ``ppo-7``; a relative ``model.zip`` names the
+    current directory)."""
+    path = Path(os.path.abspath(spec))
     if path.suffix != ".zip":
         return path.name
     if path.name == "best_model.zip" and path.parent.name == "best":

@@ -228,6 +228,7 @@ def plot_tuning(report: dict, out: Path) -> Path:
     ax.plot(it, [r["best_validation_score"] for r in h], "o-", label="best so far")
     ax.plot(it[1:], [r["generation_best"] for r in h[1:]], ".", color="0.5", label="generation best")
     ax.set_xlabel("generation (0 = start gains)")
+    ax.xaxis.get_major_locator().set_params(integer=True)
     ax.set_ylabel("validation score (passive = 0)")
     ax.set_title(f"{report['controller']} on {report['env_id']}: "
                  + ", ".join(f"{k} = {v:.3g}" for k, v in report["gains"].items()), fontsize=9)

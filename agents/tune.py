@@ -8,8 +8,8 @@ over the given ranges maximises the controller's **validation score**: the bench
 (:mod:`agents.score`) on the validation suite of the task (frictions 0.2/0.36/0.41/0.46/0.51 at
 unbalance phases 45°/225°, :class:`agents.benchmark.Validator`), which shares no scenario with
 the benchmark, so that ``rotordrop benchmark`` afterwards still measures the tuned controller on
-unseen cases. The search starts from the class's ``GAINS`` defaults where it has them (else the
-middle of each range).
+unseen cases. The search starts from the class's ``GAINS`` defaults where it has them (clipped
+into the range; else the middle of each range).
 
 Outputs: ``tune.json`` (gains, validation score before and after, per-scenario rows, the search
 history) and ``tune.png`` (best validation score per generation).
@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from .benchmark import TASKS, Validator, controller_env_kwargs
-from .controllers import Controller, controller_class, make_controller
+from .controllers import BASELINES, Controller, controller_class, make_controller
 from .score import json_default
 from .search import cross_entropy
 
@@ -44,27 +44,28 @@ def parse_gain(text: str) -> tuple[str, float, float]:
 def _controller(spec: str, env_id: str) -> type[Controller]:
     cls = controller_class(spec)
     if cls is None:
-        raise ValueError(f"--policy {spec!r}: tune needs a controller class (a baseline name, "
-                         f"package.module:Class or file.py:Class), not a learned policy")
+        raise ValueError(f"--policy {spec!r}: tune needs a controller class (a baseline: "
+                         f"{', '.join(BASELINES)}; or package.module:Class or file.py:Class), "
+                         f"not a learned policy")
     if env_id not in TASKS.values():
         raise ValueError(f"--env must be one of {', '.join(TASKS.values())}, got {env_id!r}")
     return cls
 
 
-def _check_gains(cls: type[Controller], env_id: str, names: list[str]) -> dict:
-    """Build the controller once with its default gains to fail early, naming what is wrong."""
+def _check_gains(cls: type[Controller], env_id: str, start: dict) -> dict:
+    """Build the controller once with the start gains to fail early, naming what is wrong."""
     from .plant import Plant, make_env
     kw = controller_env_kwargs(cls, env_id)
     env = make_env(env_id, **kw)
     try:
         plant = Plant.from_env(env)
-        make_controller(cls, plant)                      # channel check, clear message
-        defaults = getattr(cls, "GAINS", {})
+        if not cls.supports(plant):
+            make_controller(cls, plant)                  # raises, naming the missing channels
         try:
-            cls(plant, **{n: defaults.get(n, 0.0) for n in names})
+            cls(plant, **start)
         except TypeError as exc:
-            raise ValueError(f"{cls.name} does not take the gains {names} as keyword arguments "
-                             f"({exc})") from None
+            raise ValueError(f"{cls.name} does not take the gains {list(start)} as keyword "
+                             f"arguments ({exc})") from None
     finally:
         env.close()
     return kw
@@ -84,12 +85,14 @@ def tune(spec: str, env_id: str, gains: list[str], out, iterations: int = 12,
                         ("--elite", elite, 1)):
         if v < lo:
             raise ValueError(f"{what} must be >= {lo}, got {v}")
+    if elite > population:
+        raise ValueError(f"--elite = {elite} must be <= --population = {population}")
     cls = _controller(spec, env_id)
-    env_kwargs = _check_gains(cls, env_id, names)
     low = np.array([lo for _, lo, _ in ranges])
     high = np.array([hi for _, _, hi in ranges])
     defaults = getattr(cls, "GAINS", {})
     start = np.clip([defaults.get(n, 0.5 * (lo + hi)) for n, lo, hi in ranges], low, high)
+    env_kwargs = _check_gains(cls, env_id, dict(zip(names, start.tolist())))
     validator = Validator(env_id)
 
     def score(theta) -> tuple[float, list[dict]]:

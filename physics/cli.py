@@ -79,8 +79,9 @@ def summary_table(m: dict) -> str:
                      f"{'yes' if v['backward_whirl'] else 'no':>7}{f'{f:.1f}' if f else '-':>14}"
                      f"{v['final_sleeve_speed_rpm']:14.0f}{f'{s0:.1f}' if s0 else '-':>12}"
                      f"{v['friction_heat_J']:19.0f}")
-    lines.append("bearing s0: static safety factor C_0 / peak bearing load (ISO 76); friction heat: "
-                 "generated at the rotor-sleeve contact after the fault")
+    lines += ["bearing s0: static safety factor C_0 / peak bearing load (ISO 76)",
+              "friction heat: generated at the rotor-sleeve contact after the fault (net: under the "
+              "paper slip law the contact can also return energy)"]
     return "\n".join(lines)
 
 

@@ -65,7 +65,8 @@ def retainer_loading(result: Result, plane: str, post: np.ndarray) -> dict:
     """Retainer-bearing design numbers after the fault: the peak radial bearing load and the
     static safety factor s_0 = C_0 / P_0 (ISO 76, P_0 = the peak radial load; below about 1
     the races deform permanently), the friction heat generated at the rotor-sleeve contact
-    (∫ F_mu v_slip dt, trapezoidal rule over the output samples) and the highest sleeve speed."""
+    (∫ F_mu v_slip dt, trapezoidal rule over the output samples; a net value, which the paper's
+    slip law can make negative, see ``Result.friction_power``) and the highest sleeve speed."""
     t = result.t[post]
     load = result.bearing_load(plane)[post]
     peak = float(load.max()) if len(load) else 0.0

@@ -352,6 +352,7 @@ def rhs(t, y, P, I, U, dy, aux):
                 else:
                     f_mu = friction_force(P[P_MU], f_r, et + W * P[P_RJ] - ws * P[P_RS], P[P_VL])
                 p_fric = f_mu * (et + W * P[P_RJ] - ws * P[P_RS])
+                p_diss += p_fric
             else:
                 # massless-sleeve limit: the sleeve rolls at w* and passes on only the drag torque
                 if fric == FRIC_PAPER:
@@ -367,8 +368,8 @@ def rhs(t, y, P, I, U, dy, aux):
                 f_mu = sgn * min(P[P_MU] * f_r, drag)
                 ws = w_roll * min(1.0, P[P_MU] * f_r / drag) if drag > 0.0 else w_roll
                 p_fric = f_mu * (et + W * P[P_RJ] - ws * P[P_RS])
-                p_diss += f_mu * ws * P[P_RS]     # the bearing drag the rolling sleeve passes on
-        p_diss += p_fric
+                # all the rotor loses: p_fric plus the bearing drag f_mu ws R the sleeve passes on
+                p_diss += f_mu * (et + W * P[P_RJ])
         # forces on the rotor at this plane: -F_r n - F_mu t, spin torque -r F_mu
         cfx = f_r * nx + f_mu * tx               # force on the sleeve side
         cfy = f_r * ny + f_mu * ty

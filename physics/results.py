@@ -95,8 +95,10 @@ class Result:
         return self._aux(plane, A_DRAG)
 
     def friction_power(self, plane: str) -> np.ndarray:
-        """Power dissipated by the rotor-sleeve contact friction, F_mu times the slip speed [W]
-        (the heat generated at the retainer's inner surface)."""
+        """Power dissipated by the rotor-sleeve contact friction, F_mu times the slip speed
+        r Omega + v_t - R omega_s [W] (the heat generated at the retainer's inner surface). Under
+        the paper's slip law (F_mu follows Omega - omega_s, not the slip speed) it can turn
+        negative: in a whirl, and slightly while the sleeve rolls at omega_s = Omega."""
         return self._aux(plane, A_PFRIC)
 
     # -- energy audit ---------------------------------------------------------------------

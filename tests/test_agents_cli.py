@@ -205,12 +205,15 @@ def test_benchmark_power_return_applies_to_every_scenario_without_its_own():
     assert _group(first) == "out-of-distribution" and _group(first, "damping") == "in-distribution"
 
 
-def test_runs_of_one_policy_get_labels_that_tell_them_apart():
+def test_runs_of_one_policy_get_labels_that_tell_them_apart(tmp_path, monkeypatch):
     from agents.benchmark import run_label
     assert run_label("runs/s1/best/best_model.zip") == "s1/best"
     assert run_label("runs/s2/best/best_model.zip") == "s2/best"
     assert run_label("runs/s1/model.zip") == run_label("runs/s1") == run_label("runs/s1/") == "s1"
     assert run_label("x/ppo-7.zip") == "ppo-7"
+    monkeypatch.chdir(tmp_path)                      # inside the run directory: never empty
+    assert run_label("model.zip") == run_label(".") == tmp_path.name
+    assert run_label("best/best_model.zip") == f"{tmp_path.name}/best"
 
 
 def test_evaluate_at_a_given_power_return(tmp_path, capsys):
@@ -249,6 +252,14 @@ class Level(Controller):
 
     def commands(self, obs):
         return {"damping": np.full((len(obs), 2), self.level)}
+
+
+class Required(Level):
+    """The same with a gain that has no default."""
+    GAINS = {}
+
+    def __init__(self, plant, level):
+        super().__init__(plant, level)
 '''
 
 
@@ -274,8 +285,15 @@ def test_tune_moves_a_damper_level_towards_more_damping(tmp_path, capsys):
         lambda plant: cls(plant, level=r["gains"]["level"]), {})
     assert again == pytest.approx(r["validation_score"], rel=1e-12)
     assert (out / "tune.png").is_file()
+    # a gain without a default starts mid-range (and the checks build it with that value)
+    assert main(["tune", "--policy", f"{path}:Required", "--env", "RotorDrop-Damping-v0",
+                 "--gain", "level=0:1", "--iterations", "0", "--quiet", "--no-plots",
+                 "--out", str(tmp_path / "req")]) == 0
+    assert json.loads((tmp_path / "req" / "tune.json").read_text())["start"] == {"level": 0.5}
     for bad, words in ((["--gain", "level=1:-1"], "LO < HI"),
                        (["--gain", "gamma=0:1"], "does not take the gains"),
+                       (["--gain", "level=0:1", "--population", "2", "--elite", "3"],
+                        "--elite = 3 must be <= --population = 2"),
                        ([], "--gain is required")):
         assert main(["tune", "--policy", spec, "--env", "RotorDrop-Damping-v0", *bad,
                      "--out", str(tmp_path / "x")]) == 2

@@ -27,7 +27,13 @@ def test_without_friction_and_damping_mechanical_energy_is_conserved():
 @pytest.mark.parametrize("overrides", [{}, {"effects.friction": "kinematic"},
                                        {"effects.retainer_bearing": "linear"},
                                        {"effects.housing": False},
-                                       {"contact.friction": 0.5}])
+                                       {"contact.friction": 0.5},
+                                       # massless sleeve (its film would follow the jumping
+                                       # rolling speed without a force doing work: off)
+                                       {"effects.sleeve_inertia": False, "effects.ehl_film": False,
+                                        "contact.friction": 0.5},
+                                       {"effects.sleeve_inertia": False, "effects.ehl_film": False,
+                                        "contact.friction": 0.5, "effects.friction": "kinematic"}])
 def test_energy_lost_equals_integrated_dissipated_power(overrides):
     r = simulate(load_scene("paper", overrides), t_end=0.4)
     res, e = energy_residual(r)
