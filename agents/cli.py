@@ -153,7 +153,8 @@ def register(sub) -> None:
     p.set_defaults(func=cmd_evaluate)
 
     p = sub.add_parser("benchmark", help="every baseline and shipped policy on a fixed scenario suite")
-    p.add_argument("--quick", action="store_true", help="a reduced suite that runs in a few minutes")
+    p.add_argument("--quick", action="store_true",
+                   help="a reduced suite: 5 scenarios x 2 phases (about 15 s)")
     p.add_argument("--policy", action="append", default=None,
                    help="extra policies or controllers to include (repeatable): a training "
                         "directory or model .zip, or your own controller class as "

@@ -9,7 +9,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from .benchmark import controller_env_kwargs, monitor_kwargs
+from .benchmark import RELEVITATION_ENVS, controller_env_kwargs, monitor_kwargs
 from .controllers import Passive, controller_class, make_controller
 from .policies import resolve
 from .rollout import run_episodes
@@ -59,6 +59,9 @@ def evaluate(policy: str, env_id: str | None, episodes: int, out: str | Path,
     from rotordrop_env import ENV_IDS
     if env_id not in ENV_IDS:
         raise ValueError(f"--env {env_id!r} is not a rotor-drop environment; known: {', '.join(ENV_IDS)}")
+    if "power_return_time" in (env_kwargs or {}) and env_id not in RELEVITATION_ENVS:
+        raise ValueError(f"--power-return-ms (power_return_time) applies to the re-levitation "
+                         f"environments ({', '.join(RELEVITATION_ENVS)}) only, not {env_id}")
     kwargs = _merge_kwargs(base_kwargs, env_kwargs or {}, randomize)
     seeds = list(range(seed, seed + episodes))
     eps = run_episodes(env_id, make_actor, seeds, kwargs, record=True)

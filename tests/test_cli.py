@@ -50,3 +50,11 @@ def test_bad_override_is_a_one_line_error_not_a_traceback():
     assert proc.returncode == 2
     assert "contact.friction" in proc.stderr and "[0, 1]" in proc.stderr
     assert "Traceback" not in proc.stderr
+
+
+def test_a_closed_pipe_is_not_a_traceback():
+    """`rotordrop params | head -1`: the reader leaves early; no BrokenPipeError traceback."""
+    proc = subprocess.run(f"{sys.executable} -m physics.cli params | head -1", shell=True,
+                          capture_output=True, text=True)
+    assert proc.stdout.count("\n") == 1
+    assert "Traceback" not in proc.stderr and "BrokenPipe" not in proc.stderr
