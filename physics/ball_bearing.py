@@ -31,6 +31,30 @@ def hertz_constant(R_x: float, R_y: float, E_red: float) -> float:
     return math.pi * k * E_red * math.sqrt(R * E_bar / (4.5 * F_bar ** 3))
 
 
+def contact_pressure_coef(R_x: float, R_y: float, E_red: float) -> float:
+    """c in p_max = c Q^(1/3): the largest Hertz pressure of a point contact under ball load Q
+    [Pa for N], p_max = 3 Q / (2 pi a b) with the Brewe-Hamrock semi-axes
+    a = (6 k^2 E Q R / (pi E'))^(1/3), b = (6 E Q R / (pi k E'))^(1/3)."""
+    R = 1.0 / (1.0 / R_x + 1.0 / R_y)
+    k = 1.0339 * (R_y / R_x) ** 0.636
+    E_bar = 1.0003 + 0.5968 * R_x / R_y
+    return 1.5 / math.pi * (math.pi ** 2 * E_red ** 2 / (36.0 * k * E_bar ** 2 * R ** 2)) ** (1.0 / 3.0)
+
+
+def raceway_radii(b) -> list[tuple[float, float]]:
+    """(R_x, R_y) of the inner and the outer ball-race contact of a bearing description."""
+    D, dm, Pd, f = b.ball_diameter, b.pitch_diameter, b.clearance, b.conformity
+    return [contact_radii(D, r_x, -f * D)
+            for r_x in ((dm - D - Pd / 2.0) / 2.0, -(dm + D + Pd / 2.0) / 2.0)]
+
+
+def max_contact_pressure(b, Q):
+    """Largest Hertz contact pressure [Pa] at either raceway for ball load(s) Q [N]."""
+    E_red = reduced_modulus(b.youngs_modulus, b.poisson)
+    c = max(contact_pressure_coef(R_x, R_y, E_red) for R_x, R_y in raceway_radii(b))
+    return c * np.cbrt(Q)
+
+
 @dataclass(frozen=True)
 class BearingConstants:
     """Everything the kernels need from a 6016-type bearing description."""
@@ -45,13 +69,9 @@ class BearingConstants:
 
 def bearing_constants(b, static_load: float) -> BearingConstants:
     """Constants for a :class:`physics.scene.Bearing` carrying ``static_load`` newtons."""
-    D, dm, Pd, f = b.ball_diameter, b.pitch_diameter, b.clearance, b.conformity
+    D, dm = b.ball_diameter, b.pitch_diameter
     E_red = reduced_modulus(b.youngs_modulus, b.poisson)
-    r_y = -f * D
-    races = []
-    for r_x in ((dm - D - Pd / 2.0) / 2.0, -(dm + D + Pd / 2.0) / 2.0):   # inner, outer raceway
-        R_x, R_y = contact_radii(D, r_x, r_y)
-        races.append((R_x, R_y, hertz_constant(R_x, R_y, E_red)))
+    races = [(R_x, R_y, hertz_constant(R_x, R_y, E_red)) for R_x, R_y in raceway_radii(b)]
     K_in, K_out = races[0][2], races[1][2]
     K_tot = (K_in ** (-2.0 / 3.0) + K_out ** (-2.0 / 3.0)) ** (-1.5)
 
@@ -97,10 +117,10 @@ def ball_forces(ux, uy, cage, n_balls, half_play, h, K_tot):
     """Sum of Hertz ball loads for inner-ring displacement (ux, uy) relative to the outer ring.
 
     delta_j = ux cos(b_j) + uy sin(b_j) - P_d/2 + h,  Q_j = K_tot delta_j^1.5 (delta_j > 0),
-    b_j = cage + 2 pi j / z. Returns (Fx, Fy, V, dV/dcage, sum Q_j): the force on the outer ring
-    (the inner ring gets the opposite), the stored energy sum K_tot delta^2.5/2.5, its cage-angle
-    derivative (work the planar model does not return as a torque) and dV/dh (both for the
-    energy audit).
+    b_j = cage + 2 pi j / z. Returns (Fx, Fy, V, dV/dcage, sum Q_j, max Q_j): the force on the
+    outer ring (the inner ring gets the opposite), the stored energy sum K_tot delta^2.5/2.5, its
+    cage-angle derivative (work the planar model does not return as a torque), dV/dh (both for
+    the energy audit) and the most heavily loaded ball's load (diagnostics).
     """
     c0 = math.cos(cage)
     s0 = math.sin(cage)
@@ -111,6 +131,7 @@ def ball_forces(ux, uy, cage, n_balls, half_play, h, K_tot):
     V = 0.0
     dV = 0.0
     qsum = 0.0
+    qmax = 0.0
     clear = half_play - h
     for _ in range(n_balls):
         d = ux * c0 + uy * s0 - clear
@@ -121,21 +142,9 @@ def ball_forces(ux, uy, cage, n_balls, half_play, h, K_tot):
             V += 0.4 * q * d
             dV += q * (-ux * s0 + uy * c0)
             qsum += q
+            qmax = max(qmax, q)
         c0, s0 = c0 * dc - s0 * ds, s0 * dc + c0 * ds
-    return fx, fy, V, dV, qsum
-
-
-@njit
-def ball_load_max(ux, uy, cage, n_balls, half_play, h, K_tot):
-    """Largest single-ball load Q_max [N] (diagnostics)."""
-    qmax = 0.0
-    clear = half_play - h
-    for j in range(n_balls):
-        b = cage + 2.0 * math.pi * j / n_balls
-        d = ux * math.cos(b) + uy * math.sin(b) - clear
-        if d > 0.0:
-            qmax = max(qmax, K_tot * d * math.sqrt(d))
-    return qmax
+    return fx, fy, V, dV, qsum, qmax
 
 
 @njit

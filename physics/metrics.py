@@ -5,7 +5,8 @@ import math
 
 import numpy as np
 
-from .model import PLANES
+from .ball_bearing import max_contact_pressure
+from .model import F_RB, PLANES, RB_SM
 from .results import Result
 
 WHIRL_MIN_REVOLUTIONS = 3.0     # net backward orbit revolutions that make a backward whirl
@@ -66,15 +67,23 @@ def retainer_loading(result: Result, plane: str, post: np.ndarray) -> dict:
     static safety factor s_0 = C_0 / P_0 (ISO 76, P_0 = the peak radial load; below about 1
     the races deform permanently), the friction heat generated at the rotor-sleeve contact
     (∫ F_mu v_slip dt, trapezoidal rule over the output samples; a net value, which the paper's
-    slip law can make negative, see ``Result.friction_power``) and the highest sleeve speed."""
+    slip law can make negative, see ``Result.friction_power``) and the highest sleeve speed.
+    With the Sopanen-Mikkola bearing also the most heavily loaded ball's peak load and its
+    largest Hertz contact pressure (either raceway; ISO 76 rates C_0 at 4 200 MPa, and about
+    4 000 MPa is the usual limit for permanent dents); None for the linear and rigid mounts,
+    which have no balls."""
     t = result.t[post]
     load = result.bearing_load(plane)[post]
     peak = float(load.max()) if len(load) else 0.0
     heat = result.friction_power(plane)[post]
     ws = result.sleeve_speed(plane)[post]
+    bearing = result.model.scene.bearing
+    q = float(result.max_ball_load(plane)[post].max()) if len(t) else 0.0
+    balls = result.model.I[F_RB] == RB_SM
     return dict(peak_bearing_load_N=peak,
-                static_safety_factor=(result.model.scene.bearing.static_load_rating / peak
-                                      if peak > 0.0 else None),
+                static_safety_factor=bearing.static_load_rating / peak if peak > 0.0 else None,
+                max_ball_load_N=q if balls else None,
+                max_contact_pressure_MPa=float(max_contact_pressure(bearing, q)) * 1e-6 if balls else None,
                 friction_heat_J=float(np.sum(0.5 * (heat[1:] + heat[:-1]) * np.diff(t))),
                 max_sleeve_speed_rpm=float(np.abs(ws).max() * RPM) if len(ws) else 0.0)
 
@@ -106,7 +115,9 @@ def compute_metrics(result: Result) -> dict:
     return out
 
 
-def worst_plane(metrics: dict, key: str) -> float:
+def worst_plane(metrics: dict, key: str) -> float | None:
     """The larger of the two retainer planes' values of a per-plane metric (``metrics["planes"]``
-    of :func:`compute_metrics`, e.g. ``"peak_contact_force_N"``)."""
-    return max(v[key] for v in metrics["planes"].values())
+    of :func:`compute_metrics`, e.g. ``"peak_contact_force_N"``); None where the metric is
+    (e.g. the ball loads of a linear retainer mount)."""
+    values = [v[key] for v in metrics["planes"].values()]
+    return None if any(v is None for v in values) else max(values)

@@ -67,7 +67,7 @@ U_AMB_POWER, U_CS1, U_CS2, U_AMB_DIRECT, U_ICMD, U_T_ON, U_REF0, N_U = 0, 1, 2, 
 
 # ------------------------------------------------------------------- diagnostics aux --
 # per plane k at aux[k*N_AUX_PLANE + j]
-(A_FR, A_FMU, A_DELTA, A_LOAD, A_WS, A_DRAG, A_PFRIC, N_AUX_PLANE) = range(8)
+(A_FR, A_FMU, A_DELTA, A_LOAD, A_WS, A_DRAG, A_PFRIC, A_QMAX, N_AUX_PLANE) = range(9)
 N_AUX = 2 * N_AUX_PLANE
 
 PLANES = ("RB1", "RB2")
@@ -384,6 +384,7 @@ def rhs(t, y, P, I, U, dy, aux):
         bfy = 0.0
         load = f_r
         qsum = 0.0
+        qmax = 0.0                               # most heavily loaded ball (SM bearing only)
         dh_dw = 0.0
         ux, uy = sx - hx, sy - hy
         uvx, uvy = svx - hvx, svy - hvy
@@ -393,7 +394,8 @@ def rhs(t, y, P, I, U, dy, aux):
             if I[F_FILM]:
                 h, dh_dw = film_thickness(ws, P[P_FILM])
             cage = P[P_CAGE] * y[i_th]
-            qx, qy, V, dV, qsum = ball_forces(ux, uy, cage, int(P[P_NB]), P[P_HALF_PLAY], h, P[P_KTOT])
+            qx, qy, V, dV, qsum, qmax = ball_forces(ux, uy, cage, int(P[P_NB]), P[P_HALF_PLAY], h,
+                                                    P[P_KTOT])
             bfx = -qx - P[P_CB] * uvx
             bfy = -qy - P[P_CB] * uvy
             load = math.sqrt(qx * qx + qy * qy)
@@ -456,6 +458,7 @@ def rhs(t, y, P, I, U, dy, aux):
         aux[o + A_WS] = ws
         aux[o + A_DRAG] = drag_t
         aux[o + A_PFRIC] = p_fric
+        aux[o + A_QMAX] = qmax
 
     # rotor equations of motion
     dy[I[S_X]] = vx
@@ -545,8 +548,8 @@ def mechanical_energy(y, P, I):
         ux, uy = sx - hx, sy - hy
         if I[F_RB] == RB_SM:
             h = film_thickness(ws, P[P_FILM])[0] if I[F_FILM] else 0.0
-            _, _, V, _, _ = ball_forces(ux, uy, P[P_CAGE] * y[I[base + J_TH]], int(P[P_NB]),
-                                        P[P_HALF_PLAY], h, P[P_KTOT])
+            _, _, V, _, _, _ = ball_forces(ux, uy, P[P_CAGE] * y[I[base + J_TH]], int(P[P_NB]),
+                                           P[P_HALF_PLAY], h, P[P_KTOT])
             E += V
         elif I[F_RB] == RB_LINEAR:
             E += 0.5 * P[P_KLIN] * (ux * ux + uy * uy)

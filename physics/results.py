@@ -5,8 +5,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .model import (A_DELTA, A_DRAG, A_FMU, A_FR, A_LOAD, A_PFRIC, A_WS, I_PLANES, J_HX, J_SX,
-                    N_AUX_PLANE, N_PLANE_IDX, P_Z_RB1, PLANES, S_EDISS, S_W, S_WEXT, S_X, Model, energies)
+from .model import (A_DELTA, A_DRAG, A_FMU, A_FR, A_LOAD, A_PFRIC, A_QMAX, A_WS, I_PLANES, J_HX,
+                    J_SX, N_AUX_PLANE, N_PLANE_IDX, P_Z_RB1, PLANES, S_EDISS, S_W, S_WEXT, S_X, Model, energies)
 
 
 @dataclass
@@ -94,6 +94,10 @@ class Result:
     def drag_torque(self, plane: str) -> np.ndarray:
         return self._aux(plane, A_DRAG)
 
+    def max_ball_load(self, plane: str) -> np.ndarray:
+        """Load on the most heavily loaded ball [N] (Sopanen-Mikkola bearing; zero otherwise)."""
+        return self._aux(plane, A_QMAX)
+
     def friction_power(self, plane: str) -> np.ndarray:
         """Power dissipated by the rotor-sleeve contact friction, F_mu times the slip speed
         r Omega + v_t - R omega_s [W] (the heat generated at the retainer's inner surface). Under
@@ -122,5 +126,6 @@ class Result:
                          f"{p}_friction_force": self.friction_force(p),
                          f"{p}_sleeve_speed": self.sleeve_speed(p),
                          f"{p}_bearing_load": self.bearing_load(p),
-                         f"{p}_friction_power": self.friction_power(p)})
+                         f"{p}_friction_power": self.friction_power(p),
+                         f"{p}_max_ball_load": self.max_ball_load(p)})
         np.savez_compressed(path, states=self.Y, state_names=np.array(self.model.names), **cols)

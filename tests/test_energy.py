@@ -89,6 +89,7 @@ def test_sleeve_spin_up_turns_half_the_friction_work_into_heat():
 def test_static_safety_factor_is_the_load_rating_over_the_peak_bearing_load():
     """s_0 = C_0 / P_0 (ISO 76); a whirl at least halves it (its loads are about twice the
     resting ones, spec §7) and the peak bearing load exceeds the static weight share."""
+    from physics.ball_bearing import max_contact_pressure
     from physics.metrics import compute_metrics
     rest = compute_metrics(simulate(load_scene("paper", {"contact.friction": 0.1}), t_end=0.4))
     whirl = compute_metrics(simulate(load_scene("paper", {"contact.friction": 0.6}), t_end=0.4))
@@ -100,5 +101,14 @@ def test_static_safety_factor_is_the_load_rating_over_the_peak_bearing_load():
                 scene.bearing.static_load_rating / e["peak_bearing_load_N"])
             assert e["peak_bearing_load_N"] > weight_share
     assert not rest["backward_whirl"] and whirl["backward_whirl"]
+    for m in (rest, whirl):                 # the worst ball: between F / Z and F, near 5 F / Z
+        for e in m["planes"].values():
+            F, Q = e["peak_bearing_load_N"], e["max_ball_load_N"]
+            assert F / scene.bearing.balls < Q < F
+            assert Q == pytest.approx(5.0 * F / scene.bearing.balls, rel=0.2)
+            assert e["max_contact_pressure_MPa"] == pytest.approx(
+                1e-6 * max_contact_pressure(scene.bearing, Q))
+    assert (whirl["planes"]["RB1"]["max_contact_pressure_MPa"]
+            > rest["planes"]["RB1"]["max_contact_pressure_MPa"])
     assert (whirl["planes"]["RB1"]["static_safety_factor"]
             < 0.5 * rest["planes"]["RB1"]["static_safety_factor"])

@@ -5,7 +5,8 @@ the support damping and the friction coefficient? Every grid cell is an ensemble
 ``members`` equally plausible drops (unbalance angle and fault time perturbed as in the paper
 study, :mod:`physics.study.ensemble`), because near the whirl threshold one drop per cell is a
 coin toss. Per cell: whirl probability, whirl revolutions, peak contact force, maximum
-displacement, peak retainer-bearing load and contact friction heat (worst retainer plane; median and range over the members), and the runs that
+displacement, peak retainer-bearing load, contact friction heat and ball-race contact pressure
+(worst retainer plane; median and range over the members that have it), and the runs that
 failed, with their errors (never dropped). Every run can be repeated with the ``rotordrop drop``
 command stored next to it.
 
@@ -37,7 +38,8 @@ MAX_RUNS = 20000
 PLANE_KPIS = {"whirl_revolutions": "whirl revolutions", "peak_contact_force_N": "peak contact force [N]",
               "max_displacement_um": "max displacement [µm]",
               "peak_bearing_load_N": "peak retainer-bearing load [N]",
-              "friction_heat_J": "contact friction heat [J]"}
+              "friction_heat_J": "contact friction heat [J]",
+              "max_contact_pressure_MPa": "max ball-race contact pressure [MPa]"}
 
 
 @dataclass(frozen=True)
@@ -132,9 +134,9 @@ def summarize_cell(outcomes: list[Outcome]) -> dict:
                errors=sorted({o.error.splitlines()[0] for o in outcomes if not o.ok}),
                whirl_probability=float(np.mean([o.metrics["backward_whirl"] for o in ok])) if ok else None)
     for key in PLANE_KPIS:
-        vals = np.array([worst_plane(o.metrics, key) for o in ok])
+        vals = np.array([v for v in (worst_plane(o.metrics, key) for o in ok) if v is not None])
         out[key] = dict(median=float(np.median(vals)), min=float(vals.min()),
-                        max=float(vals.max())) if ok else None
+                        max=float(vals.max())) if len(vals) else None
     return out
 
 
