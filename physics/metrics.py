@@ -12,6 +12,7 @@ from .results import Result
 WHIRL_MIN_REVOLUTIONS = 3.0     # net backward orbit revolutions that make a backward whirl
 WHIRL_RADIUS_FRACTION = 0.5     # only orbit samples beyond this fraction of the clearance count
 RPM = 30.0 / math.pi            # rad/s -> rpm
+ISO76_C0_PRESSURE = 4.2e9       # Pa: contact pressure at the static load rating C_0 (ball bearings)
 
 
 def first_contact_time(result: Result) -> float | None:
@@ -62,6 +63,13 @@ def whirl(result: Result, plane: str, after: float) -> dict:
                 whirl_sampling_aliased=aliased)
 
 
+def friction_heat(result: Result, plane: str, post: np.ndarray) -> np.ndarray:
+    """Cumulative heat [J] generated at the rotor-sleeve contact over the samples ``post``
+    (trapezoidal rule on ``Result.friction_power``); its last value is ``friction_heat_J``."""
+    p, t = result.friction_power(plane)[post], result.t[post]
+    return np.concatenate(([0.0], np.cumsum(0.5 * (p[1:] + p[:-1]) * np.diff(t))))[:len(t)]
+
+
 def retainer_loading(result: Result, plane: str, post: np.ndarray) -> dict:
     """Retainer-bearing design numbers after the fault: the peak radial bearing load and the
     static safety factor s_0 = C_0 / P_0 (ISO 76, P_0 = the peak radial load; below about 1
@@ -69,13 +77,12 @@ def retainer_loading(result: Result, plane: str, post: np.ndarray) -> dict:
     (∫ F_mu v_slip dt, trapezoidal rule over the output samples; a net value, which the paper's
     slip law can make negative, see ``Result.friction_power``) and the highest sleeve speed.
     With the Sopanen-Mikkola bearing also the most heavily loaded ball's peak load and its
-    largest Hertz contact pressure (either raceway; ISO 76 rates C_0 at 4 200 MPa, and about
+    largest Hertz contact pressure (either raceway; ISO 76 rates C_0 at ``ISO76_C0_PRESSURE``, and about
     4 000 MPa is the usual limit for permanent dents); None for the linear and rigid mounts,
     which have no balls."""
     t = result.t[post]
     load = result.bearing_load(plane)[post]
     peak = float(load.max()) if len(load) else 0.0
-    heat = result.friction_power(plane)[post]
     ws = result.sleeve_speed(plane)[post]
     bearing = result.model.scene.bearing
     q = float(result.max_ball_load(plane)[post].max()) if len(t) else 0.0
@@ -84,7 +91,7 @@ def retainer_loading(result: Result, plane: str, post: np.ndarray) -> dict:
                 static_safety_factor=bearing.static_load_rating / peak if peak > 0.0 else None,
                 max_ball_load_N=q if balls else None,
                 max_contact_pressure_MPa=float(max_contact_pressure(bearing, q)) * 1e-6 if balls else None,
-                friction_heat_J=float(np.sum(0.5 * (heat[1:] + heat[:-1]) * np.diff(t))),
+                friction_heat_J=float(friction_heat(result, plane, post)[-1]) if len(t) else 0.0,
                 max_sleeve_speed_rpm=float(np.abs(ws).max() * RPM) if len(ws) else 0.0)
 
 

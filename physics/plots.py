@@ -73,12 +73,49 @@ def plot_housing(result: Result, path: Path, title: str = "") -> Path:
                             path, lw=0.6, ncol=2)
 
 
+def plot_retainer(result: Result, path: Path, title: str = "") -> Path:
+    """Retainer-bearing loading after the fault: bearing load (and the worst ball's load), the
+    worst ball-race Hertz pressure against ISO 76's C_0 level (Sopanen-Mikkola bearing only),
+    and the cumulative friction heat at the rotor-sleeve contact (physics.metrics)."""
+    from .ball_bearing import max_contact_pressure
+    from .metrics import ISO76_C0_PRESSURE, friction_heat
+    from .model import F_RB, RB_SM
+    post = result.t >= (result.t_fault or 0.0)
+    t = result.t[post]
+    balls = result.model.I[F_RB] == RB_SM
+    bearing = result.model.scene.bearing
+    fig, axes = plt.subplots(3 if balls else 2, 1, figsize=(9, 8 if balls else 5.5), sharex=True,
+                             constrained_layout=True)
+    for i, p in enumerate(PLANES):
+        load = result.bearing_load(p)[post]
+        axes[0].plot(t, load, lw=0.6, color=f"C{i}",
+                     label=f"{p} bearing load (s0 = {bearing.static_load_rating / max(load.max(), 1e-9):.1f})")
+        if balls:
+            q = result.max_ball_load(p)[post]
+            axes[0].plot(t, q, lw=0.6, ls="--", color=f"C{i}", label=f"{p} worst ball")
+            axes[1].plot(t, 1e-6 * max_contact_pressure(bearing, q), lw=0.6, color=f"C{i}", label=p)
+        axes[-1].plot(t, friction_heat(result, p, post), lw=1.0, color=f"C{i}", label=p)
+    axes[0].set_ylabel("load [N]")
+    axes[0].set_title(f"Retainer-bearing loading {title}".strip())
+    if balls:
+        axes[1].axhline(ISO76_C0_PRESSURE * 1e-6, color="k", ls=":", lw=0.8,
+                        label="ISO 76 static rating level")
+        axes[1].set_ylabel("worst ball-race pressure [MPa]")
+    axes[-1].set_ylabel("contact friction heat [J]")
+    axes[-1].set_xlabel("time [s]")
+    for ax in axes:
+        ax.legend(fontsize=7, ncol=2)
+        ax.grid(alpha=0.3)
+    return save_figure(fig, path)
+
+
 def plot_drop(result: Result, out_dir: Path, title: str = "") -> list[Path]:
     out_dir = Path(out_dir)
     return [plot_orbits(result, out_dir / "orbits.png", title),
             plot_forces(result, out_dir / "contact_forces.png", title),
             plot_speeds(result, out_dir / "speeds.png", title),
-            plot_housing(result, out_dir / "housing.png", title)]
+            plot_housing(result, out_dir / "housing.png", title),
+            plot_retainer(result, out_dir / "retainer.png", title)]
 
 
 def save_figure(fig, path: Path) -> Path:

@@ -23,7 +23,7 @@ def test_drop_writes_metrics_timeseries_and_plots(tmp_path, capsys):
                     "whirl_frequency_hz", "final_sleeve_speed_rpm"):
             assert key in m["planes"][p]
     assert 300 < m["planes"]["RB1"]["max_displacement_um"] < 700
-    for png in ("orbits.png", "contact_forces.png", "speeds.png"):
+    for png in ("orbits.png", "contact_forces.png", "speeds.png", "retainer.png"):
         assert (out / png).stat().st_size > 10_000
     ts = np.load(out / "timeseries.npz")
     assert ts["t"][-1] == 0.2 and ts["RB1_contact_force"].max() == m["planes"]["RB1"]["peak_contact_force_N"]
