@@ -22,23 +22,27 @@ def contact_radii(D: float, r_x: float, r_y: float) -> tuple[float, float]:
     return 1.0 / (2.0 / D + 1.0 / r_x), 1.0 / (2.0 / D + 1.0 / r_y)
 
 
+def brewe_hamrock(R_x: float, R_y: float) -> tuple[float, float, float, float]:
+    """(R, k, E, F) of a point contact: the curvature sum R = (1/R_x + 1/R_y)^-1 and the
+    Brewe-Hamrock fits of the ellipticity k = a/b and of the elliptic integrals E and F."""
+    return (1.0 / (1.0 / R_x + 1.0 / R_y), 1.0339 * (R_y / R_x) ** 0.636,
+            1.0003 + 0.5968 * R_x / R_y, 1.5277 + 0.6023 * math.log(R_y / R_x))
+
+
 def hertz_constant(R_x: float, R_y: float, E_red: float) -> float:
     """Brewe-Hamrock point-contact constant K in Q = K delta^1.5 [N/m^1.5]."""
-    R = 1.0 / (1.0 / R_x + 1.0 / R_y)
-    k = 1.0339 * (R_y / R_x) ** 0.636
-    E_bar = 1.0003 + 0.5968 * R_x / R_y
-    F_bar = 1.5277 + 0.6023 * math.log(R_y / R_x)
+    R, k, E_bar, F_bar = brewe_hamrock(R_x, R_y)
     return math.pi * k * E_red * math.sqrt(R * E_bar / (4.5 * F_bar ** 3))
 
 
 def contact_pressure_coef(R_x: float, R_y: float, E_red: float) -> float:
     """c in p_max = c Q^(1/3): the largest Hertz pressure of a point contact under ball load Q
     [Pa for N], p_max = 3 Q / (2 pi a b) with the Brewe-Hamrock semi-axes
-    a = (6 k^2 E Q R / (pi E'))^(1/3), b = (6 E Q R / (pi k E'))^(1/3)."""
-    R = 1.0 / (1.0 / R_x + 1.0 / R_y)
-    k = 1.0339 * (R_y / R_x) ** 0.636
-    E_bar = 1.0003 + 0.5968 * R_x / R_y
-    return 1.5 / math.pi * (math.pi ** 2 * E_red ** 2 / (36.0 * k * E_bar ** 2 * R ** 2)) ** (1.0 / 3.0)
+    a = (6 k^2 E Q R / (pi E'))^(1/3), b = (6 E Q R / (pi k E'))^(1/3) (R, k, E from
+    :func:`brewe_hamrock`, E' = ``E_red``; the ellipse of :func:`hertz_constant`)."""
+    R, k, E_bar, _ = brewe_hamrock(R_x, R_y)
+    return 1.5 / math.pi * (math.pi ** 2 * E_red ** 2
+                            / (36.0 * k * E_bar ** 2 * R ** 2)) ** (1.0 / 3.0)
 
 
 def raceway_radii(b) -> list[tuple[float, float]]:
@@ -81,7 +85,7 @@ def bearing_constants(b, static_load: float) -> BearingConstants:
     G = b.pressure_viscosity * E_red
     film_coef = 0.0
     for R_x, R_y, _ in races:
-        k = 1.0339 * (R_y / R_x) ** 0.636
+        k = brewe_hamrock(R_x, R_y)[1]
         U_per_omega = b.viscosity * (dm * dm - D * D) / (4.0 * dm) / (E_red * R_x)
         W = Q_n / (E_red * R_x * R_x)
         film_coef += (2.69 * R_x * U_per_omega ** 0.67 * G ** 0.53 * W ** -0.067

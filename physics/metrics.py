@@ -77,9 +77,9 @@ def retainer_loading(result: Result, plane: str, post: np.ndarray) -> dict:
     (∫ F_mu v_slip dt, trapezoidal rule over the output samples; a net value, which the paper's
     slip law can make negative, see ``Result.friction_power``) and the highest sleeve speed.
     With the Sopanen-Mikkola bearing also the most heavily loaded ball's peak load and its
-    largest Hertz contact pressure (either raceway; ISO 76 rates C_0 at ``ISO76_C0_PRESSURE``, and about
-    4 000 MPa is the usual limit for permanent dents); None for the linear and rigid mounts,
-    which have no balls."""
+    largest Hertz contact pressure (either raceway; ISO 76 rates C_0 at ``ISO76_C0_PRESSURE``,
+    the pressure that leaves a permanent dent of 1e-4 ball diameters); None for the linear and
+    rigid mounts, which have no balls."""
     t = result.t[post]
     load = result.bearing_load(plane)[post]
     peak = float(load.max()) if len(load) else 0.0
@@ -124,7 +124,7 @@ def compute_metrics(result: Result) -> dict:
 
 def worst_plane(metrics: dict, key: str) -> float | None:
     """The larger of the two retainer planes' values of a per-plane metric (``metrics["planes"]``
-    of :func:`compute_metrics`, e.g. ``"peak_contact_force_N"``); None where the metric is
+    of :func:`compute_metrics`, e.g. ``"peak_contact_force_N"``); None where the metric is None
     (e.g. the ball loads of a linear retainer mount)."""
     values = [v[key] for v in metrics["planes"].values()]
     return None if any(v is None for v in values) else max(values)

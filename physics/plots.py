@@ -9,8 +9,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .metrics import RPM  # noqa: E402
-from .model import PLANES  # noqa: E402
+from .ball_bearing import max_contact_pressure  # noqa: E402
+from .metrics import ISO76_C0_PRESSURE, RPM, friction_heat, retainer_loading  # noqa: E402
+from .model import F_RB, PLANES, RB_SM  # noqa: E402
 from .results import Result  # noqa: E402
 
 
@@ -74,12 +75,10 @@ def plot_housing(result: Result, path: Path, title: str = "") -> Path:
 
 
 def plot_retainer(result: Result, path: Path, title: str = "") -> Path:
-    """Retainer-bearing loading after the fault: bearing load (and the worst ball's load), the
-    worst ball-race Hertz pressure against ISO 76's C_0 level (Sopanen-Mikkola bearing only),
-    and the cumulative friction heat at the rotor-sleeve contact (physics.metrics)."""
-    from .ball_bearing import max_contact_pressure
-    from .metrics import ISO76_C0_PRESSURE, friction_heat
-    from .model import F_RB, RB_SM
+    """Retainer-bearing loading after the fault (the whole run without one): bearing load (and
+    the worst ball's load), the worst ball-race Hertz pressure against ISO 76's C_0 level
+    (Sopanen-Mikkola bearing only) and the cumulative friction heat at the rotor-sleeve contact
+    (physics.metrics). The legend's s0 is over the plotted samples ("-" without load)."""
     post = result.t >= (result.t_fault or 0.0)
     t = result.t[post]
     balls = result.model.I[F_RB] == RB_SM
@@ -87,9 +86,9 @@ def plot_retainer(result: Result, path: Path, title: str = "") -> Path:
     fig, axes = plt.subplots(3 if balls else 2, 1, figsize=(9, 8 if balls else 5.5), sharex=True,
                              constrained_layout=True)
     for i, p in enumerate(PLANES):
-        load = result.bearing_load(p)[post]
-        axes[0].plot(t, load, lw=0.6, color=f"C{i}",
-                     label=f"{p} bearing load (s0 = {bearing.static_load_rating / max(load.max(), 1e-9):.1f})")
+        s0 = retainer_loading(result, p, post)["static_safety_factor"]
+        axes[0].plot(t, result.bearing_load(p)[post], lw=0.6, color=f"C{i}",
+                     label=f"{p} bearing load (s0 = {'-' if s0 is None else f'{s0:.1f}'})")
         if balls:
             q = result.max_ball_load(p)[post]
             axes[0].plot(t, q, lw=0.6, ls="--", color=f"C{i}", label=f"{p} worst ball")

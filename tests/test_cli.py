@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from physics.cli import main
+from physics.metrics import worst_plane
 
 
 def test_drop_writes_metrics_timeseries_and_plots(tmp_path, capsys):
@@ -29,12 +30,30 @@ def test_drop_writes_metrics_timeseries_and_plots(tmp_path, capsys):
     assert ts["t"][-1] == 0.2 and ts["RB1_contact_force"].max() == m["planes"]["RB1"]["peak_contact_force_N"]
     post = ts["t"] >= m["t_fault_s"]                  # the retainer metrics come from the same series
     assert ts["RB1_bearing_load"][post].max() == m["planes"]["RB1"]["peak_bearing_load_N"]
+    assert ts["RB1_max_ball_load"][post].max() == m["planes"]["RB1"]["max_ball_load_N"] > 0.0
     p, t = ts["RB1_friction_power"][post], ts["t"][post]
     assert m["planes"]["RB1"]["friction_heat_J"] == pytest.approx(
         float(np.sum(0.5 * (p[1:] + p[:-1]) * np.diff(t))), rel=1e-12)
     assert m["planes"]["RB1"]["friction_heat_J"] > 0.0
     assert "contact.friction" not in capsys.readouterr().err
     assert "friction = 0.1" in (out / "scene.toml").read_text()
+
+
+def test_drop_without_balls_or_fault_has_no_ball_metrics(tmp_path):
+    """A rigid retainer mount has no balls (ball load and pressure None) and, with the AMBs
+    still on at the end, no contact: no bearing load, so no safety factor either."""
+    out = tmp_path / "rigid"
+    assert main(["drop", "--t-end", "0.05", "--set", "effects.retainer_bearing=rigid", "--set",
+                 "amb.off_time=0.5", "--out", str(out), "--quiet"]) == 0
+    m = json.loads((out / "metrics.json").read_text())
+    assert m["t_fault_s"] is None
+    for e in m["planes"].values():
+        assert e["max_ball_load_N"] is None and e["max_contact_pressure_MPa"] is None
+        assert e["peak_bearing_load_N"] == 0.0 and e["static_safety_factor"] is None
+        assert e["friction_heat_J"] == 0.0
+    assert worst_plane(m, "max_contact_pressure_MPa") is None
+    assert (out / "retainer.png").stat().st_size > 10_000
+    assert not np.load(out / "timeseries.npz")["RB1_max_ball_load"].any()
 
 
 def test_params_lists_every_key(capsys):

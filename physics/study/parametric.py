@@ -128,7 +128,8 @@ def plan_runs(source: str, overrides: dict, axes: list[Axis], members: int, seed
 
 
 def summarize_cell(outcomes: list[Outcome]) -> dict:
-    """Whirl probability and the median / min / max of each plane KPI over the members that ran."""
+    """Whirl probability and the median / min / max of each plane KPI over the members that ran
+    and have it (None where none has it, e.g. the ball-race pressure of a linear mount)."""
     ok = [o for o in outcomes if o.ok]
     out = dict(members=len(outcomes), failed=len(outcomes) - len(ok),
                errors=sorted({o.error.splitlines()[0] for o in outcomes if not o.ok}),
