@@ -193,7 +193,7 @@ def test_parametric_sweep_grid_values_and_errors():
                        (["contact.friction=,"], "contact.friction: no values"),
                        (["bearing.balls=8:9:0.5"], r"bearing.balls = '8.5' .*\[3, 100\]"),
                        (["contact.friction=0.2", "contact.friction=0.3"], "contact.friction is given twice"),
-                       (["a.b=1", "c.d=2", "e.f=3"], "1 or 2 keys")):
+                       (["a.b=1", "c.d=2", "e.f=3", "g.h=4"], "1 to 3 keys")):
         with pytest.raises(SceneError, match=words):
             make_axes("paper", {}, bad)
     with pytest.raises(SceneError, match="both varied"):
@@ -223,3 +223,20 @@ def test_parametric_sweep_reports_failed_drops(tmp_path):
     assert all("--set solver.max_steps=100" in run["command"] for run in r["runs"])
     assert (out / "sweep.csv").read_text().splitlines()[1] == "0.2,2,2" + "," * (1 + 3 * len(PLANE_KPIS))
     assert (out / "sweep.png").is_file()
+
+
+def test_parametric_sweep_over_three_keys_maps_the_first_two_per_value_of_the_third(tmp_path):
+    """The classic retainer design map: a soft support (K_s = 5e6) keeps the rotor out of
+    whirl at mu = 0.45 where the paper's 5e7 whirls (paper §V-B trend)."""
+    out = tmp_path / "sw3"
+    assert cli_main(["study", "sweep", "--vary", "support.stiffness=5e6,5e7",
+                     "--vary", "support.damping=5000", "--vary", "contact.friction=0.1,0.45",
+                     "--members", "2", "--jobs", "1", "--quiet", "--out", str(out)]) == 0
+    r = json.loads((out / "sweep.json").read_text())
+    assert len(r["cells"]) == 4 and list(r["axes"]) == ["support.stiffness", "support.damping",
+                                                        "contact.friction"]
+    cell = {(c["support.stiffness"], c["contact.friction"]): c["whirl_probability"] for c in r["cells"]}
+    assert cell[(5e6, 0.45)] == 0.0 and cell[(5e7, 0.45)] == 1.0
+    assert cell[(5e6, 0.1)] == cell[(5e7, 0.1)] == 0.0
+    assert (out / "sweep_1.png").is_file() and (out / "sweep_2.png").is_file()
+    assert not (out / "sweep.png").exists()

@@ -4,7 +4,7 @@
 studies of Kärkkäinen, Sopanen & Mikkola §V (friction, support stiffness, support damping), the
 claims table and the sensitivity to every assumed parameter. ``rotordrop study sweep --vary
 KEY=VALUES [--vary KEY=VALUES] [--members N]`` is a parameter study of the passive drop over one
-or two scene keys (:mod:`physics.study.parametric`). Registration is light: the heavy
+to three scene keys (:mod:`physics.study.parametric`). Registration is light: the heavy
 modules are imported by the handler.
 """
 from __future__ import annotations
@@ -23,11 +23,11 @@ def register(subparsers) -> None:
     q.add_argument("--quiet", action="store_true", help="no progress bar")
     q.set_defaults(func=cmd_study_paper)
 
-    q = sub.add_parser("sweep", help="a parameter study of the passive drop over 1 or 2 scene keys, "
+    q = sub.add_parser("sweep", help="a parameter study of the passive drop over 1 to 3 scene keys, "
                                      "an ensemble of drops per cell")
     add_scene_args(q)
     q.add_argument("--vary", action="append", default=[], metavar="KEY=VALUES", required=True,
-                   help="a scene key and its values: KEY=V1,V2,... or KEY=LO:HI:STEP (1 or 2 times), "
+                   help="a scene key and its values: KEY=V1,V2,... or KEY=LO:HI:STEP (1 to 3 times; a third key gives one map per value), "
                         "e.g. --vary support.damping=2790,27900,1e5 --vary contact.friction=0.3:0.6:0.05")
     q.add_argument("--members", type=int, default=8,
                    help="drops per cell, unbalance angle and fault time perturbed (default 8)")

@@ -1,4 +1,4 @@
-"""``rotordrop study sweep``: a parameter study of the passive drop over one or two scene keys.
+"""``rotordrop study sweep``: a parameter study of the passive drop over one to three scene keys.
 
 For retainer-bearing design: how do whirl, contact force and displacement change with, say,
 the support damping and the friction coefficient? Every grid cell is an ensemble of
@@ -32,7 +32,7 @@ from ..sweep import Outcome, Run, default_jobs, run_sweep
 from .ensemble import perturbations
 
 ENSEMBLE_KEYS = ("unbalance.angle_deg", "amb.off_time")
-MAX_KEYS = 2
+MAX_KEYS = 3
 MAX_VALUES = 1000       # per key
 MAX_RUNS = 20000
 PLANE_KPIS = {"whirl_revolutions": "whirl revolutions", "peak_contact_force_N": "peak contact force [N]",
@@ -87,7 +87,7 @@ def make_axes(source: str, overrides: dict, vary: list[str]) -> list[Axis]:
     """Validated axes: every value is coerced and range-checked by the scene now, before any
     run starts (a bad value names the key and its allowed range)."""
     if not 1 <= len(vary) <= MAX_KEYS:
-        raise SceneError(f"study sweep varies 1 or {MAX_KEYS} keys (--vary), got {len(vary)}")
+        raise SceneError(f"study sweep varies 1 to {MAX_KEYS} keys (--vary), got {len(vary)}")
     axes = []
     for text in vary:
         key, raw = parse_vary(text)
@@ -165,9 +165,23 @@ def run_parametric(source: str, overrides: dict, vary: list[str], out_dir, membe
     write_csv(report, out / "sweep.csv")
     report["files"] = ["sweep.json", "sweep.csv"]
     if plots:
-        from .report import plot_parametric
-        report["files"].append(plot_parametric(report, axes, out))
+        report["files"] += plot_files(report, axes, out)
     return report
+
+
+def plot_files(report: dict, axes: list[Axis], out: Path) -> list[str]:
+    """``sweep.png`` for one or two keys; with a third key one map of the first two per value
+    of the third (``sweep_1.png``, ``sweep_2.png``, ... in the order of its values)."""
+    from .report import plot_parametric
+    if len(axes) < 3:
+        return [plot_parametric(report, axes, out)]
+    third = axes[2]
+    files = []
+    for i, v in enumerate(third.values, 1):
+        part = dict(report, cells=[c for c in report["cells"] if c[third.key] == v],
+                    scene=f"{report['scene']}, {third.key} = {value_label(v)}")
+        files.append(plot_parametric(part, axes[:2], out, f"sweep_{i}.png"))
+    return files
 
 
 def write_csv(report: dict, path: Path) -> None:

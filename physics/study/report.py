@@ -288,7 +288,7 @@ def write_report(a: dict, out: Path, figures: dict[str, list[str]], meta: dict) 
     return path
 
 
-def plot_parametric(report: dict, axes, out: Path) -> str:
+def plot_parametric(report: dict, axes, out: Path, name: str = "sweep.png") -> str:
     """``rotordrop study sweep``: whirl probability, peak contact force and maximum displacement
     over the varied keys (1 key: curves with the members' range; 2 keys: annotated maps). Cells
     with failed drops are marked (an x on the curves, "k failed" in the maps); a statistic over
@@ -369,4 +369,4 @@ def plot_parametric(report: dict, axes, out: Path) -> str:
             ax.set_ylabel(b.key)
             ax.set_title(label + ("" if key == "whirl_probability" else ", median"), fontsize=9)
         fig.suptitle(title, fontsize=10)
-    return _save(fig, out / "sweep.png")
+    return _save(fig, out / name)
