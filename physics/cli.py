@@ -73,17 +73,27 @@ def summary_table(m: dict) -> str:
              f"first contact {fc * 1e3:.2f} ms after the fault" if fc is not None else "no contact",
              f"final rotor speed {m['final_rotor_speed_rpm']:.0f} rpm",
              f"{'plane':6}{'max disp [µm]':>15}{'peak F_r [N]':>14}{'whirl':>7}{'f_whirl [Hz]':>14}"
-             f"{'sleeve [rpm]':>14}{'bearing s0':>12}{'friction heat [J]':>19}"]
+             f"{'sleeve [rpm]':>14}"]
     for p, v in m["planes"].items():
-        f, s0 = v["whirl_frequency_hz"], v["static_safety_factor"]
+        f = v["whirl_frequency_hz"]
         lines.append(f"{p:6}{v['max_displacement_um']:15.1f}{v['peak_contact_force_N']:14.0f}"
                      f"{'yes' if v['backward_whirl'] else 'no':>7}{f'{f:.1f}' if f else '-':>14}"
-                     f"{v['final_sleeve_speed_rpm']:14.0f}{f'{s0:.1f}' if s0 else '-':>12}"
+                     f"{v['final_sleeve_speed_rpm']:14.0f}")
+    lines.append(f"{'retainer':10}{'bearing load [N]':>17}{'s0':>7}{'worst ball [N]':>16}"
+                 f"{'p_max [MPa]':>13}{'friction heat [J]':>19}")
+    for p, v in m["planes"].items():
+        lines.append(f"{p:10}{v['peak_bearing_load_N']:17.0f}{_fmt(v['static_safety_factor'], '.1f'):>7}"
+                     f"{_fmt(v['max_ball_load_N'], '.0f'):>16}{_fmt(v['max_contact_pressure_MPa'], '.0f'):>13}"
                      f"{v['friction_heat_J']:19.0f}")
-    lines += ["bearing s0: static safety factor C_0 / peak bearing load (ISO 76)",
+    lines += ["s0: static safety factor C_0 / peak bearing load; p_max: Hertz pressure of the worst "
+              "ball (ISO 76 rates C_0 at 4 200 MPa)",
               "friction heat: generated at the rotor-sleeve contact after the fault (net: under the "
               "paper slip law the contact can also return energy)"]
     return "\n".join(lines)
+
+
+def _fmt(value, spec: str) -> str:
+    return "-" if value is None else format(value, spec)
 
 
 def cmd_params(args) -> int:
