@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from .benchmark import (PHASES, RELEVITATION_ENVS, Entry, Scenario, check_unique_names,
-                        controller_env_kwargs, episode_kwargs, task_of)
+                        controller_env_kwargs, episode_kwargs, run_label, task_of)
 from .controllers import BASELINES, Passive, command_for, controller_class, make_controller
 from .policies import load_shipped, resolve, shipped_names
 from .rollout import run_episodes
@@ -53,7 +53,8 @@ def _entry(spec: str, env_id: str) -> Entry:
     if trained_on != env_id:
         raise ValueError(f"policy {spec!r} was trained on {trained_on}, not on {env_id}; "
                          f"pass --env {trained_on}")
-    return Entry(policy.name, task, policy.bound, dict(policy.env_kwargs))
+    name = policy.name if spec in shipped_names() else f"{policy.name}@{run_label(spec)}"
+    return Entry(name, task, policy.bound, dict(policy.env_kwargs))
 
 
 def _check_grid(name: str, values, lo: float, hi: float, shown: float = 1.0) -> tuple[float, ...]:
