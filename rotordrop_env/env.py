@@ -10,7 +10,8 @@ import numpy as np
 
 from physics.amb import static_weight_share
 from physics.metrics import WHIRL_MIN_REVOLUTIONS, WHIRL_RADIUS_FRACTION
-from physics.model import P_Z_RB1, axis_motion
+from physics.ball_bearing import max_contact_pressure
+from physics.model import F_RB, P_Z_RB1, RB_SM, axis_motion
 from physics.scene import Scene, SceneError, load_scene
 from physics.simulate import IntegrationError, _explain
 
@@ -318,6 +319,7 @@ class RotorDropEnv(gym.Env):
                 "kpi_control_effort": float(M[K.M_EFFORT]),
                 "kpi_stator_contact": bool(out[K.O_STATOR]),
                 "kpi_bearing_overload": bool(out[K.O_OVERLOAD]),
+                **ball_kpis(self.model, self.scene, float(M[K.M_PEAK_Q])),
                 "kpi_episode_time_s": self.time}
 
     # ---------------------------------------------------------------------- rendering --
@@ -361,6 +363,15 @@ class RotorDropEnv(gym.Env):
 _INFO_KEYS = ("contact_force_N",) + tuple("reward_" + n for n in REWARD_TERMS)
 _INFO_COLS = [K.O_FORCE, *_O_TERMS]
 _info_values = operator.itemgetter(*_INFO_COLS)
+
+
+def ball_kpis(model, scene, q_max: float) -> dict:
+    """The worst ball's peak load and its Hertz contact pressure (``physics.metrics``'
+    retainer numbers, sampled at the KPI monitor's rate); NaN without Sopanen-Mikkola balls."""
+    if model.I[F_RB] != RB_SM:
+        return {"kpi_max_ball_load_N": math.nan, "kpi_max_contact_pressure_MPa": math.nan}
+    return {"kpi_max_ball_load_N": q_max,
+            "kpi_max_contact_pressure_MPa": float(max_contact_pressure(scene.bearing, q_max)) * 1e-6}
 
 
 def peak_kpis(M: np.ndarray) -> dict:

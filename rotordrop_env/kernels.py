@@ -20,7 +20,7 @@ import numba
 
 from physics._jit import njit, njit_parallel
 from physics.integrate import integrate_segment
-from physics.model import (A_FR, A_WS, I_AMB_FILT, I_AMB_INT, I_CS, N_AUX_PLANE, P_CLR,
+from physics.model import (A_FR, A_QMAX, A_WS, I_AMB_FILT, I_AMB_INT, I_CS, N_AUX_PLANE, P_CLR,
                            P_Z_AMB1, P_Z_RB1, S_W, U_AMB_DIRECT, U_AMB_POWER, U_CS1, U_ICMD,
                            U_REF0, U_T_ON, amb_currents, axis_motion, rhs, sleeve_motion)
 
@@ -34,7 +34,7 @@ LEV_NONE, LEV_DISCRETE, LEV_CONTINUOUS = 0, 1, 2
 
 # ------------------------------------------------------------------------------ monitor M --
 (M_T, M_H, M_REV1, M_REV2, M_WHIRL, M_PEAK_F, M_MAX_DISP, M_OK_START, M_RELEV,
- M_RELEV_T, M_EFFORT, M_CTRL_ON, M_POWER, M_REV_PEAK, N_M) = range(15)
+ M_RELEV_T, M_EFFORT, M_CTRL_ON, M_POWER, M_REV_PEAK, M_PEAK_Q, N_M) = range(16)
 
 # ------------------------------------------------------------------------------ outputs --
 (O_REWARD, O_R_WHIRL, O_R_CONTACT, O_R_DISP, O_R_EFFORT, O_R_SUCCESS, O_R_FAILURE, O_FORCE,
@@ -194,6 +194,7 @@ def step_one(a, y, P, I, U, atol, work, t_sub, Y_sub, aux, cur, C, M, scale, obs
     spin = 1.0 if y[I[S_W]] >= 0.0 else -1.0
     dts = dt / n_sub
     f_step = 0.0
+    q_step = 0.0
     disp_step = 0.0
     back = 0.0
     stator = False
@@ -206,6 +207,7 @@ def step_one(a, y, P, I, U, atol, work, t_sub, Y_sub, aux, cur, C, M, scale, obs
         for k in range(2):
             fr = aux[k * N_AUX_PLANE + A_FR]
             f_step = max(f_step, fr)
+            q_step = max(q_step, aux[k * N_AUX_PLANE + A_QMAX])
             px, py, pvx, pvy = axis_motion(ys, I, P[P_Z_RB1 + k])
             sx, sy, svx, svy = sleeve_motion(ys, I, k)
             r_abs = math.sqrt(px * px + py * py)
@@ -242,6 +244,7 @@ def step_one(a, y, P, I, U, atol, work, t_sub, Y_sub, aux, cur, C, M, scale, obs
         effort /= n_eff                          # mean squared normalised command
     M[M_T] = t1
     M[M_PEAK_F] = max(M[M_PEAK_F], f_step)
+    M[M_PEAK_Q] = max(M[M_PEAK_Q], q_step)
     M[M_MAX_DISP] = max(M[M_MAX_DISP], disp_step)
     M[M_REV_PEAK] = max(M[M_REV_PEAK], M[M_REV1], M[M_REV2])
     if M[M_REV_PEAK] >= C[C_WHIRL_REVS]:

@@ -7,6 +7,7 @@ import pytest
 
 import rotordrop_env
 from physics import compute_metrics, load_scene, simulate
+from physics.ball_bearing import max_contact_pressure
 from physics.scene import SceneError
 from rotordrop_env.scenario import DEFAULT_RANGES
 
@@ -108,6 +109,11 @@ def test_passive_env_reproduces_the_simulator(mu, whirl):
     d_max = max(np.hypot(*res.orbit(p)[post].T).max() for p in ("RB1", "RB2")) * 1e6
     assert info["kpi_max_displacement_um"] == pytest.approx(d_max, rel=0.01)
     assert info["kpi_backward_whirl"] is whirl and m["backward_whirl"] is whirl
+    # the retainer numbers: the worst ball's load, sampled every 0.2 ms against 50 µs
+    q_max = max(res.max_ball_load(p)[post].max() for p in ("RB1", "RB2"))
+    assert info["kpi_max_ball_load_N"] == pytest.approx(q_max, rel=0.02)
+    assert info["kpi_max_contact_pressure_MPa"] == pytest.approx(
+        1e-6 * max_contact_pressure(sv.bearing, info["kpi_max_ball_load_N"]), rel=1e-12)
     assert info["kpi_whirl_revolutions"] == pytest.approx(
         max(m["planes"][p]["whirl_revolutions"] for p in ("RB1", "RB2")), abs=0.1)
 
@@ -177,7 +183,8 @@ def test_time_limit_truncates_and_final_info_has_kpis():
     for _ in range(4):
         *_, info = env.step(0)
     for key in ("kpi_backward_whirl", "kpi_peak_contact_force_N", "kpi_max_displacement_um",
-                "kpi_relevitated", "kpi_relevitation_time_s", "kpi_control_effort"):
+                "kpi_relevitated", "kpi_relevitation_time_s", "kpi_control_effort",
+                "kpi_max_ball_load_N", "kpi_max_contact_pressure_MPa"):
         assert key in info
     assert info["kpi_relevitated"] is False and math.isnan(info["kpi_relevitation_time_s"])
 
