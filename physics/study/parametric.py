@@ -171,16 +171,22 @@ def run_parametric(source: str, overrides: dict, vary: list[str], out_dir, membe
 
 def plot_files(report: dict, axes: list[Axis], out: Path) -> list[str]:
     """``sweep.png`` for one or two keys; with a third key one map of the first two per value
-    of the third (``sweep_1.png``, ``sweep_2.png``, ... in the order of its values)."""
+    of the third (``sweep_1.png``, ``sweep_2.png``, ... in the order of its values), all on one
+    colour scale per quantity so that the maps compare."""
     from .report import plot_parametric
     if len(axes) < 3:
         return [plot_parametric(report, axes, out)]
     third = axes[2]
+    limits = {}                                  # one colour scale over all the maps
+    for key in ("peak_contact_force_N", "max_displacement_um"):
+        med = [c[key]["median"] for c in report["cells"] if c[key] is not None]
+        if med:
+            limits[key] = (min(med), max(med))
     files = []
     for i, v in enumerate(third.values, 1):
         part = dict(report, cells=[c for c in report["cells"] if c[third.key] == v],
                     scene=f"{report['scene']}, {third.key} = {value_label(v)}")
-        files.append(plot_parametric(part, axes[:2], out, f"sweep_{i}.png"))
+        files.append(plot_parametric(part, axes[:2], out, f"sweep_{i}.png", limits))
     return files
 
 

@@ -288,7 +288,8 @@ def write_report(a: dict, out: Path, figures: dict[str, list[str]], meta: dict) 
     return path
 
 
-def plot_parametric(report: dict, axes, out: Path, name: str = "sweep.png") -> str:
+def plot_parametric(report: dict, axes, out: Path, name: str = "sweep.png",
+                    limits: dict | None = None) -> str:
     """``rotordrop study sweep``: whirl probability, peak contact force and maximum displacement
     over the varied keys (1 key: curves with the members' range; 2 keys: annotated maps). Cells
     with failed drops are marked (an x on the curves, "k failed" in the maps); a statistic over
@@ -348,9 +349,8 @@ def plot_parametric(report: dict, axes, out: Path, name: str = "sweep.png") -> s
         F = failed.reshape(n_a, n_b).T
         for ax, (key, label) in zip(axs, panels):
             M = column(key).reshape(n_a, n_b).T
-            im = ax.imshow(M, origin="lower", aspect="auto", cmap="Reds",
-                           vmin=0.0 if key == "whirl_probability" else None,
-                           vmax=1.0 if key == "whirl_probability" else None)
+            lo, hi = (0.0, 1.0) if key == "whirl_probability" else (limits or {}).get(key, (None, None))
+            im = ax.imshow(M, origin="lower", aspect="auto", cmap="Reds", vmin=lo, vmax=hi)
             fig.colorbar(im, ax=ax, fraction=0.05)      # first: it settles the colour limits
             if annotate:
                 for j, i in np.ndindex(M.shape):
