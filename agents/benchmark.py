@@ -338,6 +338,7 @@ def _row(entry: Entry, sc: Scenario, eps) -> dict:
                 peak_whirl_revolutions=float(np.mean([d["peak_whirl_revolutions"] for d in k])),
                 peak_contact_force_N=s["peak_contact_force_N"],
                 max_displacement_um=s["max_displacement_um"],
+                max_contact_pressure_MPa=s["max_contact_pressure_MPa"],
                 relevitated=s["relevitation_success_rate"],
                 relevitation_time_s=s["relevitation_time_s"],
                 control_effort=s["control_effort"],

@@ -49,6 +49,7 @@ def summarize(episodes) -> dict:
                peak_contact_force_N_max=max((float(d["peak_contact_force_N"]) for d in k
                                              if d.get("peak_contact_force_N") is not None), default=None),
                max_displacement_um=mean_finite(d.get("max_displacement_um") for d in k),
+               max_contact_pressure_MPa=mean_finite(d.get("max_contact_pressure_MPa") for d in k),
                relevitation_success_rate=mean_finite(d.get("relevitated") for d in k),
                relevitation_time_s=mean_finite(d.get("relevitation_time_s") for d in k if d.get("relevitated")),
                control_effort=mean_finite(d.get("control_effort") for d in k),

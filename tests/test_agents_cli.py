@@ -49,10 +49,11 @@ def test_benchmark_quick_end_to_end(tmp_path):
     assert all(f >= 0.5 for f in fr[i:]) and (i == 0 or fr[i - 1] < 0.5)
     assert rep["scenarios"][0]["friction"] == pytest.approx(mu_star + 0.05)
     keys = {"controller", "scenario", "friction", "backward_whirl", "peak_contact_force_N",
-            "max_displacement_um"}
+            "max_displacement_um", "max_contact_pressure_MPa"}
     for row in rep["rows"]:
         assert keys <= set(row)
         assert row["episodes"] == 1
+        assert 100.0 < row["max_contact_pressure_MPa"] < 4200.0     # below the ISO 76 C_0 level
     board = {(e["task"], e["controller"]): e for e in rep["leaderboard"]}
     for task in ("damping", "relevitate"):
         assert board[(task, "passive")]["score"] == pytest.approx(0.0)
