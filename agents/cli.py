@@ -9,6 +9,27 @@ import sys
 from pathlib import Path
 
 
+ERRORS = (KeyError, ValueError, FileNotFoundError)      # bad input: one line, exit 2
+
+
+def _fail(command: str, exc: Exception) -> int:
+    print(f"rotordrop {command}: error: {exc.args[0] if exc.args else exc}", file=sys.stderr)
+    return 2
+
+
+def _wrote(out: str, files: list[str], wall_s: float | None = None) -> None:
+    print("wrote " + ", ".join(str(Path(out) / f) for f in files)
+          + (f" in {wall_s:.0f} s" if wall_s is not None else ""))
+
+
+def _power_return_s(args) -> float | None:
+    """--power-return-ms in seconds, checked in the unit typed (the envs allow 0-100 s)."""
+    ms = getattr(args, "power_return_ms", None)
+    if ms is not None and not 0.0 <= ms <= 1e5:
+        raise ValueError(f"--power-return-ms = {ms:g} must be in [0, 100000] ms")
+    return None if ms is None else 1e-3 * ms
+
+
 def _env_kwargs(args) -> dict:
     from physics.scene import parse_assignment
     kw = {}
@@ -16,12 +37,19 @@ def _env_kwargs(args) -> dict:
         kw["scene"] = args.scene
     if getattr(args, "overrides", None):
         kw["overrides"] = {k: _number(v) for k, v in map(parse_assignment, args.overrides)}
-    ms = getattr(args, "power_return_ms", None)
-    if ms is not None:
-        if not 0.0 <= ms <= 1e5:
-            raise ValueError(f"--power-return-ms = {ms:g} must be in [0, 100000] ms")
-        kw["power_return_time"] = 1e-3 * ms
+    power_return = _power_return_s(args)
+    if power_return is not None:
+        kw["power_return_time"] = power_return
     return kw
+
+
+def _output_args(p, default_out: str, progress: bool = True) -> None:
+    """--out, --no-plots (and --quiet where there is a progress bar), shared by the commands
+    that write reports."""
+    p.add_argument("--out", default=default_out, help="output directory")
+    p.add_argument("--no-plots", action="store_true", help="skip the PNG figures")
+    if progress:
+        p.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
 def _number(text: str):
@@ -53,9 +81,8 @@ def cmd_evaluate(args) -> int:
         report = evaluate(args.policy, args.env, args.episodes, args.out, env_kwargs=_env_kwargs(args),
                           seed=args.seed, plots=not args.no_plots, compare_passive=not args.no_passive,
                           randomize=not args.fixed)
-    except (KeyError, ValueError, FileNotFoundError) as exc:
-        print(f"rotordrop evaluate: error: {exc.args[0] if exc.args else exc}", file=sys.stderr)
-        return 2
+    except ERRORS as exc:
+        return _fail("evaluate", exc)
     print_summary(report)
     return 0
 
@@ -65,10 +92,9 @@ def cmd_benchmark(args) -> int:
     try:
         benchmark(args.out, quick=args.quick, policies=args.policy, max_scenarios=args.scenarios,
                   episodes=args.episodes, progress=not args.quiet, plots=not args.no_plots,
-                  power_return=None if args.power_return_ms is None else 1e-3 * args.power_return_ms)
-    except (KeyError, ValueError, FileNotFoundError) as exc:
-        print(f"rotordrop benchmark: error: {exc.args[0] if exc.args else exc}", file=sys.stderr)
-        return 2
+                  power_return=_power_return_s(args))
+    except ERRORS as exc:
+        return _fail("benchmark", exc)
     return 0
 
 
@@ -82,14 +108,12 @@ def cmd_ride_through(args) -> int:
                               delays=[d * 1e-3 for d in args.delay_ms] if args.delay_ms else grid["delays"],
                               phases=args.phase or grid["phases"], progress=not args.quiet,
                               plots=not args.no_plots)
-    except (KeyError, ValueError, FileNotFoundError) as exc:
-        print(f"rotordrop ride-through: error: {exc.args[0] if exc.args else exc}", file=sys.stderr)
-        return 2
+    except ERRORS as exc:
+        return _fail("ride-through", exc)
     print(f"ride-through time (longest power-return delay with no backward whirl and "
           f"re-levitation in every phase), {report['env_id']}:")
     print(summary_table(report))
-    print("wrote " + ", ".join(str(Path(args.out) / f) for f in report["files"])
-          + f" in {report['wall_time_s']:.0f} s")
+    _wrote(args.out, report["files"], report["wall_time_s"])
     return 0
 
 
@@ -99,13 +123,12 @@ def cmd_tune(args) -> int:
         r = tune(args.policy, args.env, args.gain, args.out, iterations=args.iterations,
                  population=args.population, elite=args.elite, seed=args.seed,
                  progress=not args.quiet, plots=not args.no_plots)
-    except (KeyError, ValueError, FileNotFoundError) as exc:
-        print(f"rotordrop tune: error: {exc.args[0] if exc.args else exc}", file=sys.stderr)
-        return 2
+    except ERRORS as exc:
+        return _fail("tune", exc)
     print(f"{r['controller']} on {r['env_id']}: validation score {r['start_validation_score']:.2f} "
           f"(start) -> {r['validation_score']:.2f} in {r['wall_time_s']:.0f} s")
     print("gains: " + ", ".join(f"{k}={v:.4g}" for k, v in r["gains"].items()))
-    print("wrote " + ", ".join(str(Path(args.out) / f) for f in r["files"]))
+    _wrote(args.out, r["files"])
     return 0
 
 
@@ -142,8 +165,7 @@ def register(sub) -> None:
     p.add_argument("--scene", default=None, help="scene preset or TOML (default: the env's)")
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="scene override (repeatable), e.g. contact.friction=0.4")
-    p.add_argument("--out", default="out/evaluate", help="output directory")
-    p.add_argument("--no-plots", action="store_true")
+    _output_args(p, "out/evaluate", progress=False)
     p.add_argument("--no-passive", action="store_true", help="skip the passive reference runs")
     p.add_argument("--fixed", action="store_true",
                    help="no scenario randomisation: every episode runs the given scene")
@@ -162,9 +184,7 @@ def register(sub) -> None:
     p.add_argument("--power-return-ms", type=float, default=None,
                    help="power-return delay of the re-levitation tasks [ms] (default: the "
                         "environments' 50 ms; the 'power back at 0.15 s' scenario keeps its own)")
-    p.add_argument("--out", default="out/benchmark", help="output directory")
-    p.add_argument("--no-plots", action="store_true")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    _output_args(p, "out/benchmark")
     p.add_argument("--scenarios", type=int, default=None, help=argparse.SUPPRESS)
     p.add_argument("--episodes", type=int, default=None, help=argparse.SUPPRESS)
     p.set_defaults(func=cmd_benchmark)
@@ -182,9 +202,7 @@ def register(sub) -> None:
     p.add_argument("--population", type=int, default=24, help="candidates per generation")
     p.add_argument("--elite", type=int, default=6, help="best candidates the next generation is fitted to")
     p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--out", default="out/tune", help="output directory")
-    p.add_argument("--no-plots", action="store_true")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    _output_args(p, "out/tune")
     p.set_defaults(func=cmd_tune)
 
     p = sub.add_parser("ride-through", help="how late the AMB power may return for a controller "
@@ -202,7 +220,5 @@ def register(sub) -> None:
     p.add_argument("--phase", type=float, action="append", default=None,
                    help="unbalance phase [deg] (repeatable; default the benchmark's 0, 90, 180, 270)")
     p.add_argument("--quick", action="store_true", help="3 frictions x 3 delays x 2 phases")
-    p.add_argument("--out", default="out/ride_through", help="output directory")
-    p.add_argument("--no-plots", action="store_true")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    _output_args(p, "out/ride_through")
     p.set_defaults(func=cmd_ride_through)
