@@ -182,7 +182,6 @@ class RotorDropEnv(gym.Env):
         C[K.C_DAMP] = 1.0 if self._damping else 0.0
         C[K.C_LEV] = (K.LEV_NONE if not self._relevitate else
                       K.LEV_DISCRETE if self.command == "discrete" else K.LEV_CONTINUOUS)
-        C[K.C_A_LEV] = 2.0 if self._damping else 0.0
         C[K.C_WHIRL_RADIUS], C[K.C_WHIRL_REVS] = WHIRL_RADIUS_FRACTION, WHIRL_MIN_REVOLUTIONS
         w = self.weights
         C[K.C_W_WHIRL], C[K.C_W_CONTACT], C[K.C_W_DISP] = w["w_whirl"], w["w_contact"], w["w_displacement"]

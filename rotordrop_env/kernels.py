@@ -25,11 +25,11 @@ from physics.model import (A_FR, A_QMAX, A_WS, I_AMB_FILT, I_AMB_INT, I_CS, N_AU
                            U_REF0, U_T_ON, amb_currents, axis_motion, rhs, sleeve_motion)
 
 # ------------------------------------------------------------------------ configuration C --
-(C_DT, C_T_FAULT, C_T_END, C_T_POWER, C_DAMP, C_LEV, C_A_LEV,
+(C_DT, C_T_FAULT, C_T_END, C_T_POWER, C_DAMP, C_LEV,
  C_RTOL, C_HMAX, C_HMIN, C_FIXED, C_MAXSTEPS,
  C_W_WHIRL, C_W_CONTACT, C_W_DISP, C_W_EFFORT, C_W_SUCCESS, C_W_FAILURE,
  C_F_REF, C_GAP, C_LOAD_RATING, C_HOLD, C_TERMINATE, C_FULL, C_CS_MIN, C_CS_MAX, C_ILIM,
- C_RELEV_RADIUS, C_WHIRL_RADIUS, C_WHIRL_REVS, N_C) = range(31)
+ C_RELEV_RADIUS, C_WHIRL_RADIUS, C_WHIRL_REVS, N_C) = range(30)
 LEV_NONE, LEV_DISCRETE, LEV_CONTINUOUS = 0, 1, 2
 
 # ------------------------------------------------------------------------------ monitor M --
@@ -96,7 +96,7 @@ def apply_action(a, y, P, I, U, C, M):
         t = M[M_T]
         if M[M_POWER] == 0.0 and _power_back(t, C):
             M[M_POWER] = 1.0
-        o = int(C[C_A_LEV])
+        o = 2 if C[C_DAMP] > 0.0 else 0          # after the damper commands, if any
         if M[M_POWER] > 0.0:
             if lev == LEV_DISCRETE:
                 want = a[o] >= 0.5 if a.shape[0] == 1 else a[o] > 0.0
