@@ -143,18 +143,17 @@ class WhirlSwitch(Controller):
 
     def commands(self, obs):
         p = self.plant
-        spin = p.spin_sign(obs)
-        decay = self.decay
-        for k in range(2):
-            x, y = p.get(obs, f"x{k + 1}"), p.get(obs, f"y{k + 1}")
-            theta = np.arctan2(y, x)
-            dtheta = np.nan_to_num((theta - self.theta[:, k] + np.pi) % (2 * np.pi) - np.pi)
-            far = np.hypot(x, y) > self.r_on * p.clearance
-            self.backward[:, k] = decay * self.backward[:, k] + np.where(far, -spin * dtheta, 0.0)
-            self.theta[:, k] = theta
-            detected = self.backward[:, k] > self.angle
-            self.last[detected, k] = self.t[detected]
-        high = self.t[:, None] - self.last <= self.hold_time
+        spin = p.spin_sign(obs)[:, None]
+        pos = p.positions(obs)
+        x, y = pos[:, 0::2], pos[:, 1::2]                       # (n, 2): planes 1, 2
+        theta = np.arctan2(y, x)
+        dtheta = np.nan_to_num((theta - self.theta + np.pi) % (2 * np.pi) - np.pi)
+        far = np.hypot(x, y) > self.r_on * p.clearance
+        self.backward = self.decay * self.backward + np.where(far, -spin * dtheta, 0.0)
+        self.theta = theta
+        t = self.t[:, None]
+        self.last = np.where(self.backward > self.angle, t, self.last)
+        high = t - self.last <= self.hold_time
         return {"damping": np.where(high, 1.0, self.hold)}
 
 

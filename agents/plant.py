@@ -38,6 +38,15 @@ def make_env(env_id: str, **kwargs):
     return gym.make(env_id, **kwargs)
 
 
+def plant_of(env_id: str, **kwargs) -> "Plant":
+    """The :class:`Plant` of ``gym.make(env_id, **kwargs)`` (the env is closed again)."""
+    env = make_env(env_id, **kwargs)
+    try:
+        return Plant.from_env(env)
+    finally:
+        env.close()
+
+
 def make_vec_env(env_id: str, n_envs: int, seed: int, env_kwargs: dict, monitor_file=None,
                  reward: str = "env", reward_kwargs: dict | None = None,
                  residual: str | None = None, residual_scale: float | None = None):
@@ -113,17 +122,27 @@ class Plant:
         j = self.index(name)
         return obs[:, j] * self.obs_scale[j]
 
-    def _block(self, obs: np.ndarray, names: tuple[str, ...]) -> np.ndarray:
+    def _block_columns(self, names: tuple[str, ...]) -> tuple[list[int], np.ndarray]:
         j = [self.index(n) for n in names]
-        return obs[:, j] * self.obs_scale[j]
+        return j, self.obs_scale[j]
+
+    @cached_property
+    def _positions(self):
+        return self._block_columns(POSITIONS)
+
+    @cached_property
+    def _velocities(self):
+        return self._block_columns(VELOCITIES)
 
     def positions(self, obs: np.ndarray) -> np.ndarray:
         """(n, 4) sensed displacements x1, y1, x2, y2 [m]."""
-        return self._block(obs, POSITIONS)
+        j, scale = self._positions
+        return obs[:, j] * scale
 
     def velocities(self, obs: np.ndarray) -> np.ndarray:
         """(n, 4) sensed velocities vx1, vy1, vx2, vy2 [m/s]."""
-        return self._block(obs, VELOCITIES)
+        j, scale = self._velocities
+        return obs[:, j] * scale
 
     def spin_sign(self, obs: np.ndarray) -> np.ndarray:
         """(n,) sign of the rotor speed (+1 at standstill)."""
@@ -157,6 +176,14 @@ class Plant:
             ch.append("currents")
         return tuple(ch)
 
+    @cached_property
+    def _action_columns(self) -> dict[str, list[int]]:
+        """Action columns of each channel (continuous action spaces)."""
+        names = self.action_names
+        cols = {"damping": ["damping1", "damping2"], "levitate": ["levitate"],
+                "currents": list(CURRENT_NAMES)}
+        return {ch: [names.index(n) for n in cols[ch]] for ch in self.channels}
+
     def compose(self, n: int, commands: dict, hold_damping: np.ndarray | None = None) -> np.ndarray:
         """The env action for each of n environments from channel commands (module docstring).
 
@@ -167,16 +194,14 @@ class Plant:
             return (np.zeros(n, dtype=np.int64) if lev is None
                     else (np.asarray(lev) > 0.5).astype(np.int64))
         a = np.zeros((n, len(self.action_names)), dtype=np.float32)
-        names = self.action_names
-        if "damping1" in names:
+        cols = self._action_columns
+        if "damping" in cols:
             d = commands.get("damping", hold_damping)
             if d is not None:
-                a[:, names.index("damping1")] = d[:, 0]
-                a[:, names.index("damping2")] = d[:, 1]
-        if "levitate" in names:
+                a[:, cols["damping"]] = d
+        if "levitate" in cols:
             lev = commands.get("levitate")
-            a[:, names.index("levitate")] = -1.0 if lev is None else np.where(np.asarray(lev) > 0.5, 1.0, -1.0)
-        if CURRENT_NAMES[0] in names and commands.get("currents") is not None:
-            for j, name in enumerate(CURRENT_NAMES):
-                a[:, names.index(name)] = commands["currents"][:, j]
+            a[:, cols["levitate"][0]] = -1.0 if lev is None else np.where(np.asarray(lev) > 0.5, 1.0, -1.0)
+        if "currents" in cols and commands.get("currents") is not None:
+            a[:, cols["currents"]] = commands["currents"]
         return np.clip(a, -1.0, 1.0)

@@ -23,8 +23,8 @@ from pathlib import Path
 import numpy as np
 
 from .benchmark import (PHASES, RELEVITATION_ENVS, Entry, Scenario, check_unique_names,
-                        controller_env_kwargs, episode_kwargs, run_label, task_of)
-from .controllers import BASELINES, Passive, command_for, controller_class, make_controller
+                        controller_entry, episode_kwargs, run_label, task_of)
+from .controllers import BASELINES, Passive, command_for, controller_class
 from .policies import load_shipped, resolve, shipped_names
 from .rollout import run_episodes
 from .score import json_default
@@ -44,17 +44,15 @@ def controllers_for(env_id: str) -> list[str]:
 
 
 def _entry(spec: str, env_id: str) -> Entry:
-    task = task_of(env_id)
     cls = controller_class(spec)
     if cls is not None:
-        return Entry(cls.name, task, lambda plant: make_controller(cls, plant),
-                     controller_env_kwargs(cls, env_id))
+        return controller_entry(cls, env_id)
     policy, trained_on = resolve(spec)
     if trained_on != env_id:
         raise ValueError(f"policy {spec!r} was trained on {trained_on}, not on {env_id}; "
                          f"pass --env {trained_on}")
     name = policy.name if spec in shipped_names() else f"{policy.name}@{run_label(spec)}"
-    return Entry(name, task, policy.bound, dict(policy.env_kwargs))
+    return Entry(name, task_of(env_id), policy.bound, dict(policy.env_kwargs))
 
 
 def _check_grid(name: str, values, lo: float, hi: float, shown: float = 1.0) -> tuple[float, ...]:

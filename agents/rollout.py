@@ -49,10 +49,10 @@ def _episode(env, plant: Plant, actor, seed: int, record: bool) -> Episode:
     obs, info = env.reset(seed=seed)
     total, steps = 0.0, 0
     rec_obs, rec_act, rec_f = [], [], []
-    start = np.ones(1, dtype=bool)
+    start, running = np.ones(1, dtype=bool), np.zeros(1, dtype=bool)
     while True:
         action, _ = actor.predict(obs[None, :], episode_start=start, deterministic=True)
-        start = np.zeros(1, dtype=bool)
+        start = running
         a = action[0]
         if record:
             rec_obs.append(obs.astype(np.float64) * plant.obs_scale)

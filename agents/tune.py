@@ -54,20 +54,16 @@ def _controller(spec: str, env_id: str) -> type[Controller]:
 
 def _check_gains(cls: type[Controller], env_id: str, start: dict) -> dict:
     """Build the controller once with the start gains to fail early, naming what is wrong."""
-    from .plant import Plant, make_env
+    from .plant import plant_of
     kw = controller_env_kwargs(cls, env_id)
-    env = make_env(env_id, **kw)
+    plant = plant_of(env_id, **kw)
+    if not cls.supports(plant):
+        make_controller(cls, plant)                      # raises, naming the missing channels
     try:
-        plant = Plant.from_env(env)
-        if not cls.supports(plant):
-            make_controller(cls, plant)                  # raises, naming the missing channels
-        try:
-            cls(plant, **start)
-        except TypeError as exc:
-            raise ValueError(f"{cls.name} does not take the gains {list(start)} as keyword "
-                             f"arguments ({exc})") from None
-    finally:
-        env.close()
+        cls(plant, **start)
+    except TypeError as exc:
+        raise ValueError(f"{cls.name} does not take the gains {list(start)} as keyword "
+                         f"arguments ({exc})") from None
     return kw
 
 
