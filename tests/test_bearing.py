@@ -31,6 +31,8 @@ def test_hertz_constant_matches_spec():
 
 
 def test_static_approach_and_largest_ball_load_under_477N():
+    """Spec §4 check: 477 N static radial load, no film -> 14.6 µm approach, linear stiffness
+    about 1.16e8 N/m, largest ball load about 271 N."""
     cage = math.pi / B.balls           # a ball straight under the load (270 deg)
     u = approach_under(477.0, cage)
     assert u * 1e6 == pytest.approx(14.6, rel=0.01)

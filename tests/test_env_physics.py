@@ -135,7 +135,11 @@ def test_discrete_command_relevitates_the_rotor_at_low_friction():
     assert forces[-30:].max() == 0.0
     assert info["reward_success"] == 0.0               # the bonus was paid once, earlier
     off, forces_off = run(0)
-    assert off["kpi_relevitated"] is False and forces_off[-30:].mean() > 100.0   # still down
+    # still down: the retainer bearings carry the weight, each plane on average its share (the
+    # step's larger plane force is read); the last 30 ms still hold some bounce, hence the half
+    s = load_scene("paper")
+    share = weight_shares(s.rotor.mass * s.world.gravity, s.positions.rb1, s.positions.rb2)[0]
+    assert off["kpi_relevitated"] is False and forces_off[-30:].mean() > 0.5 * share
 
 
 def test_direct_currents_act_after_power_returns_only():

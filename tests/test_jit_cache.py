@@ -17,11 +17,15 @@ def test_editing_any_kernel_file_changes_the_cache_directory(tmp_path):
 
 
 def test_decorating_leaves_numba_global_cache_setting_alone():
+    """Our kernels cache into CACHE_DIR, yet numba's global setting never points there: not after
+    importing the package (which decorates every kernel), nor after decorating one more."""
     from numba.core import config
     previous = config.CACHE_DIR
+    assert previous != _jit.CACHE_DIR
 
     @_jit.njit
     def twice(x):
         return 2 * x
 
     assert twice(2) == 4 and config.CACHE_DIR == previous
+    assert twice._cache._cache_path.startswith(_jit.CACHE_DIR)
