@@ -308,7 +308,7 @@ class RotorDropEnv(gym.Env):
     def kpis(self) -> dict:
         """Episode KPIs so far (the final step's ``info`` carries them)."""
         b = self._b
-        M, out = b.M, b.out
+        M = b.M
         relev = bool(M[K.M_RELEV])
         return {"kpi_backward_whirl": bool(M[K.M_WHIRL]),
                 "kpi_whirl_revolutions": float(max(M[K.M_REV1], M[K.M_REV2])),
@@ -316,8 +316,8 @@ class RotorDropEnv(gym.Env):
                 "kpi_relevitated": relev,
                 "kpi_relevitation_time_s": float(M[K.M_RELEV_T]) if relev else math.nan,
                 "kpi_control_effort": float(M[K.M_EFFORT]),
-                "kpi_stator_contact": bool(out[K.O_STATOR]),
-                "kpi_bearing_overload": bool(out[K.O_OVERLOAD]),
+                "kpi_stator_contact": bool(M[K.M_STATOR]),
+                "kpi_bearing_overload": bool(M[K.M_OVERLOAD]),
                 **ball_kpis(self.model, self.scene, float(M[K.M_PEAK_Q])),
                 "kpi_episode_time_s": self.time}
 

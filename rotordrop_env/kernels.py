@@ -34,7 +34,8 @@ LEV_NONE, LEV_DISCRETE, LEV_CONTINUOUS = 0, 1, 2
 
 # ------------------------------------------------------------------------------ monitor M --
 (M_T, M_H, M_REV1, M_REV2, M_WHIRL, M_PEAK_F, M_MAX_DISP, M_OK_START, M_RELEV,
- M_RELEV_T, M_EFFORT, M_CTRL_ON, M_POWER, M_REV_PEAK, M_PEAK_Q, N_M) = range(16)
+ M_RELEV_T, M_EFFORT, M_CTRL_ON, M_POWER, M_REV_PEAK, M_PEAK_Q, M_STATOR, M_OVERLOAD,
+ N_M) = range(18)
 
 # ------------------------------------------------------------------------------ outputs --
 (O_REWARD, O_R_WHIRL, O_R_CONTACT, O_R_DISP, O_R_EFFORT, O_R_SUCCESS, O_R_FAILURE, O_FORCE,
@@ -260,6 +261,8 @@ def step_one(a, y, P, I, U, atol, work, t_sub, Y_sub, aux, cur, C, M, scale, obs
     overload = f_step > C[C_LOAD_RATING]
     out[O_STATOR] = 1.0 if stator else 0.0
     out[O_OVERLOAD] = 1.0 if overload else 0.0
+    M[M_STATOR] = max(M[M_STATOR], out[O_STATOR])          # latched: "it happened this episode"
+    M[M_OVERLOAD] = max(M[M_OVERLOAD], out[O_OVERLOAD])
     if (stator or overload) and C[C_TERMINATE] > 0.0:
         out[O_TERM] = 1.0
         remaining = max(round((C[C_T_END] - t1) / dt), 0.0)
