@@ -151,8 +151,9 @@ class Support:
 class Solver:
     method: str = param("adaptive", "-", doc="adaptive (Dormand-Prince 5(4)) or fixed (same tableau,"
                         " constant step solver.dt)", tag="A", choices=("adaptive", "fixed"))
-    rtol: float = param(1e-5, "-", 1e-12, 1e-1, "relative tolerance (absolute = rtol x state scale);"
-                        " default chosen by `rotordrop accuracy` (docs/accuracy.md)", "A")
+    rtol: float = param(1e-5, "-", 1e-12, 1e-3, "relative tolerance (absolute = rtol x state scale);"
+                        " default chosen by `rotordrop accuracy`; looser than 1e-3 gives wrong"
+                        " bearing loads (docs/accuracy.md)", "A")
     dt: float = param(2e-6, "s", 1e-9, 1e-2, "step of the fixed-step method", "A")
     max_step: float = param(1e-3, "s", 1e-9, 1.0, "largest adaptive step", "A")
     min_step: float = param(1e-12, "s", 1e-16, 1e-6,
@@ -339,6 +340,11 @@ def _meta(group: str, name: str) -> dict:
     raise SceneError(f"unknown parameter key '{group}.{name}': {group} has {names}")
 
 
+def param_meta(key: str) -> dict:
+    """Unit, allowed range (``lo``, ``hi``) or ``choices``, source and type of ``GROUP.NAME``."""
+    return _meta(*_split_key(key))
+
+
 def _allowed(meta: dict) -> str:
     if meta.get("choices"):
         return "one of " + ", ".join(meta["choices"])
@@ -396,8 +402,7 @@ def _check_consistency(s: Scene) -> None:
         raise SceneError("positions.amb1 must be < positions.amb2 (AMB planes must differ)")
     if s.positions.rb1 >= s.positions.rb2:
         raise SceneError("positions.rb1 must be < positions.rb2 (retainer planes must differ)")
-    if s.bearing.ball_diameter >= s.bearing.pitch_diameter:
-        raise SceneError("bearing.ball_diameter must be smaller than bearing.pitch_diameter")
+    _check_bearing_geometry(s)
     if s.solver.output_rate * s.solver.t_end > 5e7:
         raise SceneError("solver.output_rate x solver.t_end must be <= 5e7 samples "
                          f"(got {s.solver.output_rate * s.solver.t_end:.3g})")
@@ -417,6 +422,24 @@ def _check_consistency(s: Scene) -> None:
             raise SceneError(f"support.damping = {sp.damping:g} must lie in [support.damping_min,"
                              f" support.damping_max] = [{sp.damping_min:g}, {sp.damping_max:g}] N s/m"
                              " with effects.semi_active_damper")
+
+
+def _check_bearing_geometry(s: Scene) -> None:
+    """The balls fit on the pitch circle; the sleeve bore R = r + c lies inside the inner raceway."""
+    b = s.bearing
+    d_max = b.pitch_diameter * math.sin(math.pi / b.balls)     # neighbouring balls touch
+    if b.ball_diameter >= d_max:
+        raise SceneError(f"bearing.ball_diameter = {b.ball_diameter * 1e3:.4g} mm is too large for"
+                         f" bearing.balls = {b.balls} on bearing.pitch_diameter ="
+                         f" {b.pitch_diameter * 1e3:.4g} mm: neighbouring balls overlap; need"
+                         f" ball_diameter < pitch_diameter sin(pi / balls) = {d_max * 1e3:.4g} mm")
+    bore = s.rotor.journal_radius + s.contact.clearance
+    race = 0.5 * (b.pitch_diameter - b.ball_diameter)
+    if bore >= race:
+        raise SceneError(f"rotor.journal_radius + contact.clearance = {bore * 1e3:.4g} mm (the sleeve"
+                         f" bore) must be < the inner raceway radius (bearing.pitch_diameter -"
+                         f" bearing.ball_diameter) / 2 = {race * 1e3:.4g} mm: the sleeve and the"
+                         f" inner ring sit between them")
 
 
 def _check_actuator(s: Scene) -> None:

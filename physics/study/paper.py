@@ -16,9 +16,9 @@ import numpy as np
 
 from ..metrics import worst_plane
 from ..results import Result
-from ..scene import Scene, load_scene
-from ..simulate import simulate
-from ..sweep import Outcome, Run, changes, outcome_of, run_sweep
+from ..scene import Scene, SceneError, load_scene
+from ..simulate import IntegrationError, simulate
+from ..sweep import Outcome, Run, changes, outcome_of, reproduce_command, run_sweep
 from .ensemble import onset, perturbations, probability_curve
 from .observables import drop_observables
 
@@ -150,7 +150,9 @@ def run_study(plan: Plan, base: StudyInput, jobs: int | None = None,
     The rest run on the process pool.
     """
     runs = plan_runs(plan, base)
-    nominal = {r: simulate(r.to_scene()) for r in runs if r.label["member"] == -1}
+    nominal = {r: simulate_figure_drop(r, f"the nominal drop of the support {r.label['study']} study"
+                                          f" (support.{r.label['study']} = {r.label['value']:g})")
+               for r in runs if r.label["member"] == -1}
     swept = iter(run_sweep([r for r in runs if r not in nominal], drop_observables, jobs=jobs,
                            desc="study paper", progress=progress))
     outcomes = [outcome_of(r, nominal[r], drop_observables) if r in nominal else next(swept)
@@ -159,6 +161,16 @@ def run_study(plan: Plan, base: StudyInput, jobs: int | None = None,
     for r, result in nominal.items():
         results.setdefault(r.label["study"], {})[r.label["value"]] = result
     return outcomes, results
+
+
+def simulate_figure_drop(run: Run, what: str) -> Result:
+    """Simulate a drop a figure needs; its error stops the study, naming the drop (``what``)
+    and the ``rotordrop drop`` command that re-runs it alone."""
+    try:
+        return simulate(run.to_scene())
+    except (SceneError, IntegrationError) as exc:
+        raise type(exc)(f"study paper: {what} (drawn in a figure) failed: {exc}; re-run it alone:"
+                        f" {reproduce_command(run)}") from None
 
 
 # ------------------------------------------------------------------------------ analysis --

@@ -6,11 +6,10 @@ import time
 from pathlib import Path
 
 from ..scene import load_scene
-from ..simulate import simulate
 from ..sweep import default_jobs
 from . import report
 from .claims import claims
-from .paper import SENSITIVITY, Plan, StudyInput, analyse, run_study
+from .paper import SENSITIVITY, Plan, StudyInput, analyse, run_study, simulate_figure_drop
 
 
 def run_paper_study(source: str, overrides: dict, out_dir, quick: bool = False,
@@ -55,8 +54,8 @@ def run_paper_study(source: str, overrides: dict, out_dir, quick: bool = False,
 def friction_runs(base: StudyInput, plan: Plan) -> dict:
     """The nominal drops at the figure frictions (full time series, simulated here; the support
     studies' nominal drops come from :func:`physics.study.paper.run_study`)."""
-    scene = base.scene
-    return {mu: simulate(scene.with_overrides({"contact.friction": mu}))
+    return {mu: simulate_figure_drop(base.run({"contact.friction": mu}),
+                                     f"the friction figure's drop at contact.friction = {mu:g}")
             for mu in plan.figure_frictions}
 
 
