@@ -18,6 +18,10 @@ COMMAND_MODULES = ("physics.study", "physics.accuracy", "agents.cli")
 OPTIONAL_RL_MODULES = ("gymnasium", "stable_baselines3", "torch", "tensorboard", "yaml")
 
 
+class UsageError(ValueError):
+    """A bad command-line argument that is not a scene parameter (one-line error, exit 2)."""
+
+
 def add_scene_args(p: argparse.ArgumentParser) -> None:
     """--scene and --set, shared by every command that runs the simulator."""
     p.add_argument("--scene", default="paper",
@@ -50,29 +54,62 @@ def cmd_drop(args) -> int:
     from .simulate import simulate
 
     scene = scene_from_args(args)
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    out = output_dir(args.out)
     result = simulate(scene, t_end=args.t_end, progress=not args.quiet)
     metrics = compute_metrics(result)
     (out / "metrics.json").write_text(json.dumps(metrics, indent=2))
     (out / "scene.toml").write_text(result.model.scene.to_toml())
     result.save_npz(out / "timeseries.npz")
-    figures = [] if args.no_plots else plot_drop(result, out, f"(mu = {scene.contact.friction:g})")
+    title = f"(mu = {scene.contact.friction:g}{'' if metrics['fault_simulated'] else ', no fault'})"
+    figures = [] if args.no_plots else plot_drop(result, out, title)
     print(summary_table(metrics))
     print(f"wrote {out / 'metrics.json'}, {out / 'timeseries.npz'}, {out / 'scene.toml'}"
           + "".join(f", {f.name}" for f in figures))
     return 0
 
 
+def output_dir(path: str) -> Path:
+    """The --out directory, created; a one-line UsageError when it cannot be."""
+    out = Path(path)
+    if out.exists() and not out.is_dir():
+        raise UsageError(f"--out {path} is an existing file, not a directory")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise UsageError(f"--out {path}: cannot create the directory ({exc.strerror})") from None
+    return out
+
+
 def summary_table(m: dict) -> str:
-    """A short human-readable table of the drop metrics."""
-    fc = m["first_contact_after_fault_s"]
+    """A short human-readable table of the drop metrics, its warnings last (``warning: ...``).
+    Without a fault in the run the post-fault tables are left out."""
     lines = [f"scene {m['scene']}: {m['t_end']:g} s simulated in {m['wall_time_s']:.3f} s "
              f"({m['rhs_evaluations']} rhs evaluations, {m['n_state']} states; compile/cache load "
-             f"{m['compile_time_s']:.2f} s)",
-             f"first contact {fc * 1e3:.2f} ms after the fault" if fc is not None else "no contact",
-             f"final rotor speed {m['final_rotor_speed_rpm']:.0f} rpm",
-             f"{'plane':6}{'max disp [µm]':>15}{'peak F_r [N]':>14}{'whirl':>7}{'f_whirl [Hz]':>14}"
+             f"{m['compile_time_s']:.2f} s)", _contact_line(m),
+             f"final rotor speed {m['final_rotor_speed_rpm']:.0f} rpm"]
+    if m["fault_simulated"]:
+        lines += _post_fault_tables(m)
+    lines.append(f"{'AMB plane':10}{'max disp [µm]':>15}{'stator':>8}")
+    for p, v in m["amb_planes"].items():
+        lines.append(f"{p:10}{v['max_displacement_um']:15.1f}{'yes' if v['stator_contact'] else 'no':>8}")
+    lines += [f"warning: {w}" for w in m["warnings"]]
+    return "\n".join(lines)
+
+
+def _contact_line(m: dict) -> str:
+    fc = m["first_contact_after_fault_s"]
+    if not m["fault_simulated"]:
+        return "no fault in the simulated time (the AMBs never switched off)"
+    if fc is None:
+        return "no contact"
+    if fc < 0.0:
+        return f"first contact {-fc * 1e3:.2f} ms BEFORE the fault (in contact while levitated)"
+    return f"first contact {fc * 1e3:.2f} ms after the fault"
+
+
+def _post_fault_tables(m: dict) -> list[str]:
+    """The per-plane drop table and the retainer-bearing table (after the fault)."""
+    lines = [f"{'plane':6}{'max disp [µm]':>15}{'peak F_r [N]':>14}{'whirl':>7}{'f_whirl [Hz]':>14}"
              f"{'sleeve [rpm]':>14}"]
     for p, v in m["planes"].items():
         f = v["whirl_frequency_hz"]
@@ -89,7 +126,7 @@ def summary_table(m: dict) -> str:
               "ball (ISO 76 rates C_0 at 4 200 MPa)",
               "friction heat: generated at the rotor-sleeve contact after the fault (net: under the "
               "paper slip law the contact can also return energy)"]
-    return "\n".join(lines)
+    return lines
 
 
 def _fmt(value, spec: str) -> str:
@@ -97,19 +134,29 @@ def _fmt(value, spec: str) -> str:
 
 
 def cmd_params(args) -> int:
-    from .scene import parameter_table, preset_names
+    from .scene import preset_names
     if args.presets:
         print("\n".join(preset_names()))
         return 0
-    rows = parameter_table()
+    rows = scene_parameter_rows(scene_from_args(args))
     if args.json:
         print(json.dumps(rows, indent=1, default=str))
         return 0
-    print(f"{'key':32}{'default':>18}  {'unit':9}{'allowed':26}{'tag':4} description")
+    print(f"scene {args.scene}: the values `rotordrop drop --scene {args.scene}` runs with "
+          "(* differs from the parameter's default)")
+    print(f"{'key':32}{'value':>18}  {'unit':9}{'allowed':26}{'tag':4} description")
     for r in rows:
-        print(f"{r['key']:32}{str(r['default']):>18}  {r['unit']:9}{r['allowed']:26}{r['tag']:4} {r['doc']}")
+        value = str(r["value"]) + ("*" if r["value"] != r["default"] else " ")
+        print(f"{r['key']:32}{value:>19} {r['unit']:9}{r['allowed']:26}{r['tag']:4} {r['doc']}")
     print("\ntags: P = paper, A = assumed, D = derived. Override any key with --set KEY=VALUE.")
     return 0
+
+
+def scene_parameter_rows(scene) -> list[dict]:
+    """``parameter_table()`` rows with the value ``scene`` uses added as ``value`` (``default``
+    stays the parameter's own default)."""
+    from .scene import parameter_table
+    return [dict(r, value=scene.get(r["key"])) for r in parameter_table()]
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -124,7 +171,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_drop)
 
-    p = sub.add_parser("params", help="list every scene parameter with unit, default and range")
+    p = sub.add_parser("params", help="list every scene parameter: the value a scene uses (default:"
+                       " the `rotordrop drop` default scene), unit, range and source")
+    add_scene_args(p)
     p.add_argument("--json", action="store_true", help="machine-readable output")
     p.add_argument("--presets", action="store_true", help="list the preset scene names")
     p.set_defaults(func=cmd_params)
@@ -146,7 +195,7 @@ def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     try:
         return args.func(args)
-    except (SceneError, IntegrationError) as exc:
+    except (SceneError, IntegrationError, UsageError) as exc:
         print(f"rotordrop: error: {exc}", file=sys.stderr)
         return 2
     except ModuleNotFoundError as exc:

@@ -1,18 +1,24 @@
-"""Drop KPIs per retainer plane: displacement, contact force, first contact, backward whirl."""
+"""Drop KPIs per retainer plane (displacement, contact force, first contact, backward whirl) and
+the checks that say when they do not describe a clean drop (contact before the fault, stator
+contact, no fault in the run, output samples too coarse), listed as ``warnings``."""
 from __future__ import annotations
 
 import math
 
 import numpy as np
 
+from .amb import weight_shares
 from .ball_bearing import max_contact_pressure
 from .model import F_RB, PLANES, RB_SM
-from .results import Result
+from .results import AMB_PLANES, Result
 
 WHIRL_MIN_REVOLUTIONS = 3.0     # net backward orbit revolutions that make a backward whirl
 WHIRL_RADIUS_FRACTION = 0.5     # only orbit samples beyond this fraction of the clearance count
 RPM = 30.0 / math.pi            # rad/s -> rpm
 ISO76_C0_PRESSURE = 4.2e9       # Pa: contact pressure at the static load rating C_0 (ball bearings)
+ALIAS_ANGLE = 0.75 * math.pi    # orbit turn between two samples beyond which the whirl may alias
+SAMPLES_PER_PERIOD = 10         # a sinusoid sampled n times a period shows >= cos(pi/n) of its
+                                # peak: 95 % at n = 10 (see min_output_rate)
 
 
 def first_contact_time(result: Result) -> float | None:
@@ -56,7 +62,7 @@ def whirl(result: Result, plane: str, after: float) -> dict:
     moving_back = -spin * dang > 0
     t_back = dt[moving_back].sum()
     freq = (-spin * dang[moving_back]).sum() / (2 * np.pi * t_back) if t_back > 0 else None
-    aliased = bool(dang.size and np.max(np.abs(dang)) > 0.75 * np.pi)
+    aliased = bool(dang.size and np.max(np.abs(dang)) > ALIAS_ANGLE)
     is_whirl = bool(revs >= WHIRL_MIN_REVOLUTIONS)
     return dict(backward_whirl=is_whirl, whirl_revolutions=float(revs),
                 whirl_frequency_hz=float(freq) if (is_whirl and freq is not None) else None,
@@ -95,6 +101,112 @@ def retainer_loading(result: Result, plane: str, post: np.ndarray) -> dict:
                 max_sleeve_speed_rpm=float(np.abs(ws).max() * RPM) if len(ws) else 0.0)
 
 
+def pre_fault(result: Result) -> np.ndarray:
+    """Samples while the AMBs still carry the rotor (every sample when the run ends first)."""
+    if result.t_fault is None:
+        return np.ones(len(result.t), dtype=bool)
+    return result.t < result.t_fault
+
+
+def contact_period(scene, plane: str, load: float) -> float | None:
+    """Period 2π √(m/k) [s] of the rotor's mass share m at a retainer plane (lever rule) on the
+    contact stiffness linearised at ``load``, k = e K (F/K)^((e-1)/e) (paper eq. 14): the rotor
+    bouncing on an immovable sleeve, the shortest period of an impact (the retainer bearing and
+    the support in series only lengthen it). None without a period (no load with e > 1)."""
+    c = scene.contact
+    m = abs(weight_shares(scene.rotor.mass, scene.positions.rb1, scene.positions.rb2)[
+        PLANES.index(plane)])
+    k = c.exponent * c.stiffness * (load / c.stiffness) ** ((c.exponent - 1.0) / c.exponent)
+    return 2.0 * math.pi * math.sqrt(m / k) if k > 0.0 and m > 0.0 else None
+
+
+def min_output_rate(result: Result, planes: dict) -> tuple[float, str]:
+    """The lowest ``solver.output_rate`` [Hz] that resolves what the metrics read from the output
+    samples, and what sets it: SAMPLES_PER_PERIOD samples per contact period (:func:`contact_period`
+    linearised at the larger of the plane's static weight share and its sampled peak contact
+    force) and per backward-whirl period where one was found (``planes``: the per-plane metrics).
+    Source: a sinusoid sampled n times a period shows at least cos(π/n) of its peak, so n = 10
+    keeps a sampled peak (contact force, displacement) within 5 % of the true one."""
+    scene = result.model.scene
+    g = scene.world.gravity if scene.effects.gravity else 0.0
+    weights = weight_shares(scene.rotor.mass * g, scene.positions.rb1, scene.positions.rb2)
+    best, source = 0.0, "nothing"
+    for p, weight in zip(PLANES, weights):
+        load = max(abs(weight), float(result.contact_force(p).max()) if len(result.t) else 0.0)
+        periods = {"contact": contact_period(scene, p, load)}
+        f_whirl = planes[p]["whirl_frequency_hz"]
+        periods["backward-whirl"] = 1.0 / f_whirl if f_whirl else None
+        for what, period in periods.items():
+            if period is not None and SAMPLES_PER_PERIOD / period > best:
+                best = SAMPLES_PER_PERIOD / period
+                source = f"{what} period at {p}, {period * 1e3:.3g} ms"
+    return best, source
+
+
+def amb_plane_metrics(result: Result) -> dict:
+    """Largest rotor displacement at each AMB plane over the run and whether it reaches the
+    stator (|r| >= amb.air_gap, the environments' criterion)."""
+    gap = result.model.scene.amb.air_gap
+    out = {}
+    for p in AMB_PLANES:
+        o = result.amb_orbit(p)
+        r2 = float((o[:, 0] ** 2 + o[:, 1] ** 2).max()) if len(o) else 0.0
+        out[p] = dict(max_displacement_um=math.sqrt(r2) * 1e6, stator_contact=r2 >= gap * gap)
+    return out
+
+
+def check_metrics(result: Result, m: dict) -> dict:
+    """The checks of a drop (added to ``m`` by :func:`compute_metrics`): whether the fault lies in
+    the run, contact before the fault (and its peak force per plane), stator contact at the AMB
+    planes and whether the output rate resolves the contact dynamics."""
+    pre = pre_fault(result)
+    out = dict(fault_simulated=result.t_fault is not None,
+               contact_before_fault=any(bool((result.penetration(p)[pre] > 0.0).any())
+                                        for p in PLANES))
+    for p in PLANES:
+        f = result.contact_force(p)[pre]
+        m["planes"][p]["pre_fault_peak_contact_force_N"] = float(f.max()) if len(f) else 0.0
+    out["amb_planes"] = amb_plane_metrics(result)
+    out["stator_contact"] = any(v["stator_contact"] for v in out["amb_planes"].values())
+    rate = result.model.scene.solver.output_rate
+    need, source = min_output_rate(result, m["planes"])
+    out.update(output_rate_hz=rate, min_output_rate_hz=need, min_output_rate_source=source,
+               output_rate_too_coarse=rate < need)
+    return out
+
+
+def warnings_of(m: dict, scene) -> list[str]:
+    """One line per failed check of :func:`check_metrics` and per aliased whirl plane."""
+    out = []
+    if not m["fault_simulated"]:
+        out.append(f"no fault in the simulated time: the AMBs switch off at amb.off_time = "
+                   f"{scene.amb.off_time:g} s, not before the end t_end = {m['t_end']:g} s; no drop "
+                   "happened, the per-plane and retainer numbers are the levitated rotor's at the "
+                   "last sample (raise --t-end / solver.t_end above amb.off_time)")
+    if m["contact_before_fault"]:
+        peaks = ", ".join(f"{p} {v['pre_fault_peak_contact_force_N']:.0f} N"
+                          for p, v in m["planes"].items())
+        out.append(f"the rotor touches the retainer bearings before the fault, while levitated "
+                   f"(peak contact force {peaks}); the post-fault metrics exclude it (check "
+                   "contact.clearance, support.stiffness, unbalance)")
+    if m["stator_contact"]:
+        disp = ", ".join(f"{p} {v['max_displacement_um']:.0f} µm" for p, v in m["amb_planes"].items())
+        out.append(f"the rotor reaches the AMB stator (amb.air_gap = {scene.amb.air_gap * 1e6:.0f} µm; "
+                   f"max displacement {disp}): the model has no stator contact, the motion "
+                   "beyond it is not physical")
+    if m["output_rate_too_coarse"]:
+        out.append(f"solver.output_rate = {m['output_rate_hz']:g} Hz is below "
+                   f"{m['min_output_rate_hz']:.0f} Hz ({SAMPLES_PER_PERIOD} samples per "
+                   f"{m['min_output_rate_source']}): peaks, first contact and whirl come from the "
+                   "output samples and are under-resolved; raise solver.output_rate")
+    for p, v in m["planes"].items():
+        if v["whirl_sampling_aliased"]:
+            out.append(f"{p}: the orbit turns more than 0.75π between output samples "
+                       "(whirl_sampling_aliased): whirl detection and frequency are unreliable; "
+                       "raise solver.output_rate")
+    return out
+
+
 def compute_metrics(result: Result) -> dict:
     """The numbers written to metrics.json (SI, with µm and rpm at the edges)."""
     t_fault = result.t_fault if result.t_fault is not None else result.t[-1]
@@ -119,6 +231,8 @@ def compute_metrics(result: Result) -> dict:
         entry.update(whirl(result, p, t_fault))
         out["planes"][p] = entry
     out["backward_whirl"] = any(out["planes"][p]["backward_whirl"] for p in PLANES)
+    out.update(check_metrics(result, out))
+    out["warnings"] = warnings_of(out, result.model.scene)
     return out
 
 

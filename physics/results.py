@@ -6,7 +6,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .model import (A_DELTA, A_DRAG, A_FMU, A_FR, A_LOAD, A_PFRIC, A_QMAX, A_WS, I_PLANES, J_HX,
-                    J_SX, N_AUX_PLANE, N_PLANE_IDX, P_Z_RB1, PLANES, S_EDISS, S_W, S_WEXT, S_X, Model, energies)
+                    J_SX, N_AUX_PLANE, N_PLANE_IDX, P_Z_AMB1, P_Z_RB1, PLANES, S_EDISS, S_W, S_WEXT, S_X,
+                    Model, axis_motion, energies)
+
+AMB_PLANES = ("AMB1", "AMB2")
 
 
 @dataclass
@@ -36,11 +39,11 @@ class Result:
         """Rotor spin speed Omega [rad/s]."""
         return self.Y[:, self.model.I[S_W]]
 
-    def _plane(self, plane: str) -> int:
+    def _plane(self, plane: str, planes: tuple[str, ...] = PLANES) -> int:
         try:
-            return PLANES.index(plane)
+            return planes.index(plane)
         except ValueError:
-            raise ValueError(f"plane must be one of {PLANES}, got {plane!r}") from None
+            raise ValueError(f"plane must be one of {planes}, got {plane!r}") from None
 
     def orbit(self, plane: str) -> np.ndarray:
         """Rotor axis position (x, y) at a retainer plane, relative to the nominal centre [m]."""
@@ -48,6 +51,14 @@ class Result:
         z = self.model.P[P_Z_RB1 + k]
         i = self.model.I[S_X]
         return np.stack([self.Y[:, i] + z * self.Y[:, i + 2], self.Y[:, i + 1] + z * self.Y[:, i + 3]], 1)
+
+    def amb_orbit(self, plane: str) -> np.ndarray:
+        """Rotor axis position (x, y) at AMB plane ``AMB1``/``AMB2`` [m]: ``model.axis_motion``,
+        the position the environments check against the stator (``amb.air_gap``), run on all
+        samples at once (its Python source on the state columns; bit-identical per sample)."""
+        z = self.model.P[P_Z_AMB1 + self._plane(plane, AMB_PLANES)]
+        px, py, _, _ = getattr(axis_motion, "py_func", axis_motion)(self.Y.T, self.model.I, z)
+        return np.stack([px, py], 1)
 
     def orbit_velocity(self, plane: str) -> np.ndarray:
         k = self._plane(plane)

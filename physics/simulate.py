@@ -9,9 +9,11 @@ from .equilibrium import levitated_state
 from .integrate import NOT_FINITE, OK, STEP_COLLAPSE, TOO_MANY_STEPS, integrate_segment
 from .model import N_AUX, AMB_NONE, F_AMB, Model, build_model, diagnostics
 from .results import Result, RunStats
-from .scene import Scene
+from .scene import Scene, SceneError, param_meta
 
 CHUNK_S = 0.01      # the run is advanced in chunks of this length (progress bar granularity)
+MAX_OUTPUT_BYTES = 2 * 1024 ** 3    # states + diagnostics kept in memory; the metrics, the time
+                                    # series file and the figures need about as much again
 
 
 class IntegrationError(RuntimeError):
@@ -59,19 +61,42 @@ class Integrator:
 
 
 def _explain(status: int, t: float, h: float, model: Model) -> str:
+    """The error message of an integrator status; its advice stays inside the allowed ranges."""
     sv = model.scene.solver
     if status == STEP_COLLAPSE:
         return (f"step size collapsed to {h:.3g} s (< solver.min_step = {sv.min_step:g} s) at "
-                f"t = {t:.6f} s: the scene is too stiff or singular there; loosen solver.rtol "
-                f"(now {sv.rtol:g}) or soften contact.stiffness / support.stiffness")
+                f"t = {t:.6f} s: the scene is too stiff or singular there; " + " or ".join(
+                    _moves(sv, ("loosen", "rtol", True), ("lower", "min_step", False))
+                    + ["soften contact.stiffness / support.stiffness"]))
     if status == TOO_MANY_STEPS:
-        return (f"step budget solver.max_steps = {sv.max_steps} exhausted at t = {t:.6f} s "
-                f"(last step {h:.3g} s); raise solver.max_steps or loosen solver.rtol")
+        head = (f"step budget solver.max_steps = {sv.max_steps} exhausted at t = {t:.6f} s "
+                f"(last step {h:.3g} s)")
+        if sv.method == "fixed":
+            head += (f": the fixed step solver.dt = {sv.dt:g} s needs {sv.t_end / sv.dt:.3g} steps"
+                     f" for solver.t_end = {sv.t_end:g} s")
+            moves = _moves(sv, ("raise", "max_steps", True), ("raise", "dt", True))
+        else:       # a step held at solver.max_step is not limited by the tolerance
+            moves = _moves(sv, ("raise", "max_steps", True), ("raise", "max_step", True)
+                           if h >= sv.max_step else ("loosen", "rtol", True))
+        return f"{head}; " + " or ".join(moves or ["shorten solver.t_end"])
     if status == NOT_FINITE:
         return (f"the fixed-step solution became non-finite at t = {t:.6f} s with solver.dt = "
-                f"{sv.dt:g} s: the step is beyond the stability limit; reduce solver.dt or use "
-                f"solver.method = adaptive")
+                f"{sv.dt:g} s: the step is beyond the stability limit; " + " or ".join(
+                    _moves(sv, ("reduce", "dt", False)) + ["use solver.method = adaptive"]))
     return f"integration failed with status {status} at t = {t}"
+
+
+def _moves(sv, *moves: tuple[str, str, bool]) -> list[str]:
+    """'raise solver.X (now v, at most hi)' for each of ``moves`` (verb, solver key, upwards)
+    that stays inside the key's allowed range."""
+    out = []
+    for verb, name, up in moves:
+        value, meta = getattr(sv, name), param_meta(f"solver.{name}")
+        bound = meta["hi"] if up else meta["lo"]
+        if (value < bound) if up else (value > bound):
+            out.append(f"{verb} solver.{name} (now {value:g}, {'at most' if up else 'at least'} "
+                       f"{bound:g})")
+    return out
 
 
 def warm_up(model: Model) -> float:
@@ -120,9 +145,9 @@ def simulate(scene: Scene, t_end: float | None = None, progress: bool = False) -
         scene = scene.with_overrides({"solver.t_end": t_end})
     model = build_model(scene)
     t_end = scene.solver.t_end
+    t_out = output_times(model)
     compile_s = warm_up(model)
-    n_out = int(round(t_end * scene.solver.output_rate)) + 1
-    t_out = np.linspace(0.0, t_end, n_out)
+    n_out = len(t_out)
     Y = np.empty((n_out, model.n_state))
     y = levitated_state(model)
     Y[0] = y
@@ -142,6 +167,22 @@ def simulate(scene: Scene, t_end: float | None = None, progress: bool = False) -
         aux[sel] = chunk
     t_fault = next((a for a, _, powered in segments(model, t_end) if not powered), None)
     return Result(model, t_out, Y, aux, integ.stats, t_fault)
+
+
+def output_times(model: Model) -> np.ndarray:
+    """The output sample times of a run (``solver.output_rate`` over ``solver.t_end``); refuses
+    (SceneError) an output whose states and diagnostics exceed MAX_OUTPUT_BYTES."""
+    sv = model.scene.solver
+    n_out = int(round(sv.t_end * sv.output_rate)) + 1
+    per_sample = 8 * (model.n_state + N_AUX)
+    if n_out * per_sample > MAX_OUTPUT_BYTES:
+        raise SceneError(
+            f"the output would hold {n_out:,} samples x {model.n_state + N_AUX} values = "
+            f"{n_out * per_sample / 1e9:.3g} GB (limit {MAX_OUTPUT_BYTES / 1e9:.3g} GB): lower "
+            f"solver.output_rate (now {sv.output_rate:g} Hz, at most "
+            f"{int((MAX_OUTPUT_BYTES // per_sample - 1) / sv.t_end)} Hz for this span) or the "
+            f"simulated time span (solver.t_end / --t-end, now {sv.t_end:g} s)")
+    return np.linspace(0.0, sv.t_end, n_out)
 
 
 def _progress(enabled: bool, total: float, name: str):
