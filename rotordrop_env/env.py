@@ -3,7 +3,9 @@ damping, AMB re-levitation, and both together. See docs/environments.md for the 
 from __future__ import annotations
 
 import math
+import numbers
 import operator
+from typing import Mapping
 
 import gymnasium as gym
 import numpy as np
@@ -18,7 +20,8 @@ from physics.simulate import IntegrationError, _explain
 from . import kernels as K
 from .buffers import Buffers
 from .layout import action_layout, observation_layout
-from .scenario import POWER_RETURN, fault_state, resolve_ranges, sample, scenario_scene
+from .scenario import (POWER_RETURN, POWER_RETURN_LIMITS, fault_state, resolve_ranges, sample,
+                       scenario_scene)
 
 REWARD_TERMS = ("whirl", "contact", "displacement", "effort", "success", "failure")
 _O_TERMS = (K.O_R_WHIRL, K.O_R_CONTACT, K.O_R_DISP, K.O_R_EFFORT, K.O_R_SUCCESS, K.O_R_FAILURE)
@@ -41,7 +44,10 @@ class RotorDropEnv(gym.Env):
     overrides                   None        dict of dotted scene keys, e.g. {"contact.friction": 0.4}
     control_dt                  1e-3        control step [s] (``env.dt``)
     episode_time                0.3         episode length after the fault [s] (time limit)
-    randomize                   False       draw a scenario at every reset (ranges below)
+    randomize                   False       draw a scenario at every reset (ranges below); keys
+                                            fixed by the user (``overrides``, the
+                                            ``power_return_time`` kwarg, a None range) keep
+                                            their value
     randomization               None        {key: (low, high) | (law, low, high) | None}
     full_state                  False       observe the whole state vector (research)
     command                     "discrete"  re-levitation envs: "discrete" or "continuous"
@@ -92,8 +98,12 @@ class RotorDropEnv(gym.Env):
         _positive("control_dt", control_dt, 1e-6, 0.1)
         _positive("episode_time", episode_time, control_dt, 100.0)
         _positive("relevitation_hold", relevitation_hold, 0.0, 100.0)
-        if int(samples_per_step) != samples_per_step or not 1 <= samples_per_step <= 1000:
+        _positive("samples_per_step", samples_per_step, 1, 1000)
+        if not float(samples_per_step).is_integer():
             raise ValueError(f"samples_per_step = {samples_per_step!r} must be an integer in [1, 1000]")
+        if overrides is not None and not isinstance(overrides, Mapping):
+            raise ValueError(f"overrides = {overrides!r} must be a dict of dotted scene keys, "
+                             "e.g. {'contact.friction': 0.3}")
         weights = dict(w_whirl=w_whirl, w_contact=w_contact, w_displacement=w_displacement,
                        w_effort=w_effort, w_success=w_success, w_failure=w_failure)
         for k, v in weights.items():
@@ -104,12 +114,15 @@ class RotorDropEnv(gym.Env):
         self.control_dt = self.dt = float(control_dt)
         self.n_steps = int(math.ceil(episode_time / control_dt - 1e-9))
         self.episode_time = self.n_steps * self.dt
-        self.randomize = bool(randomize)
-        self.full_state = bool(full_state)
+        self.randomize = _flag("randomize", randomize)
+        self.full_state = _flag("full_state", full_state)
         self.render_mode = render_mode
         self.weights = weights
         self.base_scene = self._make_scene(scene, overrides)
-        self.ranges = resolve_ranges(randomization, self._relevitate, self.base_scene)
+        self.ranges, fixed = resolve_ranges(randomization, self._relevitate, type(self).__name__)
+        #: keys the user fixed: never randomised (still drawn, so the others' draws stay put)
+        self.fixed_keys = fixed | frozenset(overrides or {}) | frozenset(
+            [POWER_RETURN] if power_return_time is not None else [])
         self.scene = self.base_scene
         fs = fault_state(self.base_scene)
         self.model = model = fs.model
@@ -124,7 +137,7 @@ class RotorDropEnv(gym.Env):
         self._act_shape = () if self._discrete else self.action_space.shape
         n_act = 1 if self._discrete else self.action_space.shape[0]
         self._bind(Buffers(model.n_state, n_obs, n_act, int(samples_per_step)))
-        self._configure_static(relevitation_hold, terminate_on_failure)
+        self._configure_static(relevitation_hold, _flag("terminate_on_failure", terminate_on_failure))
         self._renderer = None
         self._scenario: dict = {}
         self._needs_reset = True
@@ -141,7 +154,7 @@ class RotorDropEnv(gym.Env):
         if command not in (None, "discrete", "continuous"):
             raise ValueError(f"command = {command!r} must be 'discrete' or 'continuous'")
         if power_return_time is not None:
-            _positive("power_return_time", power_return_time, 0.0, 100.0)
+            _positive(POWER_RETURN, power_return_time, *POWER_RETURN_LIMITS)
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode = {render_mode!r} must be None or one of "
                              f"{self.metadata['render_modes']}")
@@ -217,11 +230,13 @@ class RotorDropEnv(gym.Env):
     # ------------------------------------------------------------------------ episode --
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         super().reset(seed=seed)
-        values = sample(self.ranges, self.np_random) if self.randomize else {}
-        fixed = dict((options or {}).get("scenario") or {})
+        values = sample(self.ranges, self.np_random, self.fixed_keys) if self.randomize else {}
+        fixed = (options or {}).get("scenario") or {}
         unknown = set(options or {}) - {"scenario"}
-        if unknown:
-            raise ValueError(f"unknown reset option(s) {sorted(unknown)}; use options="
+        if unknown or not isinstance(fixed, Mapping):
+            what = f"unknown reset option(s) {sorted(unknown)}" if unknown else \
+                f"reset option scenario = {fixed!r} is not a dict"
+            raise ValueError(f"{what}; use options="
                              "{'scenario': {dotted_key: value, 'power_return_time': s}}")
         values.update(fixed)
         if POWER_RETURN in values and not self._relevitate:
@@ -236,7 +251,7 @@ class RotorDropEnv(gym.Env):
         self.scene, self.model = scene, fs.model
         pr = values.get(POWER_RETURN, self.power_return_time)
         if pr is not None:
-            _positive(POWER_RETURN, pr, 0.0, 100.0)
+            _positive(POWER_RETURN, pr, *POWER_RETURN_LIMITS)
         self._configure_episode(fs, pr)
         b.y[:] = fs.y
         b.P[:] = fs.model.P
@@ -248,14 +263,22 @@ class RotorDropEnv(gym.Env):
         b.M[K.M_OK_START] = -1.0
         b.M[K.M_RELEV_T] = math.nan
         K.observe_now(b.y, b.P, b.I, b.U, b.C, b.M, b.work, b.aux, b.cur, b.scale, b.obs)
-        self._scenario = values
-        if pr is not None:
-            self._scenario = dict(values, **{POWER_RETURN: b.C[K.C_T_POWER] - fs.t_fault})
+        self._scenario = self._scenario_report(values, pr is not None)
         self._needs_reset = False
         if self.render_mode is not None:            # record from the first step of the episode
             self._ensure_renderer().reset()
             self._record()
         return b.obs.astype(np.float32), {"scenario": dict(self._scenario), "time_s": 0.0}
+
+    def _scenario_report(self, values: dict, power: bool) -> dict:
+        """The machine of this episode: the value of every randomisation key (drawn, fixed by
+        the user, or the scene's without ``randomize``) and of every key fixed by ``reset``
+        options; the power return as applied (on the control-step grid)."""
+        keys = sorted((set(self.ranges) | set(values)) - {POWER_RETURN})
+        out = {k: self.scene.get(k) for k in keys}
+        if power:
+            out[POWER_RETURN] = float(self._b.C[K.C_T_POWER] - self._b.C[K.C_T_FAULT])
+        return out
 
     def step(self, action):
         if self._needs_reset:
@@ -284,9 +307,11 @@ class RotorDropEnv(gym.Env):
         out = b.out
         if out[K.O_ERR]:
             what = "non-finite" if out[K.O_ERR] == K.ERR_NAN else "out-of-range"
+            if self._discrete:
+                raise ValueError(f"{what} action {action!r}: the {self.action_space} action "
+                                 "(levitate) must be 0 (stay off) or 1 (switch on)")
             raise ValueError(f"{what} action {action!r}: {self.action_space} entries must be finite "
-                             f"and in [-1, 1] ({', '.join(self.action_names)})"
-                             + (" (0 = stay off, 1 = switch on)" if self._discrete else ""))
+                             f"and in [-1, 1] ({', '.join(self.action_names)})")
         if out[K.O_STATUS]:
             raise IntegrationError(_explain(int(out[K.O_STATUS]), b.M[K.M_T], b.M[K.M_H], self.model))
         terminated = bool(out[K.O_TERM])
@@ -398,12 +423,19 @@ def step_infos(out: np.ndarray, M: np.ndarray, C: np.ndarray, relevitate: bool) 
 
 
 def _positive(name: str, value, lo: float, hi: float) -> None:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} = {value!r} must be a number in [{lo:g}, {hi:g}]") from None
-    if not (math.isfinite(v) and lo <= v <= hi):
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        raise ValueError(f"{name} = {value!r} must be a real number in [{lo:g}, {hi:g}], "
+                         f"not a {type(value).__name__}")
+    if not (math.isfinite(value) and lo <= value <= hi):
         raise ValueError(f"{name} = {value!r} must be in [{lo:g}, {hi:g}]")
+
+
+def _flag(name: str, value) -> bool:
+    """A bool kwarg (bool or numpy bool; strings and numbers are refused)."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise ValueError(f"{name} = {value!r} must be a bool (True or False), "
+                         f"not a {type(value).__name__}")
+    return bool(value)
 
 
 class PassiveEnv(RotorDropEnv):

@@ -3,6 +3,7 @@ the fault (so that no episode re-simulates the levitated phase before the drop).
 from __future__ import annotations
 
 import math
+import numbers
 from collections import OrderedDict
 from typing import Any, Mapping
 
@@ -10,10 +11,13 @@ import numpy as np
 
 from physics.equilibrium import levitated_state
 from physics.model import AMB_NONE, F_AMB, Model, build_model
-from physics.scene import Scene, SceneError
+from physics.scene import Scene, SceneError, param_meta
 from physics.simulate import Integrator, run_segments
 
 POWER_RETURN = "power_return_time"
+#: Allowed power return [s after the fault] (the ``power_return_time`` kwarg's range too).
+POWER_RETURN_LIMITS = (0.0, 100.0)
+LAWS = ("uniform", "log_uniform")
 
 #: Default randomisation ranges (spec §2 study ranges): key -> (law, low, high).
 #: ``uniform`` or ``log_uniform``; ``power_return_time`` [s after the fault] applies to the
@@ -28,42 +32,80 @@ DEFAULT_RANGES: dict[str, tuple[str, float, float]] = {
 }
 
 
-def resolve_ranges(custom: Mapping[str, Any] | None, relevitate: bool, base: Scene) -> dict:
-    """Merge user ranges into the defaults. A value is ``(low, high)`` (uniform),
-    ``(law, low, high)``, or ``None`` to keep that parameter fixed."""
-    ranges = dict(DEFAULT_RANGES)
-    for key, spec in (custom or {}).items():
+def resolve_ranges(custom: Mapping[str, Any] | None, relevitate: bool,
+                   env_name: str) -> tuple[dict, frozenset]:
+    """The defaults updated by the user's ``randomization``: (ranges drawn at every reset, keys
+    it fixes). A value is ``(low, high)`` (uniform), ``(law, low, high)``, or ``None``: fix the
+    key at the scene's value (it is still drawn, see :func:`sample`)."""
+    if custom is None:
+        custom = {}
+    if not isinstance(custom, Mapping):
+        raise ValueError(f"randomization = {custom!r} must be a dict {{key: (low, high) | "
+                         "(law, low, high) | None}")
+    if POWER_RETURN in custom and not relevitate:
+        raise ValueError(f"randomization[{POWER_RETURN!r}] applies to the re-levitation "
+                         f"environments only, not {env_name}")
+    ranges = {k: v for k, v in DEFAULT_RANGES.items() if relevitate or k != POWER_RETURN}
+    fixed = set()
+    for key, spec in custom.items():
         if spec is None:
-            ranges.pop(key, None)
-            continue
-        if key != POWER_RETURN:
-            base.get(key)                                   # unknown keys raise SceneError
-        spec = tuple(spec)
-        if len(spec) == 2:
-            spec = ("uniform",) + spec
-        if len(spec) != 3 or spec[0] not in ("uniform", "log_uniform"):
-            raise ValueError(f"randomization[{key!r}] = {spec!r}: give (low, high) or "
-                             "('uniform' | 'log_uniform', low, high)")
-        law, lo, hi = spec[0], float(spec[1]), float(spec[2])
-        if not (math.isfinite(lo) and math.isfinite(hi) and lo <= hi):
-            raise ValueError(f"randomization[{key!r}]: need finite low <= high, got ({lo}, {hi})")
-        if law == "log_uniform" and lo <= 0.0:
-            raise ValueError(f"randomization[{key!r}]: log_uniform needs low > 0, got {lo}")
-        ranges[key] = (law, lo, hi)
-    if not relevitate:
-        ranges.pop(POWER_RETURN, None)
-    return ranges
+            _bounds(key, real=False)                    # unknown keys raise
+            fixed.add(key)
+        else:
+            ranges[key] = parse_range(key, spec)
+    return ranges, frozenset(fixed)
 
 
-def sample(ranges: Mapping[str, tuple[str, float, float]], rng: np.random.Generator) -> dict:
-    """One draw per key, in sorted key order (reproducible for a seeded ``rng``)."""
+def parse_range(key: str, spec: Any) -> tuple[str, float, float]:
+    """``(low, high)`` or ``(law, low, high)`` -> (law, low, high), checked against the key's
+    allowed range (the scene's parameter table; [0, 100] s for ``power_return_time``)."""
+    what = f"randomization[{key!r}] = {spec!r}"
+    if not isinstance(spec, (list, tuple)) or len(spec) not in (2, 3):
+        raise ValueError(f"{what}: give (low, high), ('uniform' | 'log_uniform', low, high), "
+                         "or None to keep the key fixed")
+    law, lo, hi = ("uniform", *spec) if len(spec) == 2 else spec
+    if law not in LAWS:
+        raise ValueError(f"{what}: the law must be one of {', '.join(LAWS)}, got {law!r}")
+    if not all(isinstance(v, numbers.Real) and not isinstance(v, bool) for v in (lo, hi)):
+        raise ValueError(f"{what}: low and high must be real numbers")
+    lo, hi = float(lo), float(hi)
+    b_lo, b_hi, unit = _bounds(key)
+    if not (math.isfinite(lo) and math.isfinite(hi) and b_lo <= lo <= hi <= b_hi):
+        raise ValueError(f"{what}: need finite low <= high inside the allowed range of {key}, "
+                         f"[{b_lo:g}, {b_hi:g}] {unit}")
+    if law == "log_uniform" and lo <= 0.0:
+        raise ValueError(f"{what}: log_uniform needs low > 0")
+    return law, lo, hi
+
+
+def _bounds(key: str, real: bool = True) -> tuple[float, float, str]:
+    """(low, high, unit) a key may take; SceneError for an unknown key and, with ``real``, a
+    key that is not a real-valued scene parameter."""
+    if key == POWER_RETURN:
+        return (*POWER_RETURN_LIMITS, "s")
+    try:
+        meta = param_meta(key)
+    except SceneError as exc:
+        raise SceneError(f"randomization: {exc} (or {POWER_RETURN!r})") from None
+    if real and meta["type"] is not float:
+        raise SceneError(f"randomization[{key!r}]: {key} is a {meta['type'].__name__} parameter; "
+                         "only real-valued parameters can be randomised")
+    return meta["lo"], meta["hi"], meta["unit"]
+
+
+def sample(ranges: Mapping[str, tuple[str, float, float]], rng: np.random.Generator,
+           fixed: frozenset = frozenset()) -> dict:
+    """One draw per key, in sorted key order (reproducible for a seeded ``rng``). The ``fixed``
+    keys are drawn too and then left out, so that fixing a key does not change the other keys'
+    values for the same seed."""
     out = {}
     for key in sorted(ranges):
         law, lo, hi = ranges[key]
         u = rng.uniform()
         v = lo + u * (hi - lo) if law == "uniform" else math.exp(
             math.log(lo) + u * (math.log(hi) - math.log(lo)))
-        out[key] = min(max(v, lo), hi)          # no round-off outside the range
+        if key not in fixed:
+            out[key] = min(max(v, lo), hi)      # no round-off outside the range
     return out
 
 
