@@ -31,13 +31,25 @@ the power returns.
 """
 from __future__ import annotations
 
+from contextlib import contextmanager
+
 import numpy as np
 
-from .plant import Plant
+from .plant import ControllerError, Plant
 
 
 class Controller:
-    """Base class: ``act(obs)`` maps a batch of raw observations to a batch of actions."""
+    """Base class: ``act(obs)`` maps a batch of raw observations to a batch of actions.
+
+    Subclasses set ``name`` and ``needs`` and return channel values from ``commands(obs)``
+    (:mod:`agents.plant`). One controller drives many episodes, so ``__init__`` is for
+    constants (gains); **per-episode state** (integrators, filters, timers, flags) is (re)set in
+    ``reset(n, which)``, which ``predict`` calls at episode starts: for all ``n`` environments
+    when ``which`` is None, else where ``which`` is True. Override it, call
+    ``super().reset(n, which)`` first and give each state array ``n`` rows. ``self.t`` (n,) is
+    the time since each episode's start [s]. Errors in a controller, and commands of an unknown
+    channel, shape or range, raise :class:`~agents.plant.ControllerError` naming it.
+    """
 
     name = "controller"
     #: channels the controller sets (a subset of Plant.channels); the rest stay passive
@@ -73,7 +85,9 @@ class Controller:
         if "damping" in self.plant.channels and self.fresh.any():
             self.hold[self.fresh] = self.plant.damping_level(obs[self.fresh])
         self.fresh[:] = False
-        action = self.plant.compose(len(obs), self.commands(obs), self.hold)
+        with blame(self, "commands(obs)"):
+            commands = self.commands(obs)
+        action = self.plant.compose(len(obs), commands, self.hold, describe(self))
         self.t += self.plant.control_dt
         return action
 
@@ -82,15 +96,40 @@ class Controller:
         obs = np.asarray(observation, dtype=np.float64)
         single = obs.ndim == 1
         obs = np.atleast_2d(obs)
-        if self.n != len(obs):
-            self.reset(len(obs))
-        elif episode_start is not None and np.any(episode_start):
-            self.reset(len(obs), np.asarray(episode_start, dtype=bool).reshape(-1))
+        with blame(self, "reset(n, which)"):
+            if self.n != len(obs):
+                self.reset(len(obs))
+            elif episode_start is not None and np.any(episode_start):
+                self.reset(len(obs), np.asarray(episode_start, dtype=bool).reshape(-1))
+        if self.n != len(obs) or len(self.t) != len(obs):
+            raise ControllerError(f"{describe(self)}: its reset(n, which) must call "
+                                  f"super().reset(n, which)")
         action = self.act(obs)
         return (action[0] if single else action), state
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}({self.name!r})"
+
+
+def describe(actor) -> str:
+    """How errors name a controller (class or instance) or another actor (a learned policy)."""
+    cls = actor if isinstance(actor, type) else type(actor)
+    if issubclass(cls, Controller):
+        return f"controller {cls.name!r} ({cls.__name__})"
+    return f"policy {getattr(actor, 'name', cls.__qualname__)!r}"
+
+
+@contextmanager
+def blame(actor, what: str):
+    """Re-raise an error inside as one :class:`ControllerError` line naming ``actor`` and
+    ``what`` it was doing (the original exception chained)."""
+    try:
+        yield
+    except ControllerError:
+        raise
+    except Exception as exc:
+        raise ControllerError(f"{describe(actor)}: {what} failed: {type(exc).__name__}: "
+                              f"{exc.args[0] if len(exc.args) == 1 else exc}") from exc
 
 
 class Passive(Controller):
@@ -306,6 +345,9 @@ def load_controller(spec: str) -> type[Controller]:
             path = Path(target)
             if not path.is_file():
                 raise FileNotFoundError(f"controller {spec!r}: no file {path}")
+            folder = str(path.resolve().parent)  # its sibling modules import, as `python file.py`
+            if folder not in sys.path:
+                sys.path.insert(0, folder)
             module_spec = importlib.util.spec_from_file_location(f"rotordrop_user_{path.stem}", path)
             module = importlib.util.module_from_spec(module_spec)
             sys.modules[module_spec.name] = module      # as an import would (dataclasses need it)
@@ -344,11 +386,32 @@ def controller_class(spec: str) -> type[Controller] | None:
 
 
 def make_controller(cls: type[Controller], plant: Plant) -> Controller:
-    """``cls(plant)`` after checking that the environment has the channels it needs."""
+    """``cls(plant)`` after checking that the environment has the channels it needs; an error
+    in the constructor (say an argument without default) is a :class:`ControllerError`."""
     if not cls.supports(plant):
         raise ValueError(f"controller {cls.name!r} needs action channels {cls.needs}, which "
                          f"{plant.env_id} does not have (it has {', '.join(plant.channels)})")
-    return cls(plant)
+    with blame(cls, f"{cls.__name__}(plant)"):
+        return cls(plant)
+
+
+def check_controller(actor, plant: Plant, obs: np.ndarray) -> None:
+    """Fail fast before long work: ``actor.predict`` (a controller or a learned policy) on one
+    raw observation ``obs`` of the plant's environment, alone and as a batch of two new
+    episodes; anything wrong raises :class:`ControllerError` naming the actor."""
+    obs = np.asarray(obs)
+    if obs.shape != (len(plant.obs_names),):
+        raise ValueError(f"check_controller: obs has shape {obs.shape}, {plant.env_id} "
+                         f"observes ({len(plant.obs_names)},)")
+    shape = () if plant.discrete else (len(plant.action_names),)
+    for batch in (obs, np.stack([obs, obs])):
+        n = 1 if batch.ndim == 1 else len(batch)
+        with blame(actor, "predict(obs)"):
+            action, _ = actor.predict(batch, episode_start=np.ones(n, dtype=bool))
+        want = shape if batch.ndim == 1 else (n, *shape)
+        if np.shape(action) != want:
+            raise ControllerError(f"{describe(actor)}: predict returned actions of shape "
+                                  f"{np.shape(action)} for {plant.env_id}, expected {want}")
 
 
 def make_baseline(name: str, plant: Plant) -> Controller:

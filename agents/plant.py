@@ -8,18 +8,22 @@ VecEnv). Controllers address observations by name and build actions by *channel*
 channel       meaning of the value a controller gives (per environment)
 ============  =========================================================================
 ``damping``   (n, 2) damper commands in [-1, 1] (-1 = C_min, +1 = C_max) of housing 1, 2
-``levitate``  (n,) 1 = switch the built-in levitation controller on, 0 = stay off
+``levitate``  (n,) or (n, 1) 1 = switch the built-in levitation controller on, 0 = stay off
               (``command="discrete"``)
 ``currents``  (n, 4) control currents / current limit, AMB1 x, AMB1 y, AMB2 x, AMB2 y
               (``command="continuous"``)
 ============  =========================================================================
 
-Channels a controller does not set stay passive (damping held at its value at the episode
-start, AMBs off).
+Channels a controller does not set (or sets to None) stay passive (damping held at its value at
+the episode start, AMBs off). :meth:`Plant.compose` rejects, with a :class:`ControllerError`, a
+channel the environment does not have, a value of another shape and a value outside [-1, 1]
+(beyond round-off ``ROUND_OFF``) or NaN: it never clips or broadcasts a controller's mistake.
 """
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
+from difflib import get_close_matches
 from functools import cached_property
 
 import numpy as np
@@ -29,6 +33,16 @@ from rotordrop_env.layout import CURRENT_ACTIONS as CURRENT_NAMES
 SENSORS = ("x1", "y1", "vx1", "vy1", "x2", "y2", "vx2", "vy2", "rotor_speed")
 POSITIONS = ("x1", "y1", "x2", "y2")
 VELOCITIES = ("vx1", "vy1", "vx2", "vy2")
+#: columns per environment of each channel, and what its normalised value means
+CHANNEL_WIDTH = {"damping": 2, "levitate": 1, "currents": 4}
+CHANNEL_UNITS = {"damping": "-1 = C_min, +1 = C_max, not N s/m",
+                 "levitate": "1 = on, 0 = off",
+                 "currents": "current / current limit, not A"}
+ROUND_OFF = 1e-6        # tolerated excess over |value| = 1 (clipped away)
+
+
+class ControllerError(ValueError):
+    """A controller's bug or bad command, named with the controller (one line in the CLIs)."""
 
 
 def make_env(env_id: str, **kwargs):
@@ -184,24 +198,62 @@ class Plant:
                 "currents": list(CURRENT_NAMES)}
         return {ch: [names.index(n) for n in cols[ch]] for ch in self.channels}
 
-    def compose(self, n: int, commands: dict, hold_damping: np.ndarray | None = None) -> np.ndarray:
-        """The env action for each of n environments from channel commands (module docstring).
+    def checked(self, commands, n: int, who: str = "controller") -> dict[str, np.ndarray]:
+        """``commands`` (channel -> value) as (n, width) float arrays, None values dropped;
+        a :class:`ControllerError` naming ``who`` for anything else (module docstring)."""
+        if not isinstance(commands, Mapping):
+            raise ControllerError(f"{who}: commands() returned {type(commands).__name__}, expected "
+                                  f"a dict channel -> array (channels of {self.env_id}: "
+                                  f"{', '.join(self.channels) or 'none'})")
+        return {ch: self._checked_channel(ch, v, n, who)
+                for ch, v in commands.items() if v is not None}
+
+    def _checked_channel(self, channel, value, n: int, who: str) -> np.ndarray:
+        if channel not in self.channels:
+            raise ControllerError(f"{who}: {self._channel_problem(channel)}; {self.env_id} has "
+                                  f"the channels {', '.join(self.channels) or 'none'}")
+        try:
+            v = np.asarray(value, dtype=np.float64)
+        except (TypeError, ValueError) as exc:
+            raise ControllerError(f"{who}: channel {channel!r} is not numeric ({exc})") from exc
+        width = CHANNEL_WIDTH[channel]
+        shapes = [(n, width)] + ([(n,)] if width == 1 else [])
+        if v.shape not in shapes:
+            raise ControllerError(f"{who}: channel {channel!r} has shape {v.shape}, expected "
+                                  f"{' or '.join(map(str, shapes))} (one row per observation; "
+                                  f"e.g. np.full({shapes[0]}, value))")
+        bad = ~(np.abs(v) <= 1.0 + ROUND_OFF)                       # NaN is bad too
+        if bad.any():
+            raise ControllerError(f"{who}: channel {channel!r} value {v[bad][0]:g} is outside the "
+                                  f"allowed range [-1, 1] ({CHANNEL_UNITS[channel]})")
+        return v.reshape(n, width)
+
+    def _channel_problem(self, channel) -> str:
+        if channel in CHANNEL_WIDTH:
+            return (f"channel {channel!r} is not an action of this environment (set it only "
+                    f"if {channel!r} in self.plant.channels)")
+        close = get_close_matches(str(channel), list(CHANNEL_WIDTH), n=1)
+        return f"unknown channel {channel!r}" + (f" (did you mean {close[0]!r}?)" if close else "")
+
+    def compose(self, n: int, commands: dict, hold_damping: np.ndarray | None = None,
+                who: str = "controller") -> np.ndarray:
+        """The env action for each of n environments from channel commands (module docstring),
+        checked with :meth:`checked` (``who`` names the controller in errors).
 
         ``hold_damping`` (n, 2) is the passive damper command used when ``damping`` is not given.
         """
+        c = self.checked(commands, n, who)
+        lev = c["levitate"][:, 0] if "levitate" in c else None
         if self.discrete:
-            lev = commands.get("levitate")
-            return (np.zeros(n, dtype=np.int64) if lev is None
-                    else (np.asarray(lev) > 0.5).astype(np.int64))
+            return np.zeros(n, dtype=np.int64) if lev is None else (lev > 0.5).astype(np.int64)
         a = np.zeros((n, len(self.action_names)), dtype=np.float32)
         cols = self._action_columns
         if "damping" in cols:
-            d = commands.get("damping", hold_damping)
+            d = c.get("damping", hold_damping)
             if d is not None:
                 a[:, cols["damping"]] = d
         if "levitate" in cols:
-            lev = commands.get("levitate")
-            a[:, cols["levitate"][0]] = -1.0 if lev is None else np.where(np.asarray(lev) > 0.5, 1.0, -1.0)
-        if "currents" in cols and commands.get("currents") is not None:
-            a[:, cols["currents"]] = commands["currents"]
-        return np.clip(a, -1.0, 1.0)
+            a[:, cols["levitate"][0]] = -1.0 if lev is None else np.where(lev > 0.5, 1.0, -1.0)
+        if "currents" in c:
+            a[:, cols["currents"]] = c["currents"]
+        return np.clip(a, -1.0, 1.0)                  # round-off within ROUND_OFF only

@@ -2,7 +2,9 @@
 
 ``run_episodes`` is what ``evaluate`` and ``benchmark`` use: one environment per scenario,
 episodes seeded ``seeds[i]``, the KPIs taken from the final step's ``info`` (``kpi_*``), and,
-when asked, the time series needed for the orbit and force plots.
+when asked, the time series needed for the orbit and force plots. A controller is built afresh
+for every episode (so state it keeps outside ``reset`` cannot leak into the next one); a
+learned policy is built once. ``check_actor`` fails fast on a broken actor before long runs.
 """
 from __future__ import annotations
 
@@ -11,6 +13,7 @@ from typing import Callable
 
 import numpy as np
 
+from .controllers import Controller, check_controller
 from .plant import Plant, make_env
 
 
@@ -26,6 +29,7 @@ class Episode:
     actions: np.ndarray | None = None
     contact_force: np.ndarray | None = None     # per step, (steps, n) [N]
     obs_names: tuple[str, ...] = ()
+    scenario: dict | None = None                # the scenario drawn at reset (info["scenario"])
 
 
 def final_kpis(info: dict) -> dict:
@@ -35,18 +39,38 @@ def final_kpis(info: dict) -> dict:
 
 def run_episodes(env_id: str, make_actor: Callable[[Plant], object], seeds, env_kwargs=None,
                  record: bool = False) -> list[Episode]:
-    """Run one episode per seed with the actor built by ``make_actor(plant)``."""
+    """Run one episode per seed with the actor built by ``make_actor(plant)`` (a controller
+    anew for each episode)."""
     env = make_env(env_id, **(env_kwargs or {}))
     try:
         plant = Plant.from_env(env)
         actor = make_actor(plant)
-        return [_episode(env, plant, actor, int(s), record) for s in seeds]
+        episodes = []
+        for i, s in enumerate(seeds):
+            if i and isinstance(actor, Controller):
+                actor = make_actor(plant)
+            episodes.append(_episode(env, plant, actor, int(s), record))
+        return episodes
+    finally:
+        env.close()
+
+
+def check_actor(env_id: str, make_actor: Callable[[Plant], object], env_kwargs=None) -> None:
+    """Build the actor for ``gym.make(env_id, **env_kwargs)`` and run
+    :func:`~agents.controllers.check_controller` on its first observation (seed 0): raises
+    ``ControllerError`` (a ValueError) naming the actor if it cannot act."""
+    env = make_env(env_id, **(env_kwargs or {}))
+    try:
+        plant = Plant.from_env(env)
+        obs, _ = env.reset(seed=0)
+        check_controller(make_actor(plant), plant, obs)
     finally:
         env.close()
 
 
 def _episode(env, plant: Plant, actor, seed: int, record: bool) -> Episode:
     obs, info = env.reset(seed=seed)
+    scenario = info.get("scenario")
     total, steps = 0.0, 0
     rec_obs, rec_act, rec_f = [], [], []
     start, running = np.ones(1, dtype=bool), np.zeros(1, dtype=bool)
@@ -64,7 +88,7 @@ def _episode(env, plant: Plant, actor, seed: int, record: bool) -> Episode:
         steps += 1
         if terminated or truncated:
             break
-    ep = Episode(seed, final_kpis(info), total, steps, obs_names=plant.obs_names)
+    ep = Episode(seed, final_kpis(info), total, steps, obs_names=plant.obs_names, scenario=scenario)
     if record:
         ep.t = np.arange(steps) * plant.control_dt
         ep.obs = np.array(rec_obs)
