@@ -27,11 +27,17 @@ algorithm's constructor arguments a block may hold:
 =================  ===========================================================================
 
 ``learning_rate``, ``clip_range`` accept ``lin_<value>`` (linear decay to zero, as in rl-zoo3).
+Any other key must be a constructor argument of the algorithm (:func:`check_sb3` checks the
+keys against the signatures of the algorithm, ``VecNormalize`` and the environment before
+training starts).
 """
 from __future__ import annotations
 
 import ast
 import copy
+import difflib
+import inspect
+import math
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -42,6 +48,15 @@ META_KEYS = ("n_timesteps", "n_envs", "policy", "policy_kwargs", "normalize", "e
              "reward", "reward_kwargs", "residual", "residual_scale", "validation")
 REWARDS = ("env", "kpi")
 SCHEDULE_KEYS = ("learning_rate", "clip_range")
+#: constructor arguments ``rotordrop train`` sets itself, and where they come from instead
+SET_BY_TRAIN = {"policy": "the config key policy", "env": "--env", "seed": "--seed",
+                "device": "always cpu", "tensorboard_log": "--out", "verbose": "--verbose",
+                "action_noise": "noise_type / noise_std", "_init_setup_model": "internal"}
+#: integer hyperparameters and their smallest allowed value
+INTEGERS = {"n_timesteps": 1, "n_envs": 1, "eval_freq": 0, "n_eval_episodes": 1, "checkpoint_freq": 0,
+            "n_steps": 1, "batch_size": 1, "n_epochs": 1, "buffer_size": 1, "learning_starts": 0}
+#: hyperparameters that are fractions in [0, 1]
+FRACTIONS = ("gamma", "gae_lambda", "tau")
 
 
 class ConfigError(ValueError):
@@ -54,6 +69,12 @@ def _yaml():
     except ImportError as exc:   # pragma: no cover - the rl extra installs it
         raise ConfigError("reading hyperparameter files needs PyYAML: pip install 'rotordrop[rl]'") from exc
     return yaml
+
+
+def algo_class(algo: str):
+    """The Stable-Baselines3 class of ``algo``."""
+    import stable_baselines3 as sb3
+    return {"ppo": sb3.PPO, "sac": sb3.SAC, "td3": sb3.TD3}[algo]
 
 
 def default_config_path(algo: str) -> Path:
@@ -181,16 +202,78 @@ def split(hp: dict) -> tuple[dict, dict]:
         raise ConfigError(f"validation must be true or false, got {meta['validation']!r}")
     if not isinstance(meta.setdefault("reward_kwargs", {}) or {}, dict):
         raise ConfigError(f"reward_kwargs must be a mapping, got {meta['reward_kwargs']!r}")
-    for k, lo in (("n_timesteps", 1), ("n_envs", 1), ("eval_freq", 0), ("n_eval_episodes", 1),
-                  ("checkpoint_freq", 0)):
-        if k in meta:
-            try:
-                meta[k] = int(float(meta[k]))
-            except (TypeError, ValueError) as exc:
-                raise ConfigError(f"{k} must be an integer, got {meta[k]!r}") from exc
-            if meta[k] < lo:
-                raise ConfigError(f"{k} must be >= {lo}, got {meta[k]}")
+    meta["env_kwargs"] = meta.get("env_kwargs") or {}
+    if not isinstance(meta["env_kwargs"], dict):
+        raise ConfigError(f"env_kwargs must be a mapping, got {meta['env_kwargs']!r}")
+    if meta["reward_kwargs"]:
+        if meta["reward"] != "kpi":
+            raise ConfigError("reward_kwargs are the weights of reward: kpi; set reward: kpi or drop them")
+        from .reward import check_reward_kwargs
+        check_reward_kwargs(meta["reward_kwargs"])
+    for d in (meta, algo_kwargs):
+        for k in (k for k in INTEGERS if k in d):
+            d[k] = _integer(d[k], k, INTEGERS[k])
+    for k in FRACTIONS:
+        if k in algo_kwargs and not (is_finite_number(algo_kwargs[k]) and 0.0 <= algo_kwargs[k] <= 1.0):
+            raise ConfigError(f"{k} must be a number in [0, 1], got {algo_kwargs[k]!r}")
     return meta, algo_kwargs
+
+
+def is_finite_number(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def _integer(value: Any, key: str, lo: int) -> int:
+    """``value`` as an int (YAML writes 1e6 as a float) if it is a whole number >= ``lo``."""
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        number = None
+    if isinstance(value, bool) or number is None or not number.is_integer():
+        raise ConfigError(f"{key} must be an integer, got {value!r}")
+    if number < lo:
+        raise ConfigError(f"{key} must be >= {lo}, got {int(number)}")
+    return int(number)
+
+
+def check_keys(kind: str, given, allowed) -> None:
+    """ConfigError naming the first key of ``given`` not in ``allowed`` (and a close match)."""
+    unknown = [k for k in given if k not in allowed]
+    if unknown:
+        close = difflib.get_close_matches(str(unknown[0]), list(allowed), n=1)
+        hint = f" (did you mean {close[0]}?)" if close else ""
+        raise ConfigError(f"{kind}: unknown key {unknown[0]!r}{hint}; allowed: {', '.join(allowed)}")
+
+
+def signature_keys(fn, skip: tuple[str, ...] = ("self",)) -> tuple[str, ...]:
+    """The named keyword arguments of ``fn``."""
+    kinds = (inspect.Parameter.POSITIONAL_OR_KEYWORD, inspect.Parameter.KEYWORD_ONLY)
+    return tuple(k for k, p in inspect.signature(fn).parameters.items()
+                 if p.kind in kinds and k not in skip)
+
+
+def check_sb3(algo: str, env_id: str, meta: dict, algo_kwargs: dict) -> None:
+    """The keys of ``split``'s output against what they are passed to: the algorithm's
+    constructor, ``VecNormalize`` and the environment's constructor (ConfigError naming the key)."""
+    from stable_baselines3.common.vec_env import VecNormalize
+    for key in algo_kwargs:
+        if key in SET_BY_TRAIN:
+            raise ConfigError(f"{key} is set by rotordrop train ({SET_BY_TRAIN[key]}), not in the config")
+    check_keys(f"{algo} config", algo_kwargs,
+               list(dict.fromkeys([k for k in signature_keys(algo_class(algo).__init__)
+                                   if k not in SET_BY_TRAIN] + list(META_KEYS))))
+    if isinstance(meta["normalize"], dict):
+        check_keys("normalize (VecNormalize arguments)", meta["normalize"],
+                   signature_keys(VecNormalize.__init__, skip=("self", "venv")))
+    check_keys(f"env_kwargs ({env_id} arguments)", meta["env_kwargs"], env_arguments(env_id))
+
+
+def env_arguments(env_id: str) -> tuple[str, ...]:
+    """The constructor keyword arguments of a registered environment."""
+    import gymnasium as gym
+    from gymnasium.envs.registration import load_env_creator
+    import rotordrop_env  # noqa: F401  (registers the ids)
+    return signature_keys(load_env_creator(gym.spec(env_id).entry_point).__init__)
 
 
 def dump_yaml(data: dict, path: str | Path) -> None:

@@ -26,6 +26,21 @@ import numpy as np
 from physics.metrics import WHIRL_MIN_REVOLUTIONS
 
 PEAK_KEYS = ("kpi_peak_whirl_revolutions", "kpi_peak_contact_force_N", "kpi_max_displacement_um")
+#: the ``reward_kwargs`` and their defaults
+WEIGHTS = dict(w_whirl=1.0, w_force=0.5, w_disp=0.5, force_ref=1e4, disp_ref_um=800.0,
+               w_relevitate=1.0, w_time=1.0)
+REFERENCES = ("force_ref", "disp_ref_um")
+
+
+def check_reward_kwargs(kwargs: dict) -> None:
+    """ConfigError unless ``kwargs`` are known weights >= 0 and references > 0."""
+    from .hyperparams import ConfigError, check_keys, is_finite_number
+    check_keys("reward_kwargs", kwargs, tuple(WEIGHTS))
+    for key, value in kwargs.items():
+        positive = key in REFERENCES
+        if not (is_finite_number(value) and (value > 0.0 if positive else value >= 0.0)):
+            raise ConfigError(f"reward_kwargs.{key} must be a finite number "
+                              f"{'> 0' if positive else '>= 0'}, got {value!r}")
 
 
 def kpi_potential(revs, force_N, disp_um, w_whirl: float, w_force: float, w_disp: float,
@@ -41,15 +56,14 @@ def make_kpi_reward(venv, **kwargs):
     from stable_baselines3.common.vec_env import VecEnvWrapper
 
     class KpiReward(VecEnvWrapper):
-        def __init__(self, venv, w_whirl: float = 1.0, w_force: float = 0.5, w_disp: float = 0.5,
-                     force_ref: float = 1e4, disp_ref_um: float = 800.0, w_relevitate: float = 1.0,
-                     w_time: float = 1.0):
+        def __init__(self, venv, **weights):
             super().__init__(venv)
-            self.w = dict(w_whirl=w_whirl, w_force=w_force, w_disp=w_disp, force_ref=force_ref,
-                          disp_ref_um=disp_ref_um)
-            self.w_relevitate = w_relevitate
+            check_reward_kwargs(weights)
+            w = {**WEIGHTS, **weights}
+            self.w_relevitate = w.pop("w_relevitate")
             dt, horizon = (np.asarray(venv.get_attr(a), dtype=float) for a in ("dt", "episode_time"))
-            self.time_cost = w_time * dt / horizon
+            self.time_cost = w.pop("w_time") * dt / horizon
+            self.w = w
             self.phi = np.zeros(self.num_envs)
 
         def reset(self):

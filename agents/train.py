@@ -14,23 +14,41 @@ One run writes into ``--out``:
 ===========================  ================================================================
 
 ``--resume DIR|CHECKPOINT.zip`` continues a run from its newest (or the given) checkpoint with
-the statistics and replay buffer saved next to it.
+the statistics and replay buffer saved next to it. Resumed into its own directory
+(``--resume R --out R``) the run's record continues: the learning curve and
+``eval/evaluations.npz`` keep their entries, ``monitor.csv`` is appended to and ``best/`` is only
+replaced by a model that beats the best score recorded so far. Any other ``--out`` must be new or
+hold no run unless ``overwrite`` (``--overwrite``) removes the run in it.
+
+The final model is always evaluated (and checkpointed, with ``checkpoint_freq`` > 0) unless the
+last step already was an evaluation (a checkpoint), so a run shorter than ``eval_freq`` still
+writes ``best/`` and its learning curve. Every input is checked before anything is written: a
+bad key or value raises :class:`~agents.hyperparams.ConfigError` naming it.
 """
 from __future__ import annotations
 
 import json
 import re
 import shlex
+import shutil
 import sys
 import time
-from dataclasses import dataclass
+import zipfile
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from .hyperparams import ALGOS, ConfigError, dump_yaml, load_hyperparams, split
+from .hyperparams import ALGOS, ConfigError, check_sb3, dump_yaml, load_hyperparams, read_yaml, split
+from .hyperparams import algo_class as _algo_class
 
 OFF_POLICY = ("sac", "td3")
+#: the module of a saved model's policy class -> its algorithm
+POLICY_MODULES = {"stable_baselines3.common.policies": "ppo", "stable_baselines3.sac.policies": "sac",
+                  "stable_baselines3.td3.policies": "td3"}
+#: what a run writes into --out (a directory holding one of them holds a run)
+RUN_FILES = ("model.zip", "vecnormalize.pkl", "config.yaml", "training.json", "learning_curve.png",
+             "monitor.csv", "best", "checkpoints", "eval", "tb")
 
 
 @dataclass
@@ -40,16 +58,21 @@ class TrainResult:
     vecnormalize_path: Path
     timesteps: int
     wall_time_s: float
+    files: list[str] = field(default_factory=list)      # written, relative to ``out``
+    evaluations: int = 0                                  # evaluations in this session
 
-
-def _algo_class(algo: str):
-    import stable_baselines3 as sb3
-    return {"ppo": sb3.PPO, "sac": sb3.SAC, "td3": sb3.TD3}[algo]
+    def summary(self) -> str:
+        """The CLI's line: steps, time, every file written (and why best/ is missing)."""
+        line = (f"trained {self.timesteps} steps in {self.wall_time_s:.0f} s; wrote "
+                + ", ".join(str(self.out / f) for f in self.files))
+        if not self.evaluations:
+            line += "; no evaluation ran (eval_freq: 0, or no steps to go): no best/ model"
+        return line
 
 
 def _callbacks():
     """SB3 callback classes, defined lazily so that importing this module stays light."""
-    from stable_baselines3.common.callbacks import BaseCallback, EvalCallback
+    from stable_baselines3.common.callbacks import BaseCallback, CheckpointCallback, EvalCallback
 
     from .rollout import final_kpis
     from .score import mean_finite
@@ -102,6 +125,9 @@ def _callbacks():
                 self.kpi_history.append(entry)
             return cont
 
+        def _on_training_end(self):
+            _run_now(self, "eval_freq")          # the final model, unless just evaluated
+
     class TqdmCallback(BaseCallback):
         """A tqdm progress bar over environment steps (no `rich` dependency)."""
 
@@ -132,14 +158,18 @@ def _callbacks():
         suite (:class:`agents.benchmark.Validator`); the best-scoring model goes to ``best/``
         with its VecNormalize statistics, and the score into the learning curve."""
 
-        def __init__(self, env_id, algo, env_kwargs, meta, best_dir: Path, eval_cb):
+        def __init__(self, env_id, algo, env_kwargs, meta, best_dir: Path, eval_cb,
+                     best: float = -np.inf):
             super().__init__()
             from .benchmark import Validator
             self.validator = Validator(env_id)
             self.env_id, self.algo, self.env_kwargs, self.meta = env_id, algo, env_kwargs, meta
             self.best_dir, self.eval_cb = best_dir, eval_cb
-            self.best = -np.inf
-            self.seen = 0
+            self.best = best                        # a continued run's best score so far
+            self.seen = len(eval_cb.kpi_history)
+
+        def _init_callback(self) -> None:
+            self.best_dir.mkdir(parents=True, exist_ok=True)
 
         def _on_step(self) -> bool:
             if len(self.eval_cb.kpi_history) == self.seen:
@@ -160,7 +190,61 @@ def _callbacks():
                     vn.save(str(self.best_dir / "vecnormalize.pkl"))
             return True
 
-    return SaveVecNormalize, KpiEvalCallback, TqdmCallback, ValidationCallback
+        def _on_training_end(self):
+            self._on_step()                         # scores the final evaluation, if any
+            self.logger.dump(self.num_timesteps)
+
+    class FinalCheckpoint(CheckpointCallback):
+        """CheckpointCallback that also saves the final model, so that a run shorter than
+        ``checkpoint_freq`` or between two checkpoints can be resumed where it ended."""
+
+        def _on_training_end(self):
+            _run_now(self, "save_freq")
+
+    class RecordCallback(BaseCallback):
+        """Writes ``training.json`` (``record``, steps, wall time, learning curve) after every
+        evaluation and, with :meth:`write`, at the end: an interrupted run keeps its record."""
+
+        def __init__(self, path: Path, record: dict, eval_cb):
+            super().__init__()
+            self.path, self.record, self.eval_cb = path, record, eval_cb
+            self.seen = len(eval_cb.kpi_history)
+            self.t0, self.start = time.perf_counter(), 0
+
+        def _on_training_start(self):
+            self.t0, self.start = time.perf_counter(), self.model.num_timesteps
+
+        def _on_step(self) -> bool:
+            if len(self.eval_cb.kpi_history) != self.seen:
+                self.seen = len(self.eval_cb.kpi_history)
+                self.write(finished=False)
+            return True
+
+        def write(self, finished: bool) -> float:
+            wall = time.perf_counter() - self.t0
+            steps = self.model.num_timesteps - self.start
+            summary = dict(self.record, timesteps=int(self.model.num_timesteps), wall_time_s=wall,
+                           steps_per_s=steps / wall if wall > 0 else None, finished=finished,
+                           learning_curve=self.eval_cb.kpi_history)
+            self.path.write_text(json.dumps(summary, indent=2, default=str))
+            return wall
+
+    return (SaveVecNormalize, KpiEvalCallback, TqdmCallback, ValidationCallback, FinalCheckpoint,
+            RecordCallback)
+
+
+def _run_now(cb, freq_attr: str) -> None:
+    """Run a periodic SB3 callback's action at the current step (``n_calls % n_calls == 0``)
+    unless it is disabled, no step was taken or this step already ran it."""
+    freq = getattr(cb, freq_attr)
+    if freq <= 0 or cb.n_calls == 0 or cb.n_calls % freq == 0:
+        return
+    cb.num_timesteps = cb.model.num_timesteps
+    setattr(cb, freq_attr, cb.n_calls)
+    try:
+        cb._on_step()
+    finally:
+        setattr(cb, freq_attr, freq)
 
 
 def find_checkpoint(path: str | Path) -> tuple[Path, Path | None, Path | None]:
@@ -198,101 +282,293 @@ def resolve_config(env_id: str, algo: str, config=None, timesteps=None, n_envs=N
 def train(env_id: str, algo: str, out: str | Path, timesteps: int | None = None,
           n_envs: int | None = None, config: str | Path | None = None, seed: int = 0,
           resume: str | Path | None = None, threads: int = 1, progress: bool = True,
-          verbose: int = 0, command: str | None = None) -> TrainResult:
-    """Train ``algo`` on ``env_id`` and save model, statistics, config and learning curve."""
+          verbose: int = 0, command: str | None = None, overwrite: bool = False) -> TrainResult:
+    """Train ``algo`` on ``env_id`` and save model, statistics, config and learning curve
+    (module docstring: resuming, an existing ``out``, the final evaluation)."""
     if algo not in ALGOS:
         raise ConfigError(f"--algo must be one of {', '.join(ALGOS)}, got {algo!r}")
-    from stable_baselines3.common.callbacks import CallbackList, CheckpointCallback
-    from stable_baselines3.common.vec_env import VecNormalize
+    if int(threads) < 1:
+        raise ConfigError(f"--threads must be >= 1, got {threads}")
+    from stable_baselines3.common.callbacks import CallbackList
 
-    from .plant import make_vec_env
-
-    set_threads(threads)
     out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
     hp = resolve_config(env_id, algo, config, timesteps, n_envs)
     meta, algo_kwargs = split(hp)
+    check_sb3(algo, env_id, meta, algo_kwargs)
+    ckpt = find_checkpoint(resume) if resume is not None else None
+    if ckpt is not None:
+        _check_resumed_run(ckpt[0], algo, env_id)
+    continuing = ckpt is not None and run_dir(ckpt[0]).resolve() == out.resolve()
+    held = _held_run(out, continuing, overwrite)
+    curve, eval_log = (_previous_record(out, meta.get("n_eval_episodes", 5)) if continuing
+                       else ([], {}))
+    check_env(env_id, algo, meta)
+    set_threads(threads)
     total = meta.get("n_timesteps", 100_000)
-    n = meta.get("n_envs", 1)
-    env_kwargs = dict(meta.get("env_kwargs") or {})
-    Algo = _algo_class(algo)
-    if algo in OFF_POLICY and env_id.endswith("Relevitate-v0") and env_kwargs.get("command") == "discrete":
-        raise ConfigError(f"{algo} needs continuous actions: set env_kwargs.command = continuous")
+    monitor, eval_venv, model = _build(env_id, algo, meta, algo_kwargs, seed, ckpt, out, verbose)
+    remaining = max(0, total - model.num_timesteps)
+    if ckpt is not None:
+        print(f"resuming from {ckpt[0]} at {model.num_timesteps} steps; {remaining} to go")
 
-    rw = dict(reward=meta["reward"], reward_kwargs=meta["reward_kwargs"],
-              residual=meta.get("residual"), residual_scale=meta.get("residual_scale"))
-    venv = make_vec_env(env_id, n, seed, env_kwargs, monitor_file=out / "monitor.csv", **rw)
-    eval_venv = make_vec_env(env_id, 1, seed + 10_000, env_kwargs, **rw)
-    norm = meta["normalize"]
-    norm_kwargs = norm if isinstance(norm, dict) else {}
-    if resume is not None:
-        ckpt, vn_path, rb_path = find_checkpoint(resume)
-        if norm is not False:
-            if vn_path is None:
-                raise FileNotFoundError(f"checkpoint {ckpt} has no VecNormalize statistics next to it")
-            venv = VecNormalize.load(str(vn_path), venv)
-            venv.training = True
-        model = Algo.load(str(ckpt), env=venv, device="cpu", tensorboard_log=str(out / "tb"),
-                          verbose=verbose)
-        if rb_path is not None and algo in OFF_POLICY:
-            model.load_replay_buffer(str(rb_path))
-        remaining = max(0, total - model.num_timesteps)
-        print(f"resuming from {ckpt} at {model.num_timesteps} steps; {remaining} to go")
-    else:
-        if norm is not False:
-            venv = VecNormalize(venv, **norm_kwargs)
-        if algo == "td3" and "noise_type" in meta:
-            algo_kwargs["action_noise"] = _action_noise(meta, venv.action_space.shape[0])
-        model = Algo(meta.get("policy", "MlpPolicy"), venv, seed=seed, device="cpu",
-                     tensorboard_log=str(out / "tb"), verbose=verbose, **algo_kwargs)
-        remaining = total
-    if norm is not False:
-        eval_venv = VecNormalize(eval_venv, training=False, norm_reward=False,
-                                 **{k: v for k, v in norm_kwargs.items()
-                                    if k not in ("norm_reward", "training")})
-
-    SaveVecNormalize, KpiEvalCallback, TqdmCallback, ValidationCallback = _callbacks()
-    (out / "best").mkdir(exist_ok=True)
-    eval_cb = KpiEvalCallback(
-        eval_venv, n_eval_episodes=meta.get("n_eval_episodes", 5),
-        eval_freq=max(meta.get("eval_freq", 10_000) // n, 1) if meta.get("eval_freq", 1) else -1,
-        best_model_save_path=None if meta["validation"] else str(out / "best"),
-        log_path=str(out / "eval"), deterministic=True, verbose=0,
-        callback_on_new_best=None if meta["validation"] else SaveVecNormalize(out / "best" / "vecnormalize.pkl"),
-        eval_seed=seed + 10_000)
-    cbs = [eval_cb]
-    if meta["validation"]:
-        cbs.append(ValidationCallback(env_id, algo, env_kwargs, meta, out / "best", eval_cb))
-    if meta.get("checkpoint_freq", 0):
-        cbs.append(CheckpointCallback(save_freq=max(meta["checkpoint_freq"] // n, 1),
-                                      save_path=str(out / "checkpoints"), name_prefix="rl_model",
-                                      save_vecnormalize=True, save_replay_buffer=algo in OFF_POLICY))
-    if progress:
-        cbs.append(TqdmCallback(total, eval_cb))
-
+    _remove(out, held)
+    out.mkdir(parents=True, exist_ok=True)
+    _log_episodes(monitor, out / "monitor.csv", env_id, append=continuing)
     record = dict(algo=algo, env_id=env_id, seed=seed, threads=threads,
                   command=command or f"rotordrop train --env {env_id} --algo {algo} --seed {seed}",
-                  resumed_from=str(resume) if resume else None, hyperparams=hp,
+                  resumed_from=str(ckpt[0]) if ckpt else None, hyperparams=hp,
                   versions=_versions())
     dump_yaml(record, out / "config.yaml")
-    t0 = time.perf_counter()
+
+    eval_cb, record_cb, cbs = _training_callbacks(env_id, algo, meta, seed, out, eval_venv, record,
+                                                  curve, eval_log, total if progress else None)
     model.learn(total_timesteps=remaining, callback=CallbackList(cbs), tb_log_name=algo,
-                reset_num_timesteps=resume is None, progress_bar=False)
-    wall = time.perf_counter() - t0
+                reset_num_timesteps=ckpt is None, progress_bar=False)
     model_path = out / "model.zip"
     vn_path = out / "vecnormalize.pkl"
     model.save(str(model_path))
     if model.get_vec_normalize_env() is not None:
         model.get_vec_normalize_env().save(str(vn_path))
-    summary = dict(record, timesteps=int(model.num_timesteps), wall_time_s=wall,
-                   steps_per_s=remaining / wall if wall > 0 else None,
-                   learning_curve=eval_cb.kpi_history)
-    (out / "training.json").write_text(json.dumps(summary, indent=2, default=str))
+    wall = record_cb.write(finished=True)
     from .plots import plot_learning_curve
-    plot_learning_curve(eval_cb.kpi_history, out / "learning_curve.png", f"{algo} {env_id}")
-    venv.close()
+    plot_learning_curve(sorted(eval_cb.kpi_history, key=lambda h: h["timesteps"]),
+                        out / "learning_curve.png", f"{algo} {env_id}")
+    model.get_env().close()
     eval_venv.close()
-    return TrainResult(out, model_path, vn_path, int(model.num_timesteps), wall)
+    return TrainResult(out, model_path, vn_path, int(model.num_timesteps), wall, _written(out),
+                       len(eval_cb.kpi_history) - len(curve))
+
+
+def _build(env_id: str, algo: str, meta: dict, algo_kwargs: dict, seed: int, ckpt, out: Path,
+           verbose: int):
+    """(training env's VecMonitor, evaluation env, model): a new one, or the checkpoint's.
+    Nothing is written yet: the monitor's log is attached once ``out`` is ready."""
+    from .plant import make_vec_env
+    rw = dict(reward=meta["reward"], reward_kwargs=meta["reward_kwargs"],
+              residual=meta.get("residual"), residual_scale=meta.get("residual_scale"))
+    monitor = make_vec_env(env_id, meta.get("n_envs", 1), seed, meta["env_kwargs"], **rw)
+    eval_venv = _eval_env(make_vec_env(env_id, 1, seed + 10_000, meta["env_kwargs"], **rw),
+                          meta["normalize"])
+    if ckpt is not None:
+        model = _resumed_model(algo, env_id, ckpt, meta["normalize"], monitor, out, verbose)
+    else:
+        model = _new_model(algo, meta, algo_kwargs, _train_env(monitor, meta["normalize"]), seed,
+                           out, verbose)
+    return monitor, eval_venv, model
+
+
+def _training_callbacks(env_id: str, algo: str, meta: dict, seed: int, out: Path, eval_venv,
+                        record: dict, curve: list[dict], eval_log: dict, progress_total: int | None):
+    """(evaluation, record, all callbacks): evaluation with KPIs continuing ``curve`` and
+    ``eval_log`` from their best score, validation, checkpoints, progress bar, training.json."""
+    SaveVecNormalize, KpiEvalCallback, TqdmCallback, ValidationCallback, FinalCheckpoint, \
+        RecordCallback = _callbacks()
+    n = meta.get("n_envs", 1)
+    eval_freq = max(meta.get("eval_freq", 10_000) // n, 1) if meta.get("eval_freq", 1) else -1
+    keep_best = eval_freq > 0 and not meta["validation"]      # else ValidationCallback keeps it
+    eval_cb = KpiEvalCallback(
+        eval_venv, n_eval_episodes=meta.get("n_eval_episodes", 5), eval_freq=eval_freq,
+        best_model_save_path=str(out / "best") if keep_best else None,
+        log_path=str(out / "eval") if eval_freq > 0 else None, deterministic=True, verbose=0,
+        callback_on_new_best=SaveVecNormalize(out / "best" / "vecnormalize.pkl") if keep_best else None,
+        eval_seed=seed + 10_000)
+    eval_cb.kpi_history = list(curve)
+    for key, values in eval_log.items():
+        setattr(eval_cb, key, values)
+    eval_cb.best_mean_reward = _best(curve, "mean_reward")
+    cbs = [eval_cb]
+    if meta["validation"]:
+        cbs.append(ValidationCallback(env_id, algo, meta["env_kwargs"], meta, out / "best", eval_cb,
+                                      best=_best(curve, "validation_score")))
+    if meta.get("checkpoint_freq", 0):
+        cbs.append(FinalCheckpoint(save_freq=max(meta["checkpoint_freq"] // n, 1),
+                                   save_path=str(out / "checkpoints"), name_prefix="rl_model",
+                                   save_vecnormalize=True, save_replay_buffer=algo in OFF_POLICY))
+    if progress_total is not None:
+        cbs.append(TqdmCallback(progress_total, eval_cb))
+    record_cb = RecordCallback(out / "training.json", record, eval_cb)
+    return eval_cb, record_cb, cbs + [record_cb]
+
+
+def _train_env(venv, norm):
+    """The training VecEnv: ``venv`` under a fresh ``VecNormalize`` unless ``normalize: false``."""
+    from stable_baselines3.common.vec_env import VecNormalize
+    return venv if norm is False else VecNormalize(venv, **(norm if isinstance(norm, dict) else {}))
+
+
+def _eval_env(venv, norm):
+    """The evaluation VecEnv: observations normalised with the training statistics (synced at
+    every evaluation), rewards raw."""
+    from stable_baselines3.common.vec_env import VecNormalize
+    if norm is False:
+        return venv
+    kwargs = {k: v for k, v in (norm if isinstance(norm, dict) else {}).items()
+              if k not in ("norm_reward", "training")}
+    return VecNormalize(venv, training=False, norm_reward=False, **kwargs)
+
+
+def _new_model(algo: str, meta: dict, algo_kwargs: dict, venv, seed: int, out: Path, verbose: int):
+    """A fresh model; what the algorithm rejects in the hyperparameters is a ConfigError."""
+    if algo == "td3" and "noise_type" in meta:
+        algo_kwargs["action_noise"] = _action_noise(meta, venv.action_space.shape[0])
+    try:
+        return _algo_class(algo)(meta.get("policy", "MlpPolicy"), venv, seed=seed, device="cpu",
+                                 tensorboard_log=str(out / "tb"), verbose=verbose, **algo_kwargs)
+    except ConfigError:
+        raise
+    except (AssertionError, TypeError, ValueError, KeyError) as exc:
+        raise ConfigError(f"{algo} hyperparameters: {exc}") from exc
+
+
+def _resumed_model(algo: str, env_id: str, ckpt: tuple, norm, venv, out: Path, verbose: int):
+    """The checkpoint's model on ``venv`` (under its saved VecNormalize statistics) with its
+    replay buffer; a checkpoint that does not fit the algorithm or env is a ConfigError."""
+    from stable_baselines3.common.vec_env import VecNormalize
+    path, vn_path, rb_path = ckpt
+    if norm is not False and vn_path is None:
+        raise FileNotFoundError(f"checkpoint {path} has no VecNormalize statistics next to it")
+    try:
+        if norm is not False:
+            venv = VecNormalize.load(str(vn_path), venv)
+            venv.training = True
+        model = _algo_class(algo).load(str(path), env=venv, device="cpu",
+                                       tensorboard_log=str(out / "tb"), verbose=verbose)
+    except (AssertionError, TypeError, ValueError, KeyError) as exc:
+        raise ConfigError(f"--resume {path} does not fit --algo {algo} --env {env_id} with these "
+                          f"env_kwargs: {exc}") from exc
+    if rb_path is not None and algo in OFF_POLICY:
+        model.load_replay_buffer(str(rb_path))
+    return model
+
+
+def check_env(env_id: str, algo: str, meta: dict) -> None:
+    """Build the configured environment once: a bad ``env_kwargs`` value, an action space the
+    algorithm or the residual cannot drive, a residual baseline without the channels it
+    commands are ConfigErrors."""
+    from gymnasium.spaces import Box
+
+    from .controllers import make_baseline
+    from .plant import Plant, make_env
+    try:
+        env = make_env(env_id, **meta["env_kwargs"])
+    except (TypeError, ValueError, KeyError) as exc:
+        raise ConfigError(f"env_kwargs: {exc.args[0] if exc.args else exc}") from exc
+    try:
+        space = env.action_space
+        fix = f"{env_id} has the action space {space} here; set env_kwargs.command: continuous"
+        if algo in OFF_POLICY and not isinstance(space, Box):
+            raise ConfigError(f"--algo {algo} needs continuous actions: {fix}")
+        residual = meta.get("residual")
+        if residual is not None:
+            if not isinstance(space, Box):
+                raise ConfigError(f"residual: {residual} needs continuous actions: {fix}")
+            try:
+                make_baseline(residual, Plant.from_env(env))
+            except ValueError as exc:
+                raise ConfigError(f"residual: {exc}") from exc
+    finally:
+        env.close()
+
+
+def run_dir(checkpoint: Path) -> Path:
+    """The training directory a checkpoint belongs to."""
+    return checkpoint.parent.parent if checkpoint.parent.name == "checkpoints" else checkpoint.parent
+
+
+def _check_resumed_run(checkpoint: Path, algo: str, env_id: str) -> None:
+    """--algo and --env must be the resumed run's (its config.yaml; the algorithm also from the
+    checkpoint's policy class)."""
+    path = run_dir(checkpoint) / "config.yaml"
+    previous = read_yaml(path) if path.is_file() else {}
+    trained = dict(algo=previous.get("algo") or _checkpoint_algo(checkpoint), env_id=previous.get("env_id"))
+    for flag, given, key in (("--algo", algo, "algo"), ("--env", env_id, "env_id")):
+        if trained[key] not in (None, given):
+            raise ConfigError(f"{flag} {given} does not match the run resumed from {checkpoint}, "
+                              f"trained with {flag} {trained[key]}: pass {flag} {trained[key]}")
+
+
+def _checkpoint_algo(path: Path) -> str | None:
+    """The algorithm of an SB3 model zip, from the module of its policy class (None: unknown)."""
+    try:
+        with zipfile.ZipFile(path) as z:
+            data = json.loads(z.read("data"))
+    except (OSError, KeyError, ValueError, zipfile.BadZipFile) as exc:
+        raise ConfigError(f"--resume {path} is not a Stable-Baselines3 model zip ({exc})") from exc
+    return POLICY_MODULES.get(data.get("policy_class", {}).get("__module__"))
+
+
+def _held_run(out: Path, continuing: bool, overwrite: bool) -> list[str]:
+    """The run files in ``out`` that ``overwrite`` removes. ConfigError when ``out`` holds a run
+    and neither continuing it (--resume out) nor --overwrite says what to do with it."""
+    if out.exists() and not out.is_dir():
+        raise ConfigError(f"--out {out} is a file, not a directory")
+    held = [f for f in RUN_FILES if (out / f).exists()]
+    if continuing:
+        if overwrite:
+            raise ConfigError(f"--overwrite would delete the run in {out} that --resume continues: "
+                              f"drop --overwrite to continue its record, or --out a new directory")
+        return []
+    if held and not overwrite:
+        raise ConfigError(f"--out {out} already holds a training run ({', '.join(held)}): continue "
+                          f"it with --resume {out}, replace it with --overwrite, or choose another --out")
+    return held
+
+
+def _remove(out: Path, names: list[str]) -> None:
+    """``--overwrite``: delete the previous run's files (nothing else in ``out``)."""
+    for name in names:
+        if (out / name).is_dir():
+            shutil.rmtree(out / name)
+        else:
+            (out / name).unlink()
+
+
+def _previous_record(out: Path, n_eval_episodes: int) -> tuple[list[dict], dict]:
+    """The learning curve (``training.json``) and ``EvalCallback`` log (``eval/evaluations.npz``,
+    as its attributes) of the run in ``out``, to be continued."""
+    curve, log = [], {}
+    path = out / "training.json"
+    if path.is_file():
+        try:
+            curve = list(json.loads(path.read_text()).get("learning_curve") or [])
+        except (ValueError, AttributeError) as exc:
+            raise ConfigError(f"--resume {out}: {path} is not a training record ({exc}); move it "
+                              f"away to resume without the previous learning curve") from exc
+    npz = out / "eval" / "evaluations.npz"
+    if npz.is_file():
+        with np.load(npz) as d:
+            log = dict(evaluations_timesteps=d["timesteps"].tolist(),
+                       evaluations_results=d["results"].tolist(),
+                       evaluations_length=d["ep_lengths"].tolist())
+        episodes = {len(r) for r in log["evaluations_results"]}
+        if episodes and episodes != {n_eval_episodes}:
+            raise ConfigError(f"n_eval_episodes = {n_eval_episodes} differs from the run in {out} "
+                              f"({min(episodes)} per evaluation in {npz}): keep n_eval_episodes: "
+                              f"{min(episodes)} to continue it")
+    return curve, log
+
+
+def _best(curve: list[dict], key: str) -> float:
+    """The best ``key`` of a learning curve (-inf if none): the score of the model in best/."""
+    return max((float(h[key]) for h in curve if key in h), default=-np.inf)
+
+
+def _log_episodes(monitor, path: Path, env_id: str, append: bool) -> None:
+    """Attach the episode log (``monitor.csv``) to the VecMonitor once ``out`` is ready;
+    a continued run appends to it."""
+    from stable_baselines3.common.monitor import ResultsWriter
+    monitor.results_writer = ResultsWriter(
+        str(path), header={"t_start": monitor.t_start, "env_id": env_id},
+        extra_keys=monitor.info_keywords, override_existing=not (append and path.is_file()))
+
+
+def _written(out: Path) -> list[str]:
+    """The run files in ``out`` (relative), checkpoints counted."""
+    files = [f for f in ("model.zip", "vecnormalize.pkl", "config.yaml", "training.json",
+                         "learning_curve.png", "best/best_model.zip", "best/vecnormalize.pkl",
+                         "eval/evaluations.npz", "monitor.csv") if (out / f).is_file()]
+    n = len(list((out / "checkpoints").glob("*_steps.zip")))
+    return files + ([f"checkpoints/ ({n} checkpoints)"] if n else []) + \
+        (["tb/"] if (out / "tb").is_dir() else [])
 
 
 def set_threads(threads: int) -> None:

@@ -106,7 +106,7 @@ def test_evaluate_a_trained_policy_against_passive(trained, tmp_path):
     assert main(["evaluate", "--policy", str(res.out), "--episodes", "2", "--set",
                  "contact.friction=0.1", "--out", str(out)]) == 0
     report = json.loads((out / "kpis.json").read_text())
-    assert report["policy"] == "ppo-damping" and report["env_id"] == "RotorDrop-Damping-v0"
+    assert report["policy"] == "ppo-damping@run" and report["env_id"] == "RotorDrop-Damping-v0"
     eps = report["episodes"]
     assert [e["seed"] for e in eps] == [0, 1]
     # the summary is the episodes' statistics
@@ -217,3 +217,162 @@ def test_validation_keeps_the_best_model_by_validation_score(tmp_path):
     assert kept == max(scores)                                # best/ is the best-scoring model
     with pytest.raises(ConfigError, match="residual_scale"):
         split({"residual_scale": 3.0})
+
+
+# --- run directories, resuming, config errors, short runs (UAT defects) ---------------------------
+
+#: a tiny PPO damping config: 2 envs x 64 steps per rollout, one short evaluation episode
+TINY = ("RotorDrop-Damping-v0:\n  n_steps: 64\n  batch_size: 64\n  n_epochs: 1\n  n_envs: 2\n"
+        "  n_eval_episodes: 1\n  validation: false\n  policy_kwargs: \"dict(net_arch=[8])\"\n"
+        "  env_kwargs:\n    episode_time: 0.02\n")
+
+
+def _tiny(tmp_path, extra: str = "", name: str = "tiny.yaml"):
+    cfg = tmp_path / name
+    cfg.write_text(TINY + extra)
+    return cfg
+
+
+def _train(cfg, out, timesteps, **kw):
+    from agents.train import train
+    return train("RotorDrop-Damping-v0", kw.pop("algo", "ppo"), out, timesteps=timesteps,
+                 config=cfg, progress=False, **kw)
+
+
+@pytest.mark.parametrize("extra, match", [
+    ("  learning_rat: 1.0e-3\n", r"ppo config: unknown key 'learning_rat' \(did you mean learning_rate\?\)"),
+    ("  env_kwargs: {foo: 1}\n", r"env_kwargs \(RotorDrop-Damping-v0 arguments\): unknown key 'foo'; "
+                                 r"allowed: scene, overrides"),
+    ("  normalize: \"dict(foo=3)\"\n", r"normalize \(VecNormalize arguments\): unknown key 'foo'"),
+    ("  batch_size: -4\n", r"batch_size must be >= 1, got -4"),
+    ("  n_steps: 64.5\n", r"n_steps must be an integer, got 64.5"),
+    ("  gamma: 1.5\n", r"gamma must be a number in \[0, 1\], got 1.5"),
+    ("  seed: 3\n", r"seed is set by rotordrop train \(--seed\)"),
+    ("  env_kwargs: {control_dt: -1.0}\n", r"env_kwargs: control_dt"),
+    ("  reward: kpi\n  reward_kwargs: {w_wirl: 2.0}\n", r"reward_kwargs: unknown key 'w_wirl' \(did you mean w_whirl\?\)"),
+    ("  reward: kpi\n  reward_kwargs: {force_ref: 0.0}\n", r"reward_kwargs.force_ref must be a finite number > 0"),
+    ("  reward: env\n  reward_kwargs: {w_whirl: 2.0}\n", r"reward_kwargs are the weights of reward: kpi"),
+])
+def test_config_errors_name_the_key_before_anything_is_written(tmp_path, extra, match):
+    with pytest.raises(ConfigError, match=match):
+        _train(_tiny(tmp_path, extra), tmp_path / "run", 128)
+    assert not (tmp_path / "run").exists()
+
+
+def test_config_errors_of_the_action_space_and_the_algorithm(tmp_path):
+    from agents.train import train
+    cfg = tmp_path / "relev.yaml"
+    cfg.write_text("RotorDrop-Relevitate-v0:\n  env_kwargs: {command: discrete}\n")
+    # the shipped Relevitate config trains a residual on whirl-brake, which needs the currents
+    with pytest.raises(ConfigError, match=r"residual: whirl-brake needs continuous actions: "
+                                          r"RotorDrop-Relevitate-v0 has the action space Discrete\(2\)"
+                                          r".*env_kwargs.command: continuous"):
+        train("RotorDrop-Relevitate-v0", "ppo", tmp_path / "run", timesteps=128, config=cfg,
+              progress=False)
+    with pytest.raises(ConfigError, match=r"--algo sac needs continuous actions"):
+        train("RotorDrop-Relevitate-v0", "sac", tmp_path / "run", timesteps=128, config=cfg,
+              progress=False)
+    with pytest.raises(ConfigError, match=r"ppo hyperparameters: .*batch_size"):   # SB3's own check
+        _train(_tiny(tmp_path, "  batch_size: 1\n"), tmp_path / "run", 128)
+    assert not (tmp_path / "run").exists()
+
+
+def test_config_errors_reach_the_cli_as_one_line(tmp_path, capsys):
+    from physics.cli import main
+    cfg = _tiny(tmp_path, "  learning_rat: 1.0e-3\n")
+    assert main(["train", "--env", "RotorDrop-Damping-v0", "--algo", "ppo", "--config", str(cfg),
+                 "--out", str(tmp_path / "run"), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("rotordrop train: error: ppo config: unknown key")
+
+
+def test_resume_checks_the_algorithm_and_the_env_of_the_run(trained, tmp_path):
+    import shutil
+    from agents.train import train
+    res, cfg = trained
+    with pytest.raises(ConfigError, match=r"--algo sac does not match the run resumed from .*"
+                                          r"rl_model_2048_steps.zip, trained with --algo ppo"):
+        train("RotorDrop-Damping-v0", "sac", tmp_path / "a", resume=res.out, progress=False)
+    with pytest.raises(ConfigError, match=r"--env RotorDrop-Full-v0 does not match .* trained with "
+                                          r"--env RotorDrop-Damping-v0"):
+        train("RotorDrop-Full-v0", "ppo", tmp_path / "b", resume=res.out, progress=False)
+    # a bare checkpoint (no config.yaml): the algorithm from the zip, the env from its spaces
+    bare = tmp_path / "bare"
+    bare.mkdir()
+    for f in ("rl_model_2048_steps.zip", "rl_model_vecnormalize_2048_steps.pkl"):
+        shutil.copy(res.out / "checkpoints" / f, bare / f)
+    with pytest.raises(ConfigError, match=r"--algo sac does not match .* trained with --algo ppo"):
+        train("RotorDrop-Damping-v0", "sac", tmp_path / "c", resume=bare, progress=False)
+    with pytest.raises(ConfigError, match=r"--resume .* does not fit --algo ppo --env RotorDrop-Full-v0"):
+        train("RotorDrop-Full-v0", "ppo", tmp_path / "d", resume=bare, progress=False)
+    assert not any((tmp_path / d).exists() for d in "abcd")
+
+
+def test_an_out_holding_another_run_is_refused_or_overwritten(trained, tmp_path):
+    res, cfg = trained
+    before = sorted(p.relative_to(res.out) for p in res.out.rglob("*"))
+    with pytest.raises(ConfigError, match=r"--out .* already holds a training run \(model.zip.*"
+                                          r"best, checkpoints.*\): continue it with --resume"):
+        _train(cfg, res.out, 512, n_envs=4)
+    assert sorted(p.relative_to(res.out) for p in res.out.rglob("*")) == before   # untouched
+
+    old = tmp_path / "old"                      # a copy of another run, plus a file of the user's
+    import shutil
+    shutil.copytree(res.out, old)
+    (old / "notes.txt").write_text("mine")
+    new = _train(_tiny(tmp_path), old, 128, overwrite=True, seed=5)
+    assert not (old / "checkpoints" / "rl_model_1024_steps.zip").exists()     # the old run is gone
+    assert (old / "notes.txt").read_text() == "mine"
+    info = json.loads((old / "training.json").read_text())
+    assert info["seed"] == 5 and [h["timesteps"] for h in info["learning_curve"]] == [new.timesteps]
+    with pytest.raises(ConfigError, match="--overwrite would delete the run"):
+        _train(_tiny(tmp_path), old, 256, overwrite=True, resume=old)
+
+
+def test_a_short_run_evaluates_and_checkpoints_its_final_model(tmp_path):
+    """eval_freq and checkpoint_freq far beyond the run: the final model is still evaluated,
+    kept as best/, checkpointed and plotted, and the summary lists what was written."""
+    out = tmp_path / "run"
+    res = _train(_tiny(tmp_path, "  eval_freq: 25000\n  checkpoint_freq: 100000\n"), out, 200)
+    curve = json.loads((out / "training.json").read_text())["learning_curve"]
+    assert [h["timesteps"] for h in curve] == [256] and res.timesteps == 256
+    for f in ("best/best_model.zip", "best/vecnormalize.pkl", "learning_curve.png",
+              "checkpoints/rl_model_256_steps.zip", "checkpoints/rl_model_vecnormalize_256_steps.pkl"):
+        assert (out / f).is_file(), f
+        assert str(out / f) in res.summary() or f.startswith("checkpoints/")
+    assert "checkpoints/ (1 checkpoints)" in res.summary() and res.evaluations == 1
+    # eval_freq: 0 switches evaluation off, and the summary says so
+    off = _train(_tiny(tmp_path, "  eval_freq: 0\n  checkpoint_freq: 0\n"), tmp_path / "off", 128)
+    assert off.evaluations == 0 and not (tmp_path / "off" / "best").exists()
+    assert "no evaluation ran" in off.summary()
+
+
+def test_resume_into_the_same_directory_continues_the_record(tmp_path):
+    """--resume R --out R: the learning curve, evaluations.npz and monitor.csv keep the first
+    session's entries, and best/ is replaced only by a model better than the recorded best."""
+    cfg = _tiny(tmp_path, "  eval_freq: 128\n  checkpoint_freq: 256\n")
+    run = tmp_path / "run"
+    _train(cfg, run, 256)
+    first = json.loads((run / "training.json").read_text())["learning_curve"]
+    assert [h["timesteps"] for h in first] == [128, 256]
+    episodes = len((run / "monitor.csv").read_text().splitlines())
+    # pretend the first session found an excellent model: nothing later may replace it
+    record = json.loads((run / "training.json").read_text())
+    record["learning_curve"][0]["mean_reward"] = 1e9
+    (run / "training.json").write_text(json.dumps(record))
+    best = (run / "best" / "best_model.zip").read_bytes()
+
+    res = _train(cfg, run, 512, resume=run)
+    assert res.timesteps == 512
+    info = json.loads((run / "training.json").read_text())
+    assert [h["timesteps"] for h in info["learning_curve"]] == [128, 256, 384, 512]
+    assert info["learning_curve"][1] == first[1]                  # previous entries kept as they were
+    assert info["resumed_from"].endswith("rl_model_256_steps.zip") and info["finished"]
+    npz = np.load(run / "eval" / "evaluations.npz")
+    assert npz["timesteps"].tolist() == [128, 256, 384, 512]
+    assert (run / "best" / "best_model.zip").read_bytes() == best     # not replaced by a worse one
+    lines = (run / "monitor.csv").read_text().splitlines()
+    assert len(lines) > episodes and lines[1].startswith("r,l,t")   # appended under one header
+    assert sum(line.startswith("r,l,t") for line in lines) == 1
+    assert {p.name for p in (run / "checkpoints").glob("*_steps.zip")} == {
+        "rl_model_256_steps.zip", "rl_model_512_steps.zip"}
