@@ -26,7 +26,6 @@ leaderboard), ``leaderboard.md``, ``score.png``, ``whirl_map.png``, ``peak_force
 """
 from __future__ import annotations
 
-import json
 import os
 import time
 from dataclasses import dataclass, field
@@ -36,8 +35,8 @@ import numpy as np
 
 from .controllers import BASELINES, Passive, command_for, controller_class, make_controller
 from .policies import LearnedPolicy, load_shipped, shipped_names
-from .rollout import run_episodes
-from .score import fmt_or_dash, json_default, overall_score, row_cost, summarize
+from .rollout import check_actor, run_episodes
+from .score import fmt_or_dash, overall_score, row_cost, summarize, write_json
 
 EPISODE_TIME = 0.3
 EVAL_KWARGS = dict(episode_time=EPISODE_TIME, terminate_on_failure=False, randomize=False)
@@ -197,6 +196,18 @@ def run_label(spec: str) -> str:
     return path.parent.name if path.name == "model.zip" else path.stem
 
 
+def policy_label(spec: str, policy: LearnedPolicy) -> str:
+    """The display name of a learned policy: a shipped one's name, else ``name@run`` (:func:`run_label`)."""
+    return policy.name if spec in shipped_names() else f"{policy.name}@{run_label(spec)}"
+
+
+def check_power_return(seconds: float, flag: str, episode_time: float = EPISODE_TIME) -> None:
+    """The power must return inside the episode: ``seconds`` in [0, episode_time)."""
+    if not (np.isfinite(seconds) and 0.0 <= seconds < episode_time):
+        raise ValueError(f"{flag} = {1e3 * seconds:g} ms must be in [0, {1e3 * episode_time:g}) ms: "
+                         f"the power has to return within the {1e3 * episode_time:g} ms episode")
+
+
 def check_unique_names(entries: list[Entry]) -> list[Entry]:
     """``entries``, after checking that no two of a task share a name (the reports key the
     controllers by name)."""
@@ -234,9 +245,8 @@ def benchmark(out: str | Path, quick: bool = False, policies: list[str] | None =
               progress: bool = True, plots: bool = True, power_return: float | None = None) -> dict:
     """Run the suite and write benchmark.json, leaderboard.md and the plots into ``out``;
     ``power_return`` [s]: see :func:`scenario_suite`."""
-    if power_return is not None and not 0.0 <= power_return <= 100.0:     # the envs' range
-        raise ValueError(f"power_return = {power_return:g} s must be in [0, 100] s "
-                         f"(--power-return-ms: [0, 100000] ms)")
+    if power_return is not None:
+        check_power_return(power_return, "--power-return-ms")
     from tqdm.auto import tqdm
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -258,6 +268,9 @@ def benchmark(out: str | Path, quick: bool = False, policies: list[str] | None =
             pol.name = f"{pol.name}@{run_label(spec)}"
         loaded.append(pol)
     entries = check_unique_names(_entries(loaded, custom))
+    users = {c.name for c in custom}
+    for e in [e for e in entries if e.name in users]:       # fail fast, before the sweep
+        check_actor(TASKS[e.task], e.make, e.env_kwargs)
 
     sweep_phases = PHASES if episodes is None else phases     # --quick: the full threshold sweep
     bar = tqdm(total=len(THRESHOLD_GRID) * len(sweep_phases), desc="passive threshold", unit="ep",
@@ -283,7 +296,7 @@ def benchmark(out: str | Path, quick: bool = False, policies: list[str] | None =
                                   group=s.group, env_kwargs=s.env_kwargs, tasks=list(s.tasks))
                              for s in scenarios],
                   rows=rows, leaderboard=board, wall_time_s=time.perf_counter() - t0)
-    (out / "benchmark.json").write_text(json.dumps(report, indent=2, default=json_default))
+    write_json(out / "benchmark.json", report)
     (out / "leaderboard.md").write_text(leaderboard_markdown(report))
     if plots:
         from .plots import plot_benchmark
@@ -383,7 +396,8 @@ def leaderboard(rows: list[dict], scenarios: list[Scenario], threshold) -> list[
                                                            passive[r["scenario"]]["max_displacement_um"]
                                                            for r in mine])),
                          relevitation_rate=(float(np.mean([r["relevitated"] or 0.0 for r in mine]))
-                                            if relev else None))
+                                            if relev else None),
+                         stator_contact_rate=float(np.mean([r["stator_contact"] for r in mine])))
             board.append(entry)
     board.sort(key=lambda e: (list(TASKS).index(e["task"]), -e["score"]))
     return board
@@ -408,23 +422,26 @@ def leaderboard_markdown(report: dict) -> str:
     for task in dict.fromkeys(e["task"] for e in report["leaderboard"]):
         lines += [f"## {task}", "",
                   "| rank | controller | score | in-dist. | out-of-dist. | whirl rate | whirl where "
-                  "passive whirls | peak F / passive (mean, max) | disp. / passive | relevitated |",
-                  "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+                  "passive whirls | peak F / passive (mean, max) | disp. / passive | relevitated | "
+                  "stator contact |",
+                  "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
         for i, e in enumerate([e for e in report["leaderboard"] if e["task"] == task], 1):
             lines.append(f"| {i} | {e['controller']} | {e['score']:.1f} | "
                          f"{fmt_or_dash(e['in_distribution_score'], '.1f')} | "
                          f"{fmt_or_dash(e['out_of_distribution_score'], '.1f')} | {e['whirl_rate']:.2f} | "
                          f"{fmt_or_dash(e['whirl_rate_where_passive_whirls'], '.2f')} | "
                          f"{e['force_ratio']:.2f}, {e['max_force_ratio']:.2f} | "
-                         f"{e['displacement_ratio']:.2f} | {fmt_or_dash(e['relevitation_rate'], '.2f')} |")
+                         f"{e['displacement_ratio']:.2f} | {fmt_or_dash(e['relevitation_rate'], '.2f')} | "
+                         f"{e['stator_contact_rate']:.2f} |")
         lines += ["", "| controller | scenario | mu | whirl | peak revs | peak F [N] | max disp [µm] | "
-                      "relevitated | t_relev [ms] | J |", "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+                      "stator | relevitated | t_relev [ms] | J |",
+                  "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
         for r in [r for r in report["rows"] if r["task"] == task]:
             t = r["relevitation_time_s"]
             lines.append(f"| {r['controller']} | {r['scenario']} | {r['friction']:g} | "
                          f"{r['backward_whirl']:.2f} | {r['peak_whirl_revolutions']:.1f} | "
                          f"{r['peak_contact_force_N']:.0f} | {r['max_displacement_um']:.0f} | "
-                         f"{fmt_or_dash(r['relevitated'], '.2f')} | {fmt_or_dash(t * 1e3 if t is not None else None, '.0f')} | "
+                         f"{r['stator_contact']:.2f} | {fmt_or_dash(r['relevitated'], '.2f')} | {fmt_or_dash(t * 1e3 if t is not None else None, '.0f')} | "
                          f"{r.get('cost', float('nan')):.2f} |")
         lines.append("")
     return "\n".join(lines)

@@ -1,19 +1,20 @@
 """``rotordrop evaluate``: KPIs of a policy or baseline over seeded episodes, against passive.
 
-Writes ``kpis.json`` (per-episode KPIs and their summary for the policy and for the passive
-drop on the same seeds) and ``orbits.png`` / ``contact_force.png`` / ``actions.png`` (first
+Writes ``kpis.json`` (per-episode scenario and KPIs, and their summary, for the policy and for
+the passive drop on the same seeds at the policy's control step, so that the returns compare;
+strict JSON, null where a KPI is undefined) and ``orbits.png`` / ``contact_force.png`` / ``actions.png`` (first
 episode, policy against passive).
 """
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
-from .benchmark import RELEVITATION_ENVS, controller_env_kwargs, monitor_kwargs
-from .controllers import Passive, controller_class, make_controller
+from .benchmark import (EPISODE_TIME, RELEVITATION_ENVS, check_power_return, controller_env_kwargs,
+                        monitor_kwargs, policy_label)
+from .controllers import BASELINES, Passive, controller_class, make_controller
 from .policies import resolve
-from .rollout import run_episodes
-from .score import fmt_or_dash, json_default, summarize
+from .rollout import check_actor, run_episodes
+from .score import fmt_or_dash, summarize, write_json
 
 
 def _merge_kwargs(base: dict, user: dict, randomize: bool) -> dict:
@@ -36,14 +37,24 @@ def _merge_kwargs(base: dict, user: dict, randomize: bool) -> dict:
 
 
 def _actor(spec: str, env_id: str | None):
-    """(make_actor(plant), env id, env kwargs of the policy, display name)."""
+    """(make_actor(plant), env id, env kwargs of the policy, display name, whether it is a
+    user's controller class)."""
     cls = controller_class(spec)
     if cls is not None:
         if env_id is None:
             raise ValueError(f"--env is required for the controller {spec!r}")
-        return (lambda plant: make_controller(cls, plant)), env_id, controller_env_kwargs(cls, env_id), cls.name
+        return ((lambda plant: make_controller(cls, plant)), env_id, controller_env_kwargs(cls, env_id),
+                cls.name, spec not in BASELINES)
     policy, trained_on = resolve(spec)
-    return policy.bound, env_id or trained_on, dict(policy.env_kwargs), policy.name
+    return policy.bound, env_id or trained_on, dict(policy.env_kwargs), policy_label(spec, policy), False
+
+
+def _episode_rows(eps) -> list[dict]:
+    """kpis.json's per-episode records: seed, return, length, the scenario the episode ran
+    (the env's ``reset`` info, where the rollout keeps it) and the KPIs."""
+    return [dict(seed=e.seed, reward=e.reward, length=e.length,
+                 **({"scenario": e.scenario} if getattr(e, "scenario", None) is not None else {}),
+                 **e.kpis) for e in eps]
 
 
 def evaluate(policy: str, env_id: str | None, episodes: int, out: str | Path,
@@ -55,7 +66,7 @@ def evaluate(policy: str, env_id: str | None, episodes: int, out: str | Path,
     length (``terminate_on_failure=False``) unless ``env_kwargs`` says otherwise."""
     if episodes < 1:
         raise ValueError(f"--episodes must be >= 1, got {episodes}")
-    make_actor, env_id, base_kwargs, name = _actor(policy, env_id)
+    make_actor, env_id, base_kwargs, name, user_class = _actor(policy, env_id)
     from rotordrop_env import ENV_IDS
     if env_id not in ENV_IDS:
         raise ValueError(f"--env {env_id!r} is not a rotor-drop environment; known: {', '.join(ENV_IDS)}")
@@ -63,42 +74,47 @@ def evaluate(policy: str, env_id: str | None, episodes: int, out: str | Path,
         raise ValueError(f"--power-return-ms (power_return_time) applies to the re-levitation "
                          f"environments ({', '.join(RELEVITATION_ENVS)}) only, not {env_id}")
     kwargs = _merge_kwargs(base_kwargs, env_kwargs or {}, randomize)
+    if "power_return_time" in (env_kwargs or {}):
+        check_power_return(kwargs["power_return_time"], "--power-return-ms",
+                           kwargs.get("episode_time", EPISODE_TIME))     # the envs' default
+    if user_class:
+        check_actor(env_id, make_actor, kwargs)                  # fail fast: a user's class
     seeds = list(range(seed, seed + episodes))
     eps = run_episodes(env_id, make_actor, seeds, kwargs, record=True)
-    # the passive drop on the same scenarios, AMBs left off, at the default control step
-    passive_kwargs = {k: v for k, v in kwargs.items() if k not in ("command", "control_dt")}
-    passive_kwargs.update(monitor_kwargs(passive_kwargs))
+    # the passive drop on the same scenarios, AMBs left off, at the policy's control step (the
+    # return sums per-step rewards: it compares only at the same step)
+    passive_kwargs = {k: v for k, v in kwargs.items() if k != "command"}
     passive = run_episodes(env_id, Passive, seeds, passive_kwargs, record=True) if compare_passive else []
     report = dict(policy=name, env_id=env_id, env_kwargs=kwargs, seeds=seeds,
-                  summary=summarize(eps), episodes=[dict(seed=e.seed, reward=e.reward,
-                                                         length=e.length, **e.kpis) for e in eps])
+                  summary=summarize(eps), episodes=_episode_rows(eps))
     if passive:
         report["passive_summary"] = summarize(passive)
-        report["passive_episodes"] = [dict(seed=e.seed, reward=e.reward, length=e.length, **e.kpis)
-                                      for e in passive]
+        report["passive_episodes"] = _episode_rows(passive)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     if plots:
         from .plots import plot_episode_comparison
         report["figures"] = [p.name for p in plot_episode_comparison(
             eps[0], passive[0] if passive else None, name, out)]
-    (out / "kpis.json").write_text(json.dumps(report, indent=2, default=json_default))
+    write_json(out / "kpis.json", report)
     report["out"] = str(out)
     return report
-
 
 
 def print_summary(report: dict) -> None:
     rows = [(report["policy"], report["summary"])]
     if "passive_summary" in report:
         rows.append(("passive", report["passive_summary"]))
+    w = max(18, len(report["policy"]) + 2)
+    dt = report["env_kwargs"].get("control_dt")
     print(f"{report['env_id']}, {report['summary']['episodes']} episodes (seeds "
-          f"{report['seeds'][0]}..{report['seeds'][-1]})")
-    print(f"{'controller':18}{'whirl rate':>11}{'peak F [N]':>12}{'max disp [µm]':>15}"
+          f"{report['seeds'][0]}..{report['seeds'][-1]})"
+          + (f", control step {1e3 * dt:g} ms (passive at the same step)" if dt else ""))
+    print(f"{'controller':{w}}{'whirl rate':>11}{'peak F [N]':>12}{'max disp [µm]':>15}"
           f"{'relev. rate':>12}{'relev. t [ms]':>14}{'effort':>9}{'return':>9}")
     for name, s in rows:
         t = s["relevitation_time_s"]
-        print(f"{name:18}{fmt_or_dash(s['backward_whirl_rate'], '.2f'):>11}{fmt_or_dash(s['peak_contact_force_N'], '.0f'):>12}"
+        print(f"{name:{w}}{fmt_or_dash(s['backward_whirl_rate'], '.2f'):>11}{fmt_or_dash(s['peak_contact_force_N'], '.0f'):>12}"
               f"{fmt_or_dash(s['max_displacement_um'], '.0f'):>15}{fmt_or_dash(s['relevitation_success_rate'], '.2f'):>12}"
               f"{fmt_or_dash(t * 1e3 if t is not None else None, '.1f'):>14}{fmt_or_dash(s['control_effort'], '.3g'):>9}"
               f"{fmt_or_dash(s['mean_return'], '.1f'):>9}")

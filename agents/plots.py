@@ -191,8 +191,10 @@ def plot_ride_through(report: dict, out: Path) -> Path:
             for j, d in enumerate(delays):
                 ax.text(mu, d, f"{revs[j, i]:.1f}", ha="center", va="center", fontsize=6,
                         color="white" if revs[j, i] > 0.6 * vmax else "black")
-        ride = [np.nan if t is None else 1e3 * t for t in m["ride_through_s"]]
+        ride = np.array([np.nan if t is None else 1e3 * t for t in m["ride_through_s"]])
         ax.plot(mus, ride, "o-", color="C0", ms=3)
+        low = np.asarray(m["ride_through_lower_bound"], dtype=bool)
+        ax.plot(mus[low], ride[low], "^", color="C0", ms=7)      # held to the longest delay
         ax.set_title(name)
         ax.set_xlabel("friction coefficient μ")
     axes[0, 0].set_ylabel("power back after the fault [ms]")
@@ -200,7 +202,7 @@ def plot_ride_through(report: dict, out: Path) -> Path:
                         zip(mus, report["passive"]["peak_whirl_revolutions"]))
     fig.suptitle(f"{report['env_id']}: peak backward-whirl revolutions, worst of "
                  f"{len(report['phases_deg'])} phases (whirl ≥ {thr:g}"
-                 f"{': black line' if contour else ''}); blue: ride-through time\npassive drop (power never back), μ: revolutions  {passive}",
+                 f"{': black line' if contour else ''}); blue: ride-through time (▲: at least, held to the longest delay)\npassive drop (power never back), μ: revolutions  {passive}",
                  fontsize=9, y=1.04)
     fig.colorbar(im, ax=axes[0].tolist(), fraction=0.03)
     path = Path(out) / "ride_through.png"

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import pickle
+import re
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
@@ -19,6 +20,7 @@ from .controllers import BASELINES, controller_class, make_baseline, make_contro
 from .plant import Plant
 from .hyperparams import ALGOS as ALGO_NAMES
 from .residual import RESIDUAL_SCALE, residual_action
+from .score import write_json
 
 
 def shipped_dir() -> Path:
@@ -45,7 +47,9 @@ class LearnedPolicy:
     base: object | None = None
 
     def bound(self, plant: Plant) -> "LearnedPolicy":
-        """Ready to drive the environment described by ``plant`` (builds the residual's base)."""
+        """Ready to drive the environment described by ``plant`` (checks that its observations
+        and actions are the ones the policy was trained with; builds the residual's base)."""
+        self.check_spaces(plant)
         if self.residual is not None:
             self.base = make_baseline(self.residual, plant)
         return self
@@ -63,17 +67,26 @@ class LearnedPolicy:
         return action, state
 
 
+    def check_spaces(self, plant: Plant) -> None:
+        """ValueError unless ``plant``'s environment has the policy's observation and action sizes."""
+        for what, space, n in (("observations", self.model.observation_space, len(plant.obs_names)),
+                               ("actions", self.model.action_space,
+                                2 if plant.discrete else len(plant.action_names))):
+            size = space.shape[0] if space.shape else space.n
+            if size != n:
+                raise ValueError(f"policy {self.name} was trained on {self.env_id} with {size} "
+                                 f"{what}; {plant.env_id} has {n}: evaluate it on {self.env_id}")
+
     @classmethod
     def load(cls, path: str | Path, name: str | None = None) -> "LearnedPolicy":
         path = Path(path)
         if path.is_dir():
             model_path = path / "model.zip"
-            vn_path = path / "vecnormalize.pkl"
+            vn_paths = [path / "vecnormalize.pkl"]
             meta = _read_meta(path / "config.yaml")
         elif path.suffix == ".zip":
             model_path = path
-            vn_path = next((p for p in (path.with_suffix(".pkl"), path.parent / "vecnormalize.pkl")
-                            if p.is_file()), path.with_suffix(".pkl"))
+            vn_paths = _stats_candidates(path)
             meta = (_read_meta(path.with_suffix(".json")) or _read_meta(path.parent / "config.yaml")
                     or _read_meta(path.parent.parent / "config.yaml"))      # a run's best/
         else:
@@ -87,18 +100,43 @@ class LearnedPolicy:
                                     f"no config.yaml or .json next to it")
         hp = meta.get("hyperparams", {})
         env_kwargs = dict(meta.get("env_kwargs") or hp.get("env_kwargs") or {})
+        vn = _load_stats(model_path, vn_paths, hp.get("normalize", False))
         from .train import _algo_class
         model = _algo_class(algo).load(str(model_path), device="cpu")
-        vn = None
-        if vn_path.is_file():
-            with open(vn_path, "rb") as fh:
-                vn = pickle.load(fh)
-            vn.training = False
         task = env_id.split("-")[1].lower() if env_id.count("-") >= 2 else "policy"
         residual = hp.get("residual")
         scale = float(hp.get("residual_scale") or RESIDUAL_SCALE)
         return cls(name or meta.get("name") or f"{algo}-{task}", algo, env_id, env_kwargs, model,
                    vn, meta, residual, scale)
+
+
+def _stats_candidates(model_zip: Path) -> list[Path]:
+    """Where the VecNormalize statistics of a model zip may be, in order: ``<stem>.pkl`` (a
+    shipped policy), SB3's checkpoint naming (``rl_model_vecnormalize_<N>_steps.pkl`` next to
+    ``rl_model_<N>_steps.zip``), ``vecnormalize.pkl`` in its directory (a run, its ``best/``)."""
+    checkpoint = re.fullmatch(r"(.+)_(\d+)_steps\.zip", model_zip.name)
+    return [model_zip.with_suffix(".pkl"),
+            *([model_zip.with_name(f"{checkpoint[1]}_vecnormalize_{checkpoint[2]}_steps.pkl")]
+              if checkpoint else []),
+            model_zip.parent / "vecnormalize.pkl"]
+
+
+def _load_stats(model_path: Path, candidates: list[Path], normalize):
+    """The first statistics file of ``candidates``; FileNotFoundError when the run normalised
+    its observations (hyperparameter ``normalize``) and none is there."""
+    found = next((p for p in candidates if p.is_file()), None)
+    if found is None:
+        from .hyperparams import parse_literal
+        norm = parse_literal(normalize, "normalize")
+        if norm is True or (isinstance(norm, dict) and norm.get("norm_obs", True)):
+            raise FileNotFoundError(
+                f"{model_path} was trained with observation normalisation, but its VecNormalize "
+                f"statistics are missing: looked for {', '.join(str(p) for p in candidates)}")
+        return None
+    with open(found, "rb") as fh:
+        vn = pickle.load(fh)
+    vn.training = False
+    return vn
 
 
 def _read_meta(path: Path) -> dict:
@@ -170,7 +208,6 @@ def ship_policy(run_dir: str | Path, name: str, which: str = "final", dest: Path
     summary = [{k: (round(v, 4) if isinstance(v, float) else v) for k, v in h.items()
                 if k in ("timesteps", "mean_reward", "mean_failure", "mean_backward_whirl",
                          "mean_peak_contact_force_N", "mean_relevitated")} for h in curve]
-    import re
     command = command or re.sub(r"--out \S+", f"--out runs/{name}", info["command"])
     meta = dict(name=name, algo=info["algo"], env_id=info["env_id"],
                 env_kwargs=info["hyperparams"].get("env_kwargs", {}), model=which,
@@ -179,5 +216,5 @@ def ship_policy(run_dir: str | Path, name: str, which: str = "final", dest: Path
                 steps_per_s=round(info["steps_per_s"], 1) if info.get("steps_per_s") else None,
                 threads=info.get("threads"), versions=info.get("versions"),
                 hyperparams=info["hyperparams"], learning_curve=summary, notes=notes)
-    (dest / f"{name}.json").write_text(json.dumps(meta, indent=1))
+    write_json(dest / f"{name}.json", meta, indent=1)
     return dest / f"{name}.zip"

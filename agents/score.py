@@ -16,7 +16,9 @@ controller worse than passive scores below 0.
 """
 from __future__ import annotations
 
+import json
 import math
+from pathlib import Path
 
 import numpy as np
 
@@ -32,6 +34,27 @@ def json_default(o):
     if isinstance(o, np.ndarray):
         return o.tolist()
     return str(o)
+
+
+def finite_or_null(o):
+    """``o`` (a JSON-able tree) with every non-finite float as None: JSON has no NaN/Infinity."""
+    if isinstance(o, (np.generic, np.ndarray)):
+        o = o.tolist() if isinstance(o, np.ndarray) else o.item()
+    if isinstance(o, float):
+        return o if math.isfinite(o) else None
+    if isinstance(o, dict):
+        return {k: finite_or_null(v) for k, v in o.items()}
+    if isinstance(o, (list, tuple)):
+        return [finite_or_null(v) for v in o]
+    return o
+
+
+def write_json(path: str | Path, report: dict, indent: int = 2) -> Path:
+    """Write a report of the agents layer as strict JSON (null for NaN and infinities)."""
+    path = Path(path)
+    path.write_text(json.dumps(finite_or_null(report), indent=indent, default=json_default,
+                               allow_nan=False))
+    return path
 
 
 def mean_finite(values) -> float | None:

@@ -16,7 +16,7 @@ history) and ``tune.png`` (best validation score per generation).
 """
 from __future__ import annotations
 
-import json
+import inspect
 import time
 from pathlib import Path
 
@@ -24,7 +24,8 @@ import numpy as np
 
 from .benchmark import TASKS, Validator, controller_env_kwargs
 from .controllers import BASELINES, Controller, controller_class, make_controller
-from .score import json_default
+from .rollout import check_actor
+from .score import write_json
 from .search import cross_entropy
 
 
@@ -59,12 +60,26 @@ def _check_gains(cls: type[Controller], env_id: str, start: dict) -> dict:
     plant = plant_of(env_id, **kw)
     if not cls.supports(plant):
         make_controller(cls, plant)                      # raises, naming the missing channels
+    known = gain_names(cls)
+    unknown = [n for n in start if known is not None and n not in known]
+    if unknown:
+        raise ValueError(f"{cls.name} does not take the gains {unknown}; its gains: "
+                         f"{', '.join(known) or 'none'}")
     try:
         cls(plant, **start)
     except TypeError as exc:
-        raise ValueError(f"{cls.name} does not take the gains {list(start)} as keyword "
-                         f"arguments ({exc})") from None
+        raise ValueError(f"{cls.name} cannot be built with the gains {start} ({exc})") from None
+    check_actor(env_id, lambda p: cls(p, **start), kw)          # fail fast: one step runs
     return kw
+
+
+def gain_names(cls: type[Controller]) -> list[str] | None:
+    """The keyword arguments a controller class takes after ``plant`` (its ``GAINS`` when it
+    takes ``**gains``); None when that cannot be told."""
+    params = list(inspect.signature(cls.__init__).parameters.values())[2:]    # self, plant
+    if any(p.kind is p.VAR_KEYWORD for p in params):
+        return list(getattr(cls, "GAINS", {})) or None
+    return [p.name for p in params if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)]
 
 
 def tune(spec: str, env_id: str, gains: list[str], out, iterations: int = 12,
@@ -111,7 +126,7 @@ def tune(spec: str, env_id: str, gains: list[str], out, iterations: int = 12,
                   wall_time_s=time.perf_counter() - t0)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    (out / "tune.json").write_text(json.dumps(report, indent=2, default=json_default))
+    write_json(out / "tune.json", report)
     report["files"] = ["tune.json"]
     if plots:
         from .plots import plot_tuning

@@ -57,6 +57,10 @@ def test_benchmark_quick_end_to_end(tmp_path):
     board = {(e["task"], e["controller"]): e for e in rep["leaderboard"]}
     for task in ("damping", "relevitate"):
         assert board[(task, "passive")]["score"] == pytest.approx(0.0)
+        # the passive whirl (orbit ~800 um) passes the 600 um AMB gap; the flag latches to the end
+        passive = [r for r in rep["rows"] if r["task"] == task and r["controller"] == "passive"]
+        assert all(r["backward_whirl"] == 1.0 and r["stator_contact"] == 1.0 for r in passive)
+        assert board[(task, "passive")]["stator_contact_rate"] == 1.0
     assert {("damping", "max-damping"), ("damping", "whirl-switch"), ("relevitate", "pid-relevitate"),
             ("relevitate", "builtin-relevitate")} <= set(board)
     # learned controllers are named after their algorithm
