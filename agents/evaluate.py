@@ -11,7 +11,7 @@ from pathlib import Path
 
 from .benchmark import (EPISODE_TIME, RELEVITATION_ENVS, check_power_return, controller_env_kwargs,
                         monitor_kwargs, policy_label)
-from .controllers import BASELINES, Passive, controller_class, make_controller
+from .controllers import Passive, controller_class, is_controller_spec, make_controller
 from .policies import resolve
 from .rollout import check_actor, run_episodes
 from .score import fmt_or_dash, summarize, write_json
@@ -37,23 +37,22 @@ def _merge_kwargs(base: dict, user: dict, randomize: bool) -> dict:
 
 
 def _actor(spec: str, env_id: str | None):
-    """(make_actor(plant), env id, env kwargs of the policy, display name, whether it is a
-    user's controller class)."""
+    """(make_actor(plant), env id, env kwargs of the policy, display name)."""
     cls = controller_class(spec)
     if cls is not None:
         if env_id is None:
             raise ValueError(f"--env is required for the controller {spec!r}")
         return ((lambda plant: make_controller(cls, plant)), env_id, controller_env_kwargs(cls, env_id),
-                cls.name, spec not in BASELINES)
+                cls.name)
     policy, trained_on = resolve(spec)
-    return policy.bound, env_id or trained_on, dict(policy.env_kwargs), policy_label(spec, policy), False
+    return policy.bound, env_id or trained_on, dict(policy.env_kwargs), policy_label(spec, policy)
 
 
 def _episode_rows(eps) -> list[dict]:
     """kpis.json's per-episode records: seed, return, length, the scenario the episode ran
-    (the env's ``reset`` info, where the rollout keeps it) and the KPIs."""
+    (the env's ``reset`` info) and the KPIs."""
     return [dict(seed=e.seed, reward=e.reward, length=e.length,
-                 **({"scenario": e.scenario} if getattr(e, "scenario", None) is not None else {}),
+                 **({"scenario": e.scenario} if e.scenario is not None else {}),
                  **e.kpis) for e in eps]
 
 
@@ -66,7 +65,7 @@ def evaluate(policy: str, env_id: str | None, episodes: int, out: str | Path,
     length (``terminate_on_failure=False``) unless ``env_kwargs`` says otherwise."""
     if episodes < 1:
         raise ValueError(f"--episodes must be >= 1, got {episodes}")
-    make_actor, env_id, base_kwargs, name, user_class = _actor(policy, env_id)
+    make_actor, env_id, base_kwargs, name = _actor(policy, env_id)
     from rotordrop_env import ENV_IDS
     if env_id not in ENV_IDS:
         raise ValueError(f"--env {env_id!r} is not a rotor-drop environment; known: {', '.join(ENV_IDS)}")
@@ -77,7 +76,7 @@ def evaluate(policy: str, env_id: str | None, episodes: int, out: str | Path,
     if "power_return_time" in (env_kwargs or {}):
         check_power_return(kwargs["power_return_time"], "--power-return-ms",
                            kwargs.get("episode_time", EPISODE_TIME))     # the envs' default
-    if user_class:
+    if is_controller_spec(policy):
         check_actor(env_id, make_actor, kwargs)                  # fail fast: a user's class
     seeds = list(range(seed, seed + episodes))
     eps = run_episodes(env_id, make_actor, seeds, kwargs, record=True)

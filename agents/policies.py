@@ -18,7 +18,7 @@ import numpy as np
 
 from .controllers import BASELINES, controller_class, make_baseline, make_controller
 from .plant import Plant
-from .hyperparams import ALGOS as ALGO_NAMES
+from .hyperparams import ALGOS as ALGO_NAMES, algo_class, parse_literal
 from .residual import RESIDUAL_SCALE, residual_action
 from .score import write_json
 
@@ -66,7 +66,6 @@ class LearnedPolicy:
             action = residual_action(self.base, raw, action, self.residual_scale, episode_start)
         return action, state
 
-
     def check_spaces(self, plant: Plant) -> None:
         """ValueError unless ``plant``'s environment has the policy's observation and action sizes."""
         for what, space, n in (("observations", self.model.observation_space, len(plant.obs_names)),
@@ -101,8 +100,7 @@ class LearnedPolicy:
         hp = meta.get("hyperparams", {})
         env_kwargs = dict(meta.get("env_kwargs") or hp.get("env_kwargs") or {})
         vn = _load_stats(model_path, vn_paths, hp.get("normalize", False))
-        from .train import _algo_class
-        model = _algo_class(algo).load(str(model_path), device="cpu")
+        model = algo_class(algo).load(str(model_path), device="cpu")
         task = env_id.split("-")[1].lower() if env_id.count("-") >= 2 else "policy"
         residual = hp.get("residual")
         scale = float(hp.get("residual_scale") or RESIDUAL_SCALE)
@@ -126,7 +124,6 @@ def _load_stats(model_path: Path, candidates: list[Path], normalize):
     its observations (hyperparameter ``normalize``) and none is there."""
     found = next((p for p in candidates if p.is_file()), None)
     if found is None:
-        from .hyperparams import parse_literal
         norm = parse_literal(normalize, "normalize")
         if norm is True or (isinstance(norm, dict) and norm.get("norm_obs", True)):
             raise FileNotFoundError(

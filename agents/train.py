@@ -39,8 +39,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .hyperparams import ALGOS, ConfigError, check_sb3, dump_yaml, load_hyperparams, read_yaml, split
-from .hyperparams import algo_class as _algo_class
+from .hyperparams import (ALGOS, ConfigError, algo_class, check_sb3, dump_yaml, load_hyperparams,
+                          read_yaml, split)
 
 OFF_POLICY = ("sac", "td3")
 #: the module of a saved model's policy class -> its algorithm
@@ -75,7 +75,7 @@ def _callbacks():
     from stable_baselines3.common.callbacks import BaseCallback, CheckpointCallback, EvalCallback
 
     from .rollout import final_kpis
-    from .score import mean_finite
+    from .score import mean_finite, write_json
 
     class SaveVecNormalize(BaseCallback):
         """Saves the VecNormalize statistics next to the best model."""
@@ -226,7 +226,7 @@ def _callbacks():
             summary = dict(self.record, timesteps=int(self.model.num_timesteps), wall_time_s=wall,
                            steps_per_s=steps / wall if wall > 0 else None, finished=finished,
                            learning_curve=self.eval_cb.kpi_history)
-            self.path.write_text(json.dumps(summary, indent=2, default=str))
+            write_json(self.path, summary)                # strict JSON, as every report
             return wall
 
     return (SaveVecNormalize, KpiEvalCallback, TqdmCallback, ValidationCallback, FinalCheckpoint,
@@ -411,7 +411,7 @@ def _new_model(algo: str, meta: dict, algo_kwargs: dict, venv, seed: int, out: P
     if algo == "td3" and "noise_type" in meta:
         algo_kwargs["action_noise"] = _action_noise(meta, venv.action_space.shape[0])
     try:
-        return _algo_class(algo)(meta.get("policy", "MlpPolicy"), venv, seed=seed, device="cpu",
+        return algo_class(algo)(meta.get("policy", "MlpPolicy"), venv, seed=seed, device="cpu",
                                  tensorboard_log=str(out / "tb"), verbose=verbose, **algo_kwargs)
     except ConfigError:
         raise
@@ -430,7 +430,7 @@ def _resumed_model(algo: str, env_id: str, ckpt: tuple, norm, venv, out: Path, v
         if norm is not False:
             venv = VecNormalize.load(str(vn_path), venv)
             venv.training = True
-        model = _algo_class(algo).load(str(path), env=venv, device="cpu",
+        model = algo_class(algo).load(str(path), env=venv, device="cpu",
                                        tensorboard_log=str(out / "tb"), verbose=verbose)
     except (AssertionError, TypeError, ValueError, KeyError) as exc:
         raise ConfigError(f"--resume {path} does not fit --algo {algo} --env {env_id} with these "
@@ -549,7 +549,7 @@ def _previous_record(out: Path, n_eval_episodes: int) -> tuple[list[dict], dict]
 
 def _best(curve: list[dict], key: str) -> float:
     """The best ``key`` of a learning curve (-inf if none): the score of the model in best/."""
-    return max((float(h[key]) for h in curve if key in h), default=-np.inf)
+    return max((float(h[key]) for h in curve if h.get(key) is not None), default=-np.inf)
 
 
 def _log_episodes(monitor, path: Path, env_id: str, append: bool) -> None:

@@ -7,7 +7,7 @@ import numpy as np
 
 from .model import (A_DELTA, A_DRAG, A_FMU, A_FR, A_LOAD, A_PFRIC, A_QMAX, A_WS, I_PLANES, J_HX,
                     J_SX, N_AUX_PLANE, N_PLANE_IDX, P_Z_AMB1, P_Z_RB1, PLANES, S_EDISS, S_W, S_WEXT, S_X,
-                    Model, axis_motion, energies)
+                    Model, energies)
 
 AMB_PLANES = ("AMB1", "AMB2")
 
@@ -45,26 +45,22 @@ class Result:
         except ValueError:
             raise ValueError(f"plane must be one of {planes}, got {plane!r}") from None
 
+    def _axis(self, z: float, offset: int = 0) -> np.ndarray:
+        """Rotor axis (x + z a, y + z b) at axial station z; offset 4: its velocity."""
+        i = self.model.I[S_X] + offset
+        return np.stack([self.Y[:, i] + z * self.Y[:, i + 2], self.Y[:, i + 1] + z * self.Y[:, i + 3]], 1)
+
     def orbit(self, plane: str) -> np.ndarray:
         """Rotor axis position (x, y) at a retainer plane, relative to the nominal centre [m]."""
-        k = self._plane(plane)
-        z = self.model.P[P_Z_RB1 + k]
-        i = self.model.I[S_X]
-        return np.stack([self.Y[:, i] + z * self.Y[:, i + 2], self.Y[:, i + 1] + z * self.Y[:, i + 3]], 1)
+        return self._axis(self.model.P[P_Z_RB1 + self._plane(plane)])
 
     def amb_orbit(self, plane: str) -> np.ndarray:
-        """Rotor axis position (x, y) at AMB plane ``AMB1``/``AMB2`` [m]: ``model.axis_motion``,
-        the position the environments check against the stator (``amb.air_gap``), run on all
-        samples at once (its Python source on the state columns; bit-identical per sample)."""
-        z = self.model.P[P_Z_AMB1 + self._plane(plane, AMB_PLANES)]
-        px, py, _, _ = getattr(axis_motion, "py_func", axis_motion)(self.Y.T, self.model.I, z)
-        return np.stack([px, py], 1)
+        """Rotor axis position (x, y) at AMB plane ``AMB1``/``AMB2`` [m], relative to the stator
+        centre: what the environments check against the stator (``amb.air_gap``)."""
+        return self._axis(self.model.P[P_Z_AMB1 + self._plane(plane, AMB_PLANES)])
 
     def orbit_velocity(self, plane: str) -> np.ndarray:
-        k = self._plane(plane)
-        z = self.model.P[P_Z_RB1 + k]
-        i = self.model.I[S_X] + 4
-        return np.stack([self.Y[:, i] + z * self.Y[:, i + 2], self.Y[:, i + 1] + z * self.Y[:, i + 3]], 1)
+        return self._axis(self.model.P[P_Z_RB1 + self._plane(plane)], offset=4)
 
     def _body(self, plane: str, j: int) -> np.ndarray:
         i = self.model.I[I_PLANES + self._plane(plane) * N_PLANE_IDX + j]

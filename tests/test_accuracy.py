@@ -25,7 +25,7 @@ def _quick_study(tmp_path_factory, scene: str):
 
 @pytest.fixture(scope="module")
 def quick(tmp_path_factory):
-    """The quick study of the paper scene (its loosest tolerance already meets the rule)."""
+    """The quick study of the paper scene (rtol 1e-4 meets the rule; 1e-3 errs in the bearing load)."""
     return _quick_study(tmp_path_factory, "paper")
 
 
@@ -110,6 +110,29 @@ def test_the_package_default_tolerance_is_one_the_study_accepts(quick_spec):
     chosen = rows[a["recommended"]]["overrides"]
     if chosen.get("solver.method") == "adaptive":
         assert solver.rtol <= chosen["solver.rtol"]
+
+
+def test_accuracy_labels_the_recommendation_and_the_scene_setting_truthfully(quick):
+    out, a = quick
+    table = (out / "accuracy.md").read_text()
+    own = f"adaptive rtol {Scene().solver.rtol:g}"
+    assert a["scene_setting"] == dict(method="adaptive", rtol=Scene().solver.rtol,
+                                      dt=Scene().solver.dt, row=own)
+    assert "(default)" not in table
+    assert f"| {a['recommended']} **(recommended)**" in table
+    assert f"| {own}" in table and "*(scene's setting)*" in table.split(f"| {own}")[1].split("|")[0]
+    assert f"solver.rtol = {Scene().solver.rtol:g} (row '{own}')" in table
+
+
+def test_accuracy_scores_bearing_and_ball_loads(quick):
+    out, a = quick
+    table = (out / "accuracy.md").read_text()
+    assert "bearing load err, worst [%]" in table and "max ball load err, worst [%]" in table
+    loose = next(r for r in a["rows"] if r["setting"] == "adaptive rtol 0.001")
+    tight = next(r for r in a["rows"] if r["setting"] == "adaptive rtol 1e-06")
+    for key in ("peak_bearing_load_rel", "max_ball_load_rel"):
+        assert loose["errors"][key]["max"] > 10 * tight["errors"][key]["max"] > 0.0, key
+    assert all(m["peak_bearing_load_N"] > 1000.0 for m in a["reference"]["members"])
 
 
 def _row(name, kind, rhs, peak, disp, early=0.0, bearing=0.0):

@@ -139,7 +139,6 @@ def test_stator_contact_terminates_with_the_failure_penalty():
     assert sum(info[f"reward_{k}"] for k in rotordrop_env.env.REWARD_TERMS) == pytest.approx(r)
 
 
-
 def test_failure_flags_latch_when_the_episode_is_not_terminated():
     """With ``terminate_on_failure=False`` the final KPIs still say the orbit reached the stator
     (the whirl at mu = 0.5 passes the 600 um AMB gap around 50 ms, then the episode runs on)."""
@@ -154,6 +153,7 @@ def test_failure_flags_latch_when_the_episode_is_not_terminated():
             break
     assert trunc and not term and any(flags) and not flags[-1]   # on the stator, then off it
     assert info["kpi_stator_contact"]
+
 
 @pytest.mark.parametrize("env_id,action,match", [
     ("RotorDrop-Damping-v0", [np.nan, 0.0], "non-finite"),
