@@ -36,8 +36,10 @@ from __future__ import annotations
 import ast
 import copy
 import difflib
+import functools
 import inspect
 import math
+import re
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -71,6 +73,26 @@ def _yaml():
     return yaml
 
 
+@functools.cache
+def _loader():
+    """PyYAML's safe loader, reading ``1e-3`` and ``3e5`` as floats as YAML 1.2 does (YAML 1.1
+    wants a dot and a signed exponent, so ``learning_rate: 1e-3`` would arrive as a string)."""
+    yaml = _yaml()
+
+    class Loader(yaml.SafeLoader):
+        pass
+
+    Loader.add_implicit_resolver("tag:yaml.org,2002:float",
+                                 re.compile(r"^[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)[eE][-+]?[0-9]+$"),
+                                 list("-+0123456789."))
+    return Loader
+
+
+def load_yaml(text: str):
+    """Parse YAML text with :func:`_loader` (configs and a run's config.yaml)."""
+    return _yaml().load(text, Loader=_loader())
+
+
 def algo_class(algo: str):
     """The Stable-Baselines3 class of ``algo``."""
     import stable_baselines3 as sb3
@@ -88,7 +110,7 @@ def read_yaml(path: str | Path) -> dict:
     if not path.is_file():
         raise ConfigError(f"config file {path} does not exist")
     try:
-        data = _yaml().safe_load(path.read_text())
+        data = load_yaml(path.read_text())
     except Exception as exc:
         raise ConfigError(f"config file {path} is not valid YAML: {exc}") from exc
     if not isinstance(data, dict):

@@ -141,8 +141,8 @@ def _read_meta(path: Path) -> dict:
         return {}
     if path.suffix == ".json":
         return json.loads(path.read_text())
-    from .hyperparams import _yaml
-    return _yaml().safe_load(path.read_text()) or {}
+    from .hyperparams import load_yaml
+    return load_yaml(path.read_text()) or {}
 
 
 def _algo_from_zip(path: Path) -> str:

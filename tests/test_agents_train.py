@@ -44,6 +44,20 @@ def test_config_override_and_literals(tmp_path):
         load_hyperparams("a2c", "RotorDrop-Damping-v0")
 
 
+def test_scientific_notation_in_a_config_is_a_number(tmp_path):
+    """YAML 1.1 (PyYAML's default) reads 1e-3 as a string; configs read it as a float."""
+    cfg = tmp_path / "sci.yaml"
+    cfg.write_text("RotorDrop-Damping-v0:\n  learning_rate: 3e-4\n  n_timesteps: 2E5\n"
+                   "  ent_coef: -1.5e-2\n  policy: MlpPolicy\n  n_steps: 64\n"
+                   "  env_kwargs:\n    control_dt: 2e-3\n")
+    hp = load_hyperparams("ppo", "RotorDrop-Damping-v0", cfg)
+    assert hp["learning_rate"] == 3e-4 and hp["n_timesteps"] == 2e5 and hp["ent_coef"] == -0.015
+    assert hp["env_kwargs"]["control_dt"] == 2e-3 and hp["n_steps"] == 64
+    assert hp["policy"] == "MlpPolicy"
+    import yaml
+    assert yaml.safe_load("a: 1e-3")["a"] == "1e-3"        # the global loader is left untouched
+
+
 @pytest.fixture(scope="module")
 def trained(tmp_path_factory):
     """A 2048-step PPO run on the damping task with checkpoints every 1024 steps."""
