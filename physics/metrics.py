@@ -8,14 +8,15 @@ import math
 import numpy as np
 
 from .amb import weight_shares
-from .ball_bearing import max_contact_pressure
+from .ball_bearing import max_contact_pressure, static_max_ball_load
 from .model import F_RB, PLANES, RB_SM
 from .results import AMB_PLANES, Result
 
 WHIRL_MIN_REVOLUTIONS = 3.0     # net backward orbit revolutions that make a backward whirl
 WHIRL_RADIUS_FRACTION = 0.5     # only orbit samples beyond this fraction of the clearance count
 RPM = 30.0 / math.pi            # rad/s -> rpm
-ISO76_C0_PRESSURE = 4.2e9       # Pa: contact pressure at the static load rating C_0 (ball bearings)
+ISO76_C0_PRESSURE = 4.2e9       # Pa: ISO 76's nominal contact pressure at C_0 (ball bearings);
+                                # the model's own level is rating_pressure()
 ALIAS_ANGLE = 0.75 * math.pi    # orbit turn between two samples beyond which the whirl may alias
 SAMPLES_PER_PERIOD = 10         # a sinusoid sampled n times a period shows >= cos(pi/n) of its
                                 # peak: 95 % at n = 10 (see min_output_rate)
@@ -76,6 +77,16 @@ def friction_heat(result: Result, plane: str, post: np.ndarray) -> np.ndarray:
     return np.concatenate(([0.0], np.cumsum(0.5 * (p[1:] + p[:-1]) * np.diff(t))))[:len(t)]
 
 
+def rating_pressure(bearing) -> float:
+    """Worst ball-race Hertz pressure [Pa] at s_0 = 1: the bearing statically carrying its load
+    rating C_0 (``bearing.static_load_rating``) with a ball under the load
+    (:func:`physics.ball_bearing.static_max_ball_load`). 3 655 MPa for the shipped 6016 with
+    C_0 = 40 kN, below ISO 76's nominal ``ISO76_C0_PRESSURE``: C_0 is a catalogue value, the
+    pressure comes from the model's Hertz contacts."""
+    return float(max_contact_pressure(bearing, static_max_ball_load(bearing,
+                                                                    bearing.static_load_rating)))
+
+
 def retainer_loading(result: Result, plane: str, post: np.ndarray) -> dict:
     """Retainer-bearing design numbers after the fault: the peak radial bearing load and the
     static safety factor s_0 = C_0 / P_0 (ISO 76, P_0 = the peak radial load; below about 1
@@ -83,9 +94,9 @@ def retainer_loading(result: Result, plane: str, post: np.ndarray) -> dict:
     (∫ F_mu v_slip dt, trapezoidal rule over the output samples; a net value, which the paper's
     slip law can make negative, see ``Result.friction_power``) and the highest sleeve speed.
     With the Sopanen-Mikkola bearing also the most heavily loaded ball's peak load and its
-    largest Hertz contact pressure (either raceway; ISO 76 rates C_0 at ``ISO76_C0_PRESSURE``,
-    the pressure that leaves a permanent dent of 1e-4 ball diameters); None for the linear and
-    rigid mounts, which have no balls."""
+    largest Hertz contact pressure (either raceway; :func:`rating_pressure` is its level at
+    s_0 = 1, where ISO 76 puts the permanent dent of 1e-4 ball diameters); None for the linear
+    and rigid mounts, which have no balls."""
     t = result.t[post]
     load = result.bearing_load(plane)[post]
     peak = float(load.max()) if len(load) else 0.0
@@ -232,6 +243,8 @@ def compute_metrics(result: Result) -> dict:
         entry.update(whirl(result, p, t_fault))
         out["planes"][p] = entry
     out["backward_whirl"] = any(out["planes"][p]["backward_whirl"] for p in PLANES)
+    balls = result.model.I[F_RB] == RB_SM
+    out["rating_pressure_MPa"] = rating_pressure(result.model.scene.bearing) * 1e-6 if balls else None
     out.update(check_metrics(result, out))
     out["warnings"] = warnings_of(out, result.model.scene)
     return out

@@ -10,7 +10,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from .ball_bearing import max_contact_pressure  # noqa: E402
-from .metrics import ISO76_C0_PRESSURE, RPM, friction_heat, retainer_loading  # noqa: E402
+from .metrics import (ISO76_C0_PRESSURE, RPM, friction_heat, rating_pressure,  # noqa: E402
+                      retainer_loading)
 from .model import F_RB, PLANES, RB_SM  # noqa: E402
 from .results import Result  # noqa: E402
 
@@ -76,7 +77,7 @@ def plot_housing(result: Result, path: Path, title: str = "") -> Path:
 
 def plot_retainer(result: Result, path: Path, title: str = "") -> Path:
     """Retainer-bearing loading after the fault (the whole run without one): bearing load (and
-    the worst ball's load), the worst ball-race Hertz pressure against ISO 76's C_0 level
+    the worst ball's load), the worst ball-race Hertz pressure against :func:`pressure_levels`
     (Sopanen-Mikkola bearing only) and the cumulative friction heat at the rotor-sleeve contact
     (physics.metrics). The legend's s0 is over the plotted samples ("-" without load)."""
     post = result.t >= (result.t_fault or 0.0)
@@ -97,8 +98,8 @@ def plot_retainer(result: Result, path: Path, title: str = "") -> Path:
     axes[0].set_ylabel("load [N]")
     axes[0].set_title(f"Retainer-bearing loading {title}".strip())
     if balls:
-        axes[1].axhline(ISO76_C0_PRESSURE * 1e-6, color="k", ls=":", lw=0.8,
-                        label="ISO 76 static rating level")
+        for (label, mpa), ls in zip(pressure_levels(bearing).items(), ("--", ":")):
+            axes[1].axhline(mpa, color="k", ls=ls, lw=0.8, label=label)
         axes[1].set_ylabel("worst ball-race pressure [MPa]")
     axes[-1].set_ylabel("contact friction heat [J]")
     axes[-1].set_xlabel("time [s]")
@@ -106,6 +107,14 @@ def plot_retainer(result: Result, path: Path, title: str = "") -> Path:
         ax.legend(fontsize=7, ncol=2)
         ax.grid(alpha=0.3)
     return save_figure(fig, path)
+
+
+def pressure_levels(bearing) -> dict[str, float]:
+    """Reference lines of the pressure panel [MPa] by legend label: the model's pressure at
+    s0 = 1 (:func:`physics.metrics.rating_pressure`) and ISO 76's nominal level."""
+    p0 = rating_pressure(bearing) * 1e-6
+    return {f"s0 = 1 (C0 = {bearing.static_load_rating * 1e-3:g} kN): {p0:.0f} MPa": p0,
+            f"ISO 76 nominal C0 level {ISO76_C0_PRESSURE * 1e-6:.0f} MPa": ISO76_C0_PRESSURE * 1e-6}
 
 
 def plot_drop(result: Result, out_dir: Path, title: str = "") -> list[Path]:
