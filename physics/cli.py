@@ -22,6 +22,19 @@ class UsageError(ValueError):
     """A bad command-line argument that is not a scene parameter (one-line error, exit 2)."""
 
 
+def at_least(low: int):
+    """argparse type of an integer option >= ``low`` (``--jobs``, ``--members``: 1; ``--seed``: 0)."""
+    def integer(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            value = None
+        if value is None or value < low:
+            raise argparse.ArgumentTypeError(f"must be an integer >= {low}, got {text!r}")
+        return value
+    return integer
+
+
 def add_scene_args(p: argparse.ArgumentParser) -> None:
     """--scene and --set, shared by every command that runs the simulator."""
     p.add_argument("--scene", default="paper",
@@ -121,16 +134,21 @@ def _post_fault_tables(m: dict) -> list[str]:
     for p, v in m["planes"].items():
         lines.append(f"{p:10}{v['peak_bearing_load_N']:17.0f}{_fmt(v['static_safety_factor'], '.1f'):>7}"
                      f"{_fmt(v['max_ball_load_N'], '.0f'):>16}{_fmt(v['max_contact_pressure_MPa'], '.0f'):>13}"
-                     f"{v['friction_heat_J']:19.0f}")
+                     f"{_fmt(v['friction_heat_J'], '.0f'):>19}")
+    p0 = m.get("rating_pressure_MPa")
     lines += ["s0: static safety factor C_0 / peak bearing load; p_max: Hertz pressure of the worst "
-              "ball (ISO 76 rates C_0 at 4 200 MPa)",
+              "ball" + (f" (s0 = 1 at {p0:.0f} MPa for this bearing)" if p0 else ""),
               "friction heat: generated at the rotor-sleeve contact after the fault (net: under the "
               "paper slip law the contact can also return energy)"]
     return lines
 
 
 def _fmt(value, spec: str) -> str:
-    return "-" if value is None else format(value, spec)
+    """``value`` formatted, "-" for None; a value that rounds to zero never prints as "-0"."""
+    if value is None:
+        return "-"
+    text = format(value, spec)
+    return text[1:] if text.startswith("-") and float(text) == 0.0 else text
 
 
 def cmd_params(args) -> int:
@@ -144,10 +162,11 @@ def cmd_params(args) -> int:
         return 0
     print(f"scene {args.scene}: the values `rotordrop drop --scene {args.scene}` runs with "
           "(* differs from the parameter's default)")
-    print(f"{'key':32}{'value':>18}  {'unit':9}{'allowed':26}{'tag':4} description")
+    wide = max(len(r["allowed"]) for r in rows) + 2
+    print(f"{'key':32}{'value':>18}  {'unit':9}{'allowed':{wide}}{'tag':4} description")
     for r in rows:
         value = str(r["value"]) + ("*" if r["value"] != r["default"] else " ")
-        print(f"{r['key']:32}{value:>19} {r['unit']:9}{r['allowed']:26}{r['tag']:4} {r['doc']}")
+        print(f"{r['key']:32}{value:>19} {r['unit']:9}{r['allowed']:{wide}}{r['tag']:4} {r['doc']}")
     print("\ntags: P = paper, A = assumed, D = derived. Override any key with --set KEY=VALUE.")
     return 0
 

@@ -32,6 +32,9 @@ class Result:
 
     # -- rotor ----------------------------------------------------------------------------
     def state(self, name: str) -> np.ndarray:
+        """The time series of one state by name (``Model.names``, e.g. ``"x"``, ``"Omega"``)."""
+        if name not in self.model.names:
+            raise ValueError(f"state must be one of {', '.join(self.model.names)}; got {name!r}")
         return self.Y[:, self.model.index(name)]
 
     @property

@@ -264,26 +264,46 @@ def preset_names() -> list[str]:
 
 def load_scene(source: str | Path = "paper", overrides: Mapping[str, Any] | None = None) -> Scene:
     """A scene from a preset name or a TOML file path, with optional dotted overrides."""
-    src = str(source)
-    if src in preset_names():
-        text = resources.files("physics.presets").joinpath(src + ".toml").read_text()
-        scene = scene_from_toml(text, name=src)
-    elif Path(src).is_file():
-        scene = scene_from_toml(Path(src).read_text(), name=Path(src).stem)
-    else:
-        raise SceneError(f"scene {src!r} is neither a preset ({', '.join(preset_names())}) "
-                         "nor an existing TOML file")
+    scene = _load_base(str(source), ())
     return scene.with_overrides(overrides) if overrides else scene
 
 
-def scene_from_toml(text: str, name: str = "custom") -> Scene:
+def _load_base(src: str, chain: tuple[str, ...], base_dir: Path | None = None) -> Scene:
+    """The scene ``src`` names: a preset, or a TOML file (a relative path is read from
+    ``base_dir``, the directory of the file whose ``base`` names it; else the current directory).
+    ``chain``: the scenes that led here through ``base``, to refuse a cycle."""
+    if src in preset_names():
+        ident, path = src, None
+    else:
+        path = (base_dir / src) if base_dir is not None and not Path(src).is_absolute() else Path(src)
+        if not path.is_file():
+            what = f"base {src!r} of {chain[-1]}" if chain else f"scene {src!r}"
+            raise SceneError(f"{what} is neither a preset ({', '.join(preset_names())}) nor an existing"
+                             " TOML file" + (f" (looked for {path})" if chain else ""))
+        ident = str(path.resolve())
+    if ident in chain:
+        raise SceneError("scene base chain is a cycle: " + " -> ".join(chain + (ident,)))
+    if path is None:
+        text = resources.files("physics.presets").joinpath(src + ".toml").read_text()
+        return scene_from_toml(text, name=src, _chain=chain + (ident,))
+    return scene_from_toml(path.read_text(), name=path.stem, base_dir=path.parent,
+                           _chain=chain + (ident,))
+
+
+def scene_from_toml(text: str, name: str = "custom", base_dir: Path | None = None,
+                    _chain: tuple[str, ...] = ()) -> Scene:
+    """A scene from TOML text; ``base = "NAME"`` starts from a preset or another TOML file (a
+    relative path is read from ``base_dir``, the directory of the file the text comes from)."""
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(f"malformed TOML in scene {name!r}: {exc}") from None
     data.pop("name", None)
     base_name = data.pop("base", None)
-    base = load_scene(base_name) if base_name else Scene()
+    if base_name is not None and not isinstance(base_name, str):
+        raise SceneError(f"scene {name!r}: base = {base_name!r} must be a string: a preset name or"
+                         " a TOML file path")
+    base = _load_base(base_name, _chain, base_dir) if base_name else Scene()
     flat: dict[str, Any] = {}
     for group, vals in data.items():
         if not isinstance(vals, dict):

@@ -17,6 +17,7 @@ import shlex
 import traceback
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
+from numbers import Integral
 from typing import Any, Callable, Iterable, Sequence
 
 from .metrics import compute_metrics
@@ -131,15 +132,30 @@ def default_jobs() -> int:
         return max(1, os.cpu_count() or 1)
 
 
+def plan_jobs(jobs: int | None, runs: int) -> tuple[int, str]:
+    """Worker processes for ``runs`` drops: ``jobs`` (>= 1; None: all cores) capped at the CPU
+    count and at the number of drops, and a note saying so when ``jobs`` was capped ("" else)."""
+    if jobs is not None and (isinstance(jobs, bool) or not isinstance(jobs, Integral) or jobs < 1):
+        from .cli import UsageError
+        raise UsageError(f"--jobs must be an integer >= 1, got {jobs!r}")
+    cpus = default_jobs()
+    used = max(1, min(cpus if jobs is None else jobs, cpus, runs))
+    if jobs is None or used == jobs:
+        return used, ""
+    return used, (f"--jobs {jobs} capped at {used} worker process(es) "
+                  f"({cpus} CPU(s), {runs} drop(s) to run)")
+
+
 def run_sweep(runs: Sequence[Run] | Iterable[Run], evaluate: Evaluate | None = None,
               jobs: int | None = None, desc: str = "sweep", progress: bool = True) -> list[Outcome]:
-    """Simulate ``runs`` on ``jobs`` processes (default: all cores); outcomes in input order.
+    """Simulate ``runs`` on ``jobs`` processes (default: all cores; at most one per CPU and per
+    run, :func:`plan_jobs`); outcomes in input order.
 
     ``evaluate(result) -> dict`` (a module-level function, so it can be pickled) computes extra
     numbers from the full result inside the worker; only the small dicts travel back.
     """
     runs = list(runs)
-    jobs = default_jobs() if jobs is None else max(1, int(jobs))
+    jobs = plan_jobs(jobs, len(runs))[0]
     bar = _bar(progress, len(runs), desc)
     out: list[Outcome] = []
     try:

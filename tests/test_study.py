@@ -112,6 +112,8 @@ def _check_required_fields(a):
     for c in a["claims"]:
         assert {"claim", "ours", "reproduced"} <= c.keys() and isinstance(c["reproduced"], bool)
     assert a["runs"]["failed"] == 0 and not a["failures"]
+    assert a["held"] == {"contact.friction": 0.25, "support.stiffness": 5e7, "support.damping": 5000.0}
+    assert a["warnings"]["total"]["no_fault"] == 0 and set(a["warnings"]) >= {"total", "friction"}
 
 
 def _check_physics(a):
@@ -145,6 +147,9 @@ def _check_report(out, a):
         assert (out / f).is_file() and (out / f).stat().st_size > 5000, f
     for c in a["claims"]:
         assert c["claim"] in text
+    assert "## 2. Support stiffness (μ = 0.25, C_s = 5000 N s/m)" in text
+    assert "## 3. Support damping (μ = 0.25, K_s = 5e7 N/m)" in text
+    assert "\nDrop checks: " in text or "no drop flagged" in text
     assert a["reproduce"] and all(r["command"].startswith("rotordrop drop --scene")
                                   for r in a["reproduce"])
     assert all(r["command"] in text for r in a["reproduce"])
@@ -221,7 +226,8 @@ def test_parametric_sweep_reports_failed_drops(tmp_path):
     assert "solver.max_steps" in cell["errors"][0]
     assert len(r["runs"]) == 2 and not any(run["ok"] for run in r["runs"])
     assert all("--set solver.max_steps=100" in run["command"] for run in r["runs"])
-    assert (out / "sweep.csv").read_text().splitlines()[1] == "0.2,2,2" + "," * (1 + 3 * len(PLANE_KPIS))
+    assert (out / "sweep.csv").read_text().splitlines()[1] == ("0.2,2,2" + "," * (1 + 3 * len(PLANE_KPIS))
+                                                           + ",0" * 5)      # no warnings: no metrics
     assert (out / "sweep.png").is_file()
 
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 
 def register(subparsers) -> None:
-    from ..cli import add_scene_args
+    from ..cli import add_scene_args, at_least
     p = subparsers.add_parser("study", help="re-run a published study: report.md, figures, study.json")
     sub = p.add_subparsers(dest="study", required=True)
     q = sub.add_parser("paper", help="the paper's friction, stiffness and damping studies (§V)")
@@ -19,7 +19,8 @@ def register(subparsers) -> None:
     q.add_argument("--out", default="out/study", help="output directory")
     q.add_argument("--quick", action="store_true",
                    help="coarse grid and small ensembles (same outputs, minutes -> seconds)")
-    q.add_argument("--jobs", type=int, default=None, help="worker processes (default: all cores)")
+    q.add_argument("--jobs", type=at_least(1), default=None,
+                   help="worker processes (default: all cores; at most one per CPU and per drop)")
     q.add_argument("--quiet", action="store_true", help="no progress bar")
     q.set_defaults(func=cmd_study_paper)
 
@@ -29,11 +30,12 @@ def register(subparsers) -> None:
     q.add_argument("--vary", action="append", default=[], metavar="KEY=VALUES", required=True,
                    help="a scene key and its values: KEY=V1,V2,... or KEY=LO:HI:STEP (1 to 3 times; a third key gives one map per value), "
                         "e.g. --vary support.damping=2790,27900,1e5 --vary contact.friction=0.3:0.6:0.05")
-    q.add_argument("--members", type=int, default=8,
+    q.add_argument("--members", type=at_least(1), default=8,
                    help="drops per cell, unbalance angle and fault time perturbed (default 8)")
-    q.add_argument("--seed", type=int, default=0, help="seed of the ensemble perturbations")
+    q.add_argument("--seed", type=at_least(0), default=0, help="seed of the ensemble perturbations")
     q.add_argument("--out", default="out/sweep", help="output directory")
-    q.add_argument("--jobs", type=int, default=None, help="worker processes (default: all cores)")
+    q.add_argument("--jobs", type=at_least(1), default=None,
+                   help="worker processes (default: all cores; at most one per CPU and per drop)")
     q.add_argument("--no-plots", action="store_true", help="no sweep.png")
     q.add_argument("--quiet", action="store_true", help="no progress bar")
     q.set_defaults(func=cmd_study_sweep)
@@ -50,17 +52,13 @@ def cmd_study_paper(args) -> int:
 
 def cmd_study_sweep(args) -> int:
     from ..cli import overrides_from_args
-    from .parametric import ENSEMBLE_KEYS, run_parametric, summary_table
+    from .parametric import notes, run_parametric, summary_table
     report = run_parametric(args.scene, overrides_from_args(args), args.vary, args.out,
                             members=args.members, seed=args.seed, jobs=args.jobs,
                             progress=not args.quiet, plots=not args.no_plots)
     print(summary_table(report))
-    if report["members"] < args.members:
-        print(f"note: --set/--vary fix {' and '.join(ENSEMBLE_KEYS)}, the keys that make the "
-              f"ensemble, so each cell is {report['members']} drop, not {args.members}")
-    if report["failed"]:
-        print(f"{report['failed']} drops failed (column 'failed'; the statistics are over the drops "
-              f"that ran); their errors are in sweep.json (cells[].errors, runs[].error)")
+    for line in notes(report, args.members):
+        print(line)
     print("wrote " + ", ".join(f"{args.out}/{f}" for f in report["files"])
           + f" in {report['wall_time_s']:.0f} s")
     return 0

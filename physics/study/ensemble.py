@@ -11,10 +11,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from numbers import Integral
 from typing import Sequence
 
 import numpy as np
 
+ENSEMBLE_KEYS = ("unbalance.angle_deg", "amb.off_time")    # the scene keys a member perturbs
 JITTER_S = 0.5e-3      # fault-time jitter half-width [s]: a few unbalance revolutions at 10 krpm
 
 
@@ -27,6 +29,8 @@ def perturbations(n: int, t_off: float, seed: int = 0, jitter_s: float = JITTER_
     """
     if n < 1:
         raise ValueError(f"an ensemble needs at least one member, got n = {n}")
+    if isinstance(seed, bool) or not isinstance(seed, Integral) or seed < 0:
+        raise ValueError(f"the ensemble seed must be an integer >= 0, got {seed!r}")
     rng = np.random.default_rng(seed)
     angles = 360.0 * (np.arange(n) + rng.uniform(size=n)) / n
     slots = (np.arange(n) + rng.uniform(size=n)) / n

@@ -19,13 +19,18 @@ from ..results import Result
 from ..scene import Scene, SceneError, load_scene
 from ..simulate import IntegrationError, simulate
 from ..sweep import Outcome, Run, changes, outcome_of, reproduce_command, run_sweep
-from .ensemble import onset, perturbations, probability_curve
+from .checks import as_drop, warning_counts
+from .ensemble import ENSEMBLE_KEYS, onset, perturbations, probability_curve
 from .observables import drop_observables
 
 SLIPS = ("paper", "kinematic")
 STIFFNESS = (5e6, 5e7, 5e8)               # support stiffness study [N/m] (paper §V)
 SOFT, BASE, STIFF = STIFFNESS             # soft (the ~600 µm statement), base case, stiff
 DAMPING = (2790.0, 27900.0)               # support damping study [N s/m] (paper §V): low, high
+# the keys the studies set themselves (a --set on them would be replaced in some drops and
+# mislabel the rest); the scene's own values of HELD_KEYS are the ones the other studies hold
+HELD_KEYS = ("contact.friction", "support.stiffness", "support.damping")
+STUDY_KEYS = HELD_KEYS + ("effects.friction", "effects.bearing_friction") + ENSEMBLE_KEYS
 
 
 @dataclass(frozen=True)
@@ -93,6 +98,13 @@ class StudyInput:
     source: str = "paper"
     overrides: dict[str, Any] = field(default_factory=dict)
 
+    def __post_init__(self):
+        clash = [k for k in STUDY_KEYS if k in self.overrides]
+        if clash:
+            raise SceneError(f"study paper sets {', '.join(clash)} itself: --set is refused on "
+                             f"{', '.join(STUDY_KEYS)} (the studies vary or perturb them); for other "
+                             "values use `rotordrop study sweep --vary`")
+
     @property
     def scene(self) -> Scene:
         return load_scene(self.source, self.overrides)
@@ -147,7 +159,8 @@ def run_study(plan: Plan, base: StudyInput, jobs: int | None = None,
     The nominal drops of the support studies (``member`` -1) are drawn in the figures, so they
     run here in this process and their full results come back too, as ``{study: {value:
     result}}``; an error in one of them stops the study, as a figure cannot be drawn without it.
-    The rest run on the process pool.
+    The rest run on the process pool. A run that ended before the fault is a failed drop
+    (:func:`physics.study.checks.as_drop`).
     """
     runs = plan_runs(plan, base)
     nominal = {r: simulate_figure_drop(r, f"the nominal drop of the support {r.label['study']} study"
@@ -155,7 +168,7 @@ def run_study(plan: Plan, base: StudyInput, jobs: int | None = None,
                for r in runs if r.label["member"] == -1}
     swept = iter(run_sweep([r for r in runs if r not in nominal], drop_observables, jobs=jobs,
                            desc="study paper", progress=progress))
-    outcomes = [outcome_of(r, nominal[r], drop_observables) if r in nominal else next(swept)
+    outcomes = [as_drop(outcome_of(r, nominal[r], drop_observables) if r in nominal else next(swept))
                 for r in runs]
     results: dict[str, dict[float, Result]] = {}
     for r, result in nominal.items():
@@ -178,8 +191,10 @@ def analyse(plan: Plan, base: StudyInput, outcomes: list[Outcome]) -> dict:
     """Reduce the outcomes to the study's numbers (everything in study.json except the claims)."""
     by = _index(outcomes)
     friction = _friction(plan, by.get("friction", []))
+    scene = base.scene
     return dict(
         scene=base.source, overrides=base.overrides,
+        held={k: scene.get(k) for k in HELD_KEYS},
         plan=dict(frictions=list(plan.frictions), members=plan.members,
                   sensitivity_frictions=list(plan.sens_frictions),
                   sensitivity_members=plan.sens_members, soft_members=plan.soft_members,
@@ -191,8 +206,10 @@ def analyse(plan: Plan, base: StudyInput, outcomes: list[Outcome]) -> dict:
         slip_law_agreement=friction["slip_agreement"],
         support_stiffness=_support(by.get("stiffness", []), "stiffness"),
         support_damping=_support(by.get("damping", []), "damping"),
-        sensitivity=_sensitivity(by.get("sensitivity", []), sensitivity_settings(base.scene)),
+        sensitivity=_sensitivity(by.get("sensitivity", []), sensitivity_settings(scene)),
         runs=dict(total=len(outcomes), failed=sum(not o.ok for o in outcomes)),
+        warnings=dict(total=warning_counts(outcomes),
+                      **{study: warning_counts(outs) for study, outs in by.items()}),
         failures=[dict(command=o.run.to_dict()["command"], error=o.error, labels=o.run.label)
                   for o in outcomes if not o.ok],
     )

@@ -6,9 +6,10 @@ the support damping and the friction coefficient? Every grid cell is an ensemble
 study, :mod:`physics.study.ensemble`), because near the whirl threshold one drop per cell is a
 coin toss. Per cell: whirl probability, whirl revolutions, peak contact force, maximum
 displacement, peak retainer-bearing load, contact friction heat and ball-race contact pressure
-(worst retainer plane; median and range over the members that have it), and the runs that
-failed, with their errors (never dropped). Every run can be repeated with the ``rotordrop drop``
-command stored next to it.
+(worst retainer plane; median and range over the members that have it), the runs that
+failed, with their errors (never dropped; a run that ended before the fault is a failed drop),
+and the drops per failed ``rotordrop drop`` check (:mod:`physics.study.checks`). Every run can
+be repeated with the ``rotordrop drop`` command stored next to it.
 
 Values: ``KEY=V1,V2,...`` (numbers or choices, e.g. ``effects.friction=paper,kinematic``) or
 ``KEY=LO:HI:STEP`` (inclusive numeric range).
@@ -28,10 +29,10 @@ import numpy as np
 
 from ..metrics import worst_plane
 from ..scene import SceneError, load_scene
-from ..sweep import Outcome, Run, default_jobs, run_sweep
-from .ensemble import perturbations
+from ..sweep import Outcome, Run, plan_jobs, run_sweep
+from .checks import WARNING_KINDS, as_drop, warning_counts, warnings_note
+from .ensemble import ENSEMBLE_KEYS, perturbations
 
-ENSEMBLE_KEYS = ("unbalance.angle_deg", "amb.off_time")
 MAX_KEYS = 3
 MAX_VALUES = 1000       # per key
 MAX_RUNS = 20000
@@ -111,14 +112,15 @@ def plan_runs(source: str, overrides: dict, axes: list[Axis], members: int, seed
     if members < 1:
         raise SceneError(f"--members must be >= 1, got {members}")
     keys = ensemble_keys(overrides, axes)
-    base = load_scene(source, overrides)
-    pert = [{k: p[k] for k in keys} for p in perturbations(members, base.get("amb.off_time"), seed)]
-    if not keys:
-        pert = [{}]                   # the user fixed every ensemble key: one drop per cell
-    n = len(pert) * math.prod(len(a.values) for a in axes)
-    if n > MAX_RUNS:
+    n = (members if keys else 1) * math.prod(len(a.values) for a in axes)
+    if n > MAX_RUNS:                  # before the members are drawn: --members 1e8 fails at once
         raise SceneError(f"study sweep would simulate {n} drops; at most {MAX_RUNS} "
                          f"(fewer values or --members)")
+    if keys:
+        base = load_scene(source, overrides)
+        pert = [{k: p[k] for k in keys} for p in perturbations(members, base.get("amb.off_time"), seed)]
+    else:
+        pert = [{}]                   # the user fixed every ensemble key: one drop per cell
     runs = []
     for cell in product(*(a.values for a in axes)):
         point = dict(zip((a.key for a in axes), cell))
@@ -129,10 +131,13 @@ def plan_runs(source: str, overrides: dict, axes: list[Axis], members: int, seed
 
 def summarize_cell(outcomes: list[Outcome]) -> dict:
     """Whirl probability and the median / min / max of each plane KPI over the members that ran
-    and have it (None where none has it, e.g. the ball-race pressure of a linear mount)."""
+    and have it (None where none has it, e.g. the ball-race pressure of a linear mount), and the
+    drops per failed drop check (``warnings``, :mod:`physics.study.checks`). A run without a
+    fault is a failed drop (:func:`~physics.study.checks.as_drop`)."""
     ok = [o for o in outcomes if o.ok]
     out = dict(members=len(outcomes), failed=len(outcomes) - len(ok),
                errors=sorted({o.error.splitlines()[0] for o in outcomes if not o.ok}),
+               warnings=warning_counts(outcomes),
                whirl_probability=float(np.mean([o.metrics["backward_whirl"] for o in ok])) if ok else None)
     for key in PLANE_KPIS:
         vals = np.array([v for v in (worst_plane(o.metrics, key) for o in ok) if v is not None])
@@ -147,8 +152,9 @@ def run_parametric(source: str, overrides: dict, vary: list[str], out_dir, membe
     """Plan, simulate and summarise the sweep; write ``sweep.json``, ``sweep.csv``, ``sweep.png``."""
     axes = make_axes(source, overrides, vary)
     runs = plan_runs(source, overrides, axes, members, seed)
+    jobs, jobs_note = plan_jobs(jobs, len(runs))
     t0 = time.perf_counter()
-    outcomes = run_sweep(runs, jobs=jobs, desc="study sweep", progress=progress)
+    outcomes = [as_drop(o) for o in run_sweep(runs, jobs=jobs, desc="study sweep", progress=progress)]
     per_cell = len(runs) // math.prod(len(a.values) for a in axes)
     cells = []
     for i, cell in enumerate(product(*(a.values for a in axes))):
@@ -157,8 +163,8 @@ def run_parametric(source: str, overrides: dict, vary: list[str], out_dir, membe
     report = dict(scene=source, overrides=overrides, axes={a.key: list(a.values) for a in axes},
                   members=per_cell, seed=seed, ensemble_keys=ensemble_keys(overrides, axes),
                   cells=cells, runs=[o.to_dict() for o in outcomes],
-                  failed=sum(not o.ok for o in outcomes), jobs=jobs or default_jobs(),
-                  wall_time_s=time.perf_counter() - t0)
+                  failed=sum(not o.ok for o in outcomes), warnings=warning_counts(outcomes),
+                  jobs=jobs, jobs_note=jobs_note, wall_time_s=time.perf_counter() - t0)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     (out / "sweep.json").write_text(json.dumps(report, indent=1))
@@ -193,26 +199,46 @@ def plot_files(report: dict, axes: list[Axis], out: Path) -> list[str]:
 def write_csv(report: dict, path: Path) -> None:
     keys = list(report["axes"])
     fields = keys + ["members", "failed", "whirl_probability"] + [
-        f"{k}_{s}" for k in PLANE_KPIS for s in ("median", "min", "max")]
+        f"{k}_{s}" for k in PLANE_KPIS for s in ("median", "min", "max")] + [
+        f"warnings_{k}" for k in WARNING_KINDS]
     with open(path, "w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(fields)
         for c in report["cells"]:
             w.writerow([c[k] for k in keys] + [c["members"], c["failed"], c["whirl_probability"]]
                        + [None if c[k] is None else c[k][s] for k in PLANE_KPIS
-                          for s in ("median", "min", "max")])
+                          for s in ("median", "min", "max")]
+                       + [c["warnings"][k] for k in WARNING_KINDS])
 
 
 def summary_table(report: dict) -> str:
-    """Markdown: one row per cell."""
+    """Markdown: one row per cell; the last column counts the drops per failed drop check."""
     keys = list(report["axes"])
     head = ("| " + " | ".join(keys) + " | whirl prob. | peak force median (max) [N] | "
-            "max disp. median (max) [µm] | failed |\n|" + "---|" * (len(keys) + 4) + "\n")
+            "max disp. median (max) [µm] | failed | warnings |\n|" + "---|" * (len(keys) + 5) + "\n")
     rows = []
     for c in report["cells"]:
         f, d = c["peak_contact_force_N"], c["max_displacement_um"]
+        flagged = ", ".join(f"{k} {n}" for k, n in c["warnings"].items() if n) or "-"
         rows.append("| " + " | ".join(value_label(c[k]) for k in keys)
                     + (f" | {c['whirl_probability']:.2f} | {f['median']:.0f} ({f['max']:.0f}) | "
                        f"{d['median']:.0f} ({d['max']:.0f})" if f else " | - | - | -")
-                    + f" | {c['failed']} |")
+                    + f" | {c['failed']} | {flagged} |")
     return head + "\n".join(rows) + "\n"
+
+
+def notes(report: dict, members: int) -> list[str]:
+    """The lines printed under the table: capped --jobs, fixed ensemble, failed and flagged drops."""
+    out = [f"note: {report['jobs_note']}"] if report["jobs_note"] else []
+    if report["members"] < members:
+        out.append(f"note: --set/--vary fix {' and '.join(ENSEMBLE_KEYS)}, the keys that make the "
+                   f"ensemble, so each cell is {report['members']} drop, not {members}")
+    if report["failed"]:
+        out.append(f"{report['failed']} drops failed (column 'failed'; the statistics are over the "
+                   "drops that ran; a run that ended before the fault is a failed drop); their errors "
+                   "are in sweep.json (cells[].errors, runs[].error)")
+    flagged = warnings_note(report["warnings"])
+    if flagged:
+        out.append(f"{flagged}; see column 'warnings', and runs[].metrics.warnings in sweep.json "
+                   "for the texts `rotordrop drop` prints")
+    return out

@@ -11,6 +11,7 @@ import numpy as np  # noqa: E402
 
 from ..plots import RPM, orbit_panel, save_figure  # noqa: E402
 from ..results import Result  # noqa: E402
+from .checks import warnings_note  # noqa: E402
 from .claims import PAPER_SOFT_Y_UM, PAPER_THRESHOLD  # noqa: E402
 from .paper import BASE, SOFT  # noqa: E402
 from .parametric import PLANE_KPIS, value_label  # noqa: E402
@@ -146,7 +147,7 @@ def plot_sensitivity(a: dict, out: Path) -> str:
     axes[1].axvline(PAPER_SOFT_Y_UM, color="k", ls="--", lw=0.8, label="paper ≈ 600 µm")
     axes[1].legend(fontsize=7, loc="lower right")
     axes[1].grid(True, axis="x", alpha=0.3)
-    axes[1].set_xlabel("max Y at K_s = 5e6, μ = 0.25 [µm]")
+    axes[1].set_xlabel(f"max Y at {_soft_case(a)} [µm]")
     axes[0].set_yticks(y)
     axes[0].set_yticklabels(labels, fontsize=7)
     return _save(fig, out / "sensitivity.png")
@@ -162,6 +163,34 @@ def _f(x, spec=".2f"):
     return "–" if x is None else format(x, spec)
 
 
+def _num(x: float) -> str:
+    """A scene value as the report writes it: 0.25, 5000, 5e7."""
+    mantissa, _, exp = f"{x:g}".partition("e")
+    return mantissa + (f"e{int(exp)}" if exp else "")
+
+
+def _held(a: dict, key: str) -> str:
+    """The scene's value of a key the other studies hold fixed (``analyse()["held"]``)."""
+    return _num(a["held"][key])
+
+
+def _soft_case(a: dict) -> str:
+    return f"K_s = {_num(SOFT)}, μ = {_held(a, 'contact.friction')}"
+
+
+def _checks_text(a: dict) -> str:
+    """The drop checks of every run, per study (``analyse()["warnings"]``)."""
+    total = warnings_note(a["warnings"]["total"])
+    if not total:
+        return "Drop checks (the warnings `rotordrop drop` prints): no drop flagged.\n"
+    per = "; ".join(f"{study}: " + ", ".join(f"{k} {n}" for k, n in counts.items() if n)
+                    for study, counts in a["warnings"].items()
+                    if study != "total" and any(counts.values()))
+    return (f"D{total[1:]} (per study: {per}). These are the warnings `rotordrop drop` prints for the "
+            "run's command; the drops are in the statistics, except those without a fault, which "
+            "count as failed.\n")
+
+
 def write_report(a: dict, out: Path, figures: dict[str, list[str]], meta: dict) -> Path:
     """The Markdown report (every number in it is in study.json)."""
     L: list[str] = []
@@ -169,17 +198,19 @@ def write_report(a: dict, out: Path, figures: dict[str, list[str]], meta: dict) 
     th = a["friction_threshold"]
     w("# The paper's drop study, reproduced\n")
     w(f"Kärkkäinen, Sopanen & Mikkola, §V, on the `{a['scene']}` scene"
-      + (f" with overrides `{a['overrides']}`" if a["overrides"] else "")
+      + (" with " + ", ".join(f"`--set {k}={v}`" for k, v in a["overrides"].items())
+         if a["overrides"] else "")
       + f". {a['runs']['total']} drops, {a['runs']['failed']} failed; "
       f"{meta['wall_s']:.0f} s wall on {meta['jobs']} process(es)"
       + (" (**quick** mode: coarse grid, small ensembles — statistics are indicative only)"
          if meta["quick"] else "") + ".\n")
+    w(_checks_text(a))
     w("## Summary\n")
     w("| quantity | paper | ours |\n|---|---|---|")
     w(f"| whirl threshold (50 % probability), paper slip | 0.39 | {_f(th['paper'])} |")
     w(f"| whirl threshold (50 % probability), kinematic slip | – | {_f(th['kinematic'])} |")
     soft = next((r for r in a["support_stiffness"] if r["stiffness"] == SOFT), {})
-    w(f"| max Y at K_s = 5e6, μ = 0.25 | ≈ 600 µm | {_f(soft.get('max_y_displacement_um'), '.0f')} µm |")
+    w(f"| max Y at {_soft_case(a)} | ≈ 600 µm | {_f(soft.get('max_y_displacement_um'), '.0f')} µm |")
     n_ok = sum(c["reproduced"] for c in a["claims"])
     w(f"| claims reproduced | – | {n_ok} of {len(a['claims'])} |\n")
     w(meta.get("calibration", ""))
@@ -213,7 +244,8 @@ def write_report(a: dict, out: Path, figures: dict[str, list[str]], meta: dict) 
     w(f"![sleeve speed]({figures['friction'][2]})\n")
     w(f"![response]({figures['response'][0]})\n")
 
-    w("\n## 2. Support stiffness (μ = 0.25, C_s = 5000 N s/m)\n")
+    w(f"\n## 2. Support stiffness (μ = {_held(a, 'contact.friction')}, "
+      f"C_s = {_held(a, 'support.damping')} N s/m)\n")
     base_f = next((r.get("peak_contact_force_N") for r in a["support_stiffness"]
                    if r["stiffness"] == BASE), None)
     soft_f = soft.get("peak_contact_force_N")
@@ -233,7 +265,8 @@ def write_report(a: dict, out: Path, figures: dict[str, list[str]], meta: dict) 
     w(f"![stiffness orbits]({figures['stiffness'][0]})\n")
     w(f"![stiffness response]({figures['stiffness'][1]})\n")
 
-    w("\n## 3. Support damping (μ = 0.25, K_s = 5e7 N/m)\n")
+    w(f"\n## 3. Support damping (μ = {_held(a, 'contact.friction')}, "
+      f"K_s = {_held(a, 'support.stiffness')} N/m)\n")
     w("| C_s [N s/m] | peak F_r [N] | max radial [µm] | whirl prob. | force settling [s] | "
       "RMS radial speed in sleeve [mm/s] | contact losses |\n|---|---|---|---|---|---|---|")
     for r in a["support_damping"]:
@@ -261,7 +294,7 @@ def write_report(a: dict, out: Path, figures: dict[str, list[str]], meta: dict) 
     w(f"Each assumed [A] parameter moved within its plausible range, one at a time, around the "
       f"`{a['scene']}` scene: whirl onset from μ = {a['plan']['sensitivity_frictions'][0]:g} … "
       f"{a['plan']['sensitivity_frictions'][-1]:g} with {a['plan']['sensitivity_members']} drops "
-      f"per μ (paper slip), and the soft-support response (K_s = 5e6, μ = 0.25, median of "
+      f"per μ (paper slip), and the soft-support response ({_soft_case(a)}, median of "
       f"{a['plan']['soft_members']}).\n")
     w(f"![sensitivity]({figures['sensitivity'][0]})\n")
     w("| parameter | value | 50 % crossing | every drop whirls from | lowest whirl | "

@@ -6,20 +6,22 @@ import time
 from pathlib import Path
 
 from ..scene import load_scene
-from ..sweep import default_jobs
+from ..sweep import plan_jobs
 from . import report
+from .checks import warnings_note
 from .claims import claims
-from .paper import SENSITIVITY, Plan, StudyInput, analyse, run_study, simulate_figure_drop
+from .paper import (SENSITIVITY, Plan, StudyInput, analyse, plan_runs, run_study,
+                    simulate_figure_drop)
 
 
 def run_paper_study(source: str, overrides: dict, out_dir, quick: bool = False,
                     jobs: int | None = None, progress: bool = True) -> str:
     """Run the study, write ``study.json``, ``report.md`` and the figures; return a summary."""
+    plan = Plan.make(quick)
+    base = StudyInput(source, dict(overrides))          # refuses --set on the studies' own keys
+    jobs, jobs_note = plan_jobs(jobs, len(plan_runs(plan, base)))
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    plan = Plan.make(quick)
-    base = StudyInput(source, dict(overrides))
-    jobs = default_jobs() if jobs is None else jobs
     t0 = time.perf_counter()
     outcomes, nominal = run_study(plan, base, jobs=jobs, progress=progress)
     a = analyse(plan, base, outcomes)
@@ -46,9 +48,12 @@ def run_paper_study(source: str, overrides: dict, out_dir, quick: bool = False,
     path = report.write_report(a, out, figures, meta)
     th = a["friction_threshold"]
     ok = sum(c["reproduced"] for c in a["claims"])
+    flagged = warnings_note(a["warnings"]["total"])
+    notes = ([f"note: {jobs_note}"] if jobs_note else []) + ([flagged] if flagged else [])
     return (f"whirl threshold (50 %): paper slip {th['paper']}, kinematic {th['kinematic']}; "
             f"{ok}/{len(a['claims'])} claims reproduced; {a['runs']['failed']} of "
-            f"{a['runs']['total']} runs failed; {wall:.0f} s\nwrote {path}, {out / 'study.json'}")
+            f"{a['runs']['total']} runs failed; {wall:.0f} s\n" + "".join(n + "\n" for n in notes)
+            + f"wrote {path}, {out / 'study.json'}")
 
 
 def friction_runs(base: StudyInput, plan: Plan) -> dict:
