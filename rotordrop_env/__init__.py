@@ -7,7 +7,7 @@ Ids: ``RotorDrop-Passive-v0``, ``RotorDrop-Damping-v0``, ``RotorDrop-Relevitate-
 ``RotorDrop-Full-v0`` (see docs/environments.md). ``BatchedRotorDropVecEnv`` / ``make_batched``
 step N rotors in one parallel numba call as a Stable-Baselines3 ``VecEnv``.
 """
-from gymnasium.envs.registration import register, registry
+from gymnasium.envs.registration import WrapperSpec, register, registry
 
 ENV_IDS = {
     "RotorDrop-Passive-v0": "rotordrop_env.env:PassiveEnv",
@@ -16,9 +16,12 @@ ENV_IDS = {
     "RotorDrop-Full-v0": "rotordrop_env.env:FullEnv",
 }
 
+#: outermost wrapper of every gym.make: KPIs also when a TimeLimit ends the episode early
+_WRAPPERS = (WrapperSpec("EpisodeKPIs", "rotordrop_env.wrappers:EpisodeKPIs", {}),)
+
 for _id, _entry in ENV_IDS.items():
     if _id not in registry:
-        register(id=_id, entry_point=_entry)
+        register(id=_id, entry_point=_entry, additional_wrappers=_WRAPPERS)
 
 
 def __getattr__(name):

@@ -48,7 +48,8 @@ class RotorDropEnv(gym.Env):
                                             fixed by the user (``overrides``, the
                                             ``power_return_time`` kwarg, a None range) keep
                                             their value
-    randomization               None        {key: (low, high) | (law, low, high) | None}
+    randomization               None        {key: (low, high) | (law, low, high) | None};
+                                            needs randomize=True, no range for a fixed key
     full_state                  False       observe the whole state vector (research)
     command                     "discrete"  re-levitation envs: "discrete" or "continuous"
     power_return_time           0.05        re-levitation envs: power returns [s after fault]
@@ -120,6 +121,7 @@ class RotorDropEnv(gym.Env):
         self.weights = weights
         self.base_scene = self._make_scene(scene, overrides)
         self.ranges, fixed = resolve_ranges(randomization, self._relevitate, type(self).__name__)
+        _check_unused_ranges(randomization, self.randomize, overrides, power_return_time)
         #: keys the user fixed: never randomised (still drawn, so the others' draws stay put)
         self.fixed_keys = fixed | frozenset(overrides or {}) | frozenset(
             [POWER_RETURN] if power_return_time is not None else [])
@@ -179,14 +181,18 @@ class RotorDropEnv(gym.Env):
         return base
 
     def _bind(self, buffers: Buffers) -> None:
-        """Use these arrays (own ones, or a row of a batched VecEnv's stack)."""
+        """Use these arrays (own ones, or a row of a batched VecEnv's stack) from the next reset."""
         old = getattr(self, "_b", None)
         if old is not None:
             for name in ("C", "scale"):
                 getattr(buffers, name)[...] = getattr(old, name)
+        self._use(buffers)
+        self._needs_reset = True
+
+    def _use(self, buffers: Buffers) -> None:
+        """Step on these arrays as they are (a copied batch re-attaching its rows)."""
         self._b = buffers
         self._args = buffers.args()
-        self._needs_reset = True
 
     def _configure_static(self, hold: float, terminate: bool) -> None:
         b = self._b
@@ -276,8 +282,8 @@ class RotorDropEnv(gym.Env):
         options; the power return as applied (on the control-step grid)."""
         keys = sorted((set(self.ranges) | set(values)) - {POWER_RETURN})
         out = {k: self.scene.get(k) for k in keys}
-        if power:
-            out[POWER_RETURN] = float(self._b.C[K.C_T_POWER] - self._b.C[K.C_T_FAULT])
+        if power:                               # without the subtraction's round-off
+            out[POWER_RETURN] = round(float(self._b.C[K.C_T_POWER] - self._b.C[K.C_T_FAULT]), 12)
         return out
 
     def step(self, action):
@@ -306,22 +312,30 @@ class RotorDropEnv(gym.Env):
         b = self._b
         out = b.out
         if out[K.O_ERR]:
-            what = "non-finite" if out[K.O_ERR] == K.ERR_NAN else "out-of-range"
-            if self._discrete:
-                raise ValueError(f"{what} action {action!r}: the {self.action_space} action "
-                                 "(levitate) must be 0 (stay off) or 1 (switch on)")
-            raise ValueError(f"{what} action {action!r}: {self.action_space} entries must be finite "
-                             f"and in [-1, 1] ({', '.join(self.action_names)})")
+            self._action_error(out[K.O_ERR], action)
         if out[K.O_STATUS]:
             raise IntegrationError(_explain(int(out[K.O_STATUS]), b.M[K.M_T], b.M[K.M_H], self.model))
         terminated = bool(out[K.O_TERM])
         truncated = bool(out[K.O_TRUNC])
         info = self._step_info(terminated or truncated)
+        self._show_step()
+        return b.obs.astype(np.float32), float(out[K.O_REWARD]), terminated, truncated, info
+
+    def _action_error(self, err: int, action) -> None:
+        """Raise the ValueError of a refused action (``err``: the kernel's ERR_* code)."""
+        what = "non-finite" if err == K.ERR_NAN else "out-of-range"
+        if self._discrete:
+            raise ValueError(f"{what} action {action!r}: the {self.action_space} action "
+                             "(levitate) must be 0 (stay off) or 1 (switch on)")
+        raise ValueError(f"{what} action {action!r}: {self.action_space} entries must be finite "
+                         f"and in [-1, 1] ({', '.join(self.action_names)})")
+
+    def _show_step(self) -> None:
+        """Record the step for the episode view (and redraw it in "human" mode)."""
         if self._renderer is not None:
             self._record()
             if self.render_mode == "human":
                 self.render()
-        return b.obs.astype(np.float32), float(out[K.O_REWARD]), terminated, truncated, info
 
     def _step_info(self, done: bool) -> dict:
         b = self._b
@@ -430,6 +444,22 @@ def _positive(name: str, value, lo: float, hi: float) -> None:
         raise ValueError(f"{name} = {value!r} must be in [{lo:g}, {hi:g}]")
 
 
+def _check_unused_ranges(randomization, randomize: bool, overrides, power_return_time) -> None:
+    """Refuse randomisation ranges that would be silently dropped: all of them without
+    ``randomize``, and a range for a key that ``overrides`` or the ``power_return_time`` kwarg
+    fixes (a None range, "keep the key fixed", agrees with them)."""
+    if randomization and not randomize:
+        raise ValueError(f"randomization = {randomization!r} has no effect without randomize=True: "
+                         "pass randomize=True, or leave randomization out")
+    fixed_by = {key: f"overrides[{key!r}]" for key in overrides or {}}
+    if power_return_time is not None:
+        fixed_by[POWER_RETURN] = f"the power_return_time = {power_return_time!r} kwarg"
+    for key, spec in (randomization or {}).items():
+        if spec is not None and key in fixed_by:
+            raise ValueError(f"randomization[{key!r}] = {spec!r} is a range for a key that "
+                             f"{fixed_by[key]} fixes; give only one of the two (or None as its range)")
+
+
 def _flag(name: str, value) -> bool:
     """A bool kwarg (bool or numpy bool; strings and numbers are refused)."""
     if not isinstance(value, (bool, np.bool_)):
@@ -460,7 +490,7 @@ class PassiveEnv(RotorDropEnv):
     =====  =============  =============================================  ==================
 
     With ``full_state=True`` the observation is the whole state vector (``model.names``, scaled
-    by ``model.scale``) followed by ``time``.
+    by ``model.obs_scale``) followed by ``time``.
 
     Version history: v0 (initial release).
     """

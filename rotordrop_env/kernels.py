@@ -66,6 +66,17 @@ def check_action(a, C):
 
 
 @njit
+def first_bad_action(A, C):
+    """(row, error) of the first row of ``A`` that :func:`check_action` refuses, else (-1,
+    ERR_NONE): the batch checks every action before it advances any environment."""
+    for e in range(A.shape[0]):
+        err = check_action(A[e], C[e])
+        if err != ERR_NONE:
+            return e, err
+    return -1, ERR_NONE
+
+
+@njit
 def _switch_on(t, y, P, I, U):
     """Engage the built-in PID: ramp the reference from the sensed position, reset integrators."""
     U[U_AMB_POWER] = 1.0

@@ -10,9 +10,8 @@ import math
 import numpy as np
 from gymnasium import spaces
 
-from physics.model import Model
+from physics.model import VELOCITY, Model
 
-VELOCITY_SCALE = 0.1         # m/s: the impact speed after a free fall through the gap is 0.077 m/s
 SENSOR_NAMES = ("x1", "y1", "vx1", "vy1", "x2", "y2", "vx2", "vy2")
 LEV_NAMES = ("amb_power", "controller_on", "i1x", "i1y", "i2x", "i2y")
 CURRENT_ACTIONS = ("current_amb1_x", "current_amb1_y", "current_amb2_x", "current_amb2_y")
@@ -28,11 +27,11 @@ def observation_layout(model: Model, damping: bool, relevitate: bool, full_state
     scale: list[float] = []
     if full_state:
         names += list(model.names)
-        scale += list(model.scale)
+        scale += list(model.obs_scale)
     else:
         for n in SENSOR_NAMES:
             names.append(n)
-            scale.append(c if n[0] in "xy" else VELOCITY_SCALE)
+            scale.append(c if n[0] in "xy" else VELOCITY)
         names += ["rotor_speed", "sleeve_speed1", "sleeve_speed2"]
         scale += [omega0] * 3
         if damping:

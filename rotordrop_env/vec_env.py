@@ -9,6 +9,9 @@ Each of the N environments is an ordinary ``gym.make(env_id, **env_kwargs)`` env
 arrays are rows of one stack; resets (scenario sampling from each env's own ``np_random``) run
 per environment in Python, steps run all rows in :func:`rotordrop_env.kernels.step_batch`,
 parallel over environments with numba's threads (``numba.set_num_threads`` limits them).
+All actions are checked before any environment advances; with a ``render_mode`` each environment
+records its steps as a single one does; a pickled or deep-copied batch re-attaches its
+environments to its own stack.
 
 Importing this module sets ``OMP_WAIT_POLICY=PASSIVE`` unless it is already set: with numba's
 OpenMP threading layer, threads that spin at the end of each parallel step steal the core of a
@@ -47,6 +50,9 @@ class BatchedRotorDropVecEnv(VecEnv):
         import rotordrop_env  # noqa: F401  (registers the ids)
         if int(n_envs) != n_envs or n_envs < 1:
             raise ValueError(f"n_envs = {n_envs!r} must be a positive integer")
+        if "max_episode_steps" in env_kwargs:     # gym.make's TimeLimit: .unwrapped drops it
+            raise ValueError("max_episode_steps does not apply to the batched VecEnv; set the "
+                             "episode length with episode_time (= steps x control_dt)")
         self.envs: list[RotorDropEnv] = []
         for _ in range(int(n_envs)):
             env = gym.make(env_id, **env_kwargs).unwrapped
@@ -93,13 +99,16 @@ class BatchedRotorDropVecEnv(VecEnv):
         except ValueError:
             raise ValueError(f"actions of shape {a.shape} do not fit {self.num_envs} environments "
                              f"with action space {self.action_space}") from None
+        e, err = K.first_bad_action(act, self.stack.C)
+        if e >= 0:                                # before any env advances; single env's message
+            self.envs[e]._action_error(err, a[e])
         if self.n_threads is not None:
             numba.set_num_threads(self.n_threads)
         K.step_batch(*self._args)
         out = self.stack.out
-        bad = np.flatnonzero(out[:, K.O_ERR] + out[:, K.O_STATUS])
-        if bad.size:                              # the single env's clear error message
-            e = bad[0]
+        failed = np.flatnonzero(out[:, K.O_STATUS])
+        if failed.size:                           # the single env's clear IntegrationError
+            e = failed[0]
             self.envs[e]._finish(a[e])
         obs = self.stack.obs.astype(np.float32)
         rewards = out[:, K.O_REWARD].astype(np.float32)
@@ -107,6 +116,9 @@ class BatchedRotorDropVecEnv(VecEnv):
         truncated = out[:, K.O_TRUNC] > 0.0
         dones = terminated | truncated
         infos = step_infos(out, self.stack.M, self.stack.C, self.envs[0]._relevitate)
+        if self.render_mode is not None:          # before the auto-resets clear the views
+            for env in self.envs:
+                env._show_step()
         for e in np.flatnonzero(dones):
             infos[e].update(self.envs[e].kpis())
             infos[e]["terminal_observation"] = obs[e].copy()
@@ -114,6 +126,14 @@ class BatchedRotorDropVecEnv(VecEnv):
             new_obs, self.reset_infos[e] = self.envs[e].reset()
             obs[e] = new_obs
         return obs, rewards, dones, infos
+
+    def __setstate__(self, state: dict) -> None:
+        """A copy (pickle, deepcopy) steps on its own stack: its environments' arrays are
+        views of that stack's rows again (copying breaks the views into separate arrays)."""
+        self.__dict__.update(state)
+        for e, env in enumerate(self.envs):
+            env._use(self.stack.row(e))
+        self._args = self.stack.args()
 
     def running_kpis(self) -> dict[str, np.ndarray]:
         """Every environment's running-maximum KPIs as arrays (see ``env.peak_kpis``); after an

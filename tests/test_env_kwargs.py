@@ -1,11 +1,14 @@
 """Environment kwargs: user-fixed keys stay out of the randomisation, stable draws, the scenario
 in reset's info, and clear errors for bad ranges, wrong types and bad discrete actions."""
+import math
+
 import gymnasium as gym
 import numpy as np
 import pytest
 
 import rotordrop_env  # noqa: F401  (registers the ids)
 from physics.scene import SceneError
+from rotordrop_env import kernels as K
 from rotordrop_env.scenario import DEFAULT_RANGES, parse_range
 
 KW = dict(episode_time=0.002, randomize=True)
@@ -142,3 +145,54 @@ def test_reset_scenario_option_must_be_a_dict():
     env = gym.make("RotorDrop-Damping-v0", episode_time=0.002)
     with pytest.raises(ValueError, match="scenario = 'contact.friction=0.3' is not a dict"):
         env.reset(options={"scenario": "contact.friction=0.3"})
+
+
+def test_randomization_without_randomize_is_an_error():
+    with pytest.raises(ValueError, match=r"randomization = .*contact.friction.* no effect without "
+                                         r"randomize=True"):
+        gym.make("RotorDrop-Damping-v0", randomization={"contact.friction": (0.1, 0.3)})
+    env = gym.make("RotorDrop-Damping-v0", randomization={}, episode_time=0.002)   # nothing lost
+    assert env.unwrapped.randomize is False
+
+
+@pytest.mark.parametrize("env_id,kwargs,match", [
+    ("RotorDrop-Damping-v0", dict(overrides={"contact.friction": 0.45},
+                                  randomization={"contact.friction": (0.1, 0.3)}),
+     r"randomization\['contact.friction'\] = \(0.1, 0.3\) .* overrides\['contact.friction'\] fixes"),
+    ("RotorDrop-Relevitate-v0", dict(power_return_time=0.03,
+                                     randomization={"power_return_time": (0.02, 0.04)}),
+     r"randomization\['power_return_time'\] = .* the power_return_time = 0.03 kwarg fixes"),
+])
+def test_a_range_for_a_fixed_key_is_an_error(env_id, kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        gym.make(env_id, **{**KW, **kwargs})
+
+
+def test_a_none_range_agrees_with_the_fixing_kwarg():
+    sc, _ = scenario("RotorDrop-Relevitate-v0", power_return_time=0.03,
+                     overrides={"contact.friction": 0.45},
+                     randomization={"power_return_time": None, "contact.friction": None})
+    assert sc["power_return_time"] == 0.03 and sc["contact.friction"] == 0.45
+
+
+@pytest.mark.parametrize("seconds", [0.05, 0.08, 0.03, 0.0333])
+def test_power_return_is_reported_without_round_off(seconds):
+    """The report is the applied time (on the 1 ms grid) rounded to 1e-12 s; the physics keeps
+    the unrounded instant."""
+    env = gym.make("RotorDrop-Relevitate-v0", power_return_time=seconds, episode_time=0.002)
+    _, info = env.reset(seed=0)
+    steps = math.ceil(seconds / 1e-3 - 1e-9)
+    on_grid = round(steps * 1e-3, 12)
+    assert info["scenario"]["power_return_time"] == on_grid
+    assert repr(info["scenario"]["power_return_time"]) == repr(round(on_grid, 6))
+    C = env.unwrapped._b.C
+    t_fault = C[K.C_T_FAULT]
+    assert C[K.C_T_POWER] == t_fault + steps * 1e-3
+
+
+def test_drawn_power_returns_are_reported_cleanly():
+    env = gym.make("RotorDrop-Relevitate-v0", **KW)
+    for seed in range(5):
+        _, info = env.reset(seed=seed)
+        value = info["scenario"]["power_return_time"]
+        assert value == round(value, 12) and len(repr(value)) <= 6     # e.g. 0.073
