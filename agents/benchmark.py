@@ -201,6 +201,24 @@ def policy_label(spec: str, policy: LearnedPolicy) -> str:
     return policy.name if spec in shipped_names() else f"{policy.name}@{run_label(spec)}"
 
 
+def extras(specs: list[str]) -> tuple[list[LearnedPolicy], list]:
+    """The ``--policy`` extras: learned policies given by path, named ``name@run``
+    (:func:`policy_label`, as in evaluate and ride-through), and controller classes; the
+    baselines and shipped policies are in already."""
+    policies, classes = [], []
+    for spec in dict.fromkeys(specs):
+        if spec in shipped_names() or spec in BASELINES:
+            continue
+        cls = controller_class(spec)
+        if cls is not None:
+            classes.append(cls)
+            continue
+        policy = LearnedPolicy.load(spec)
+        policy.name = policy_label(spec, policy)
+        policies.append(policy)
+    return policies, classes
+
+
 def check_power_return(seconds: float, flag: str, episode_time: float = EPISODE_TIME) -> None:
     """The power must return inside the episode: ``seconds`` in [0, episode_time)."""
     if not (np.isfinite(seconds) and 0.0 <= seconds < episode_time):
@@ -254,19 +272,8 @@ def benchmark(out: str | Path, quick: bool = False, policies: list[str] | None =
     phases = QUICK_PHASES if quick else PHASES
     if episodes is not None:
         phases = PHASES[:max(1, min(episodes, len(PHASES)))]
-    loaded = [load_shipped(n) for n in shipped_names()]
-    custom = []
-    for spec in dict.fromkeys(policies or []):
-        if spec in shipped_names() or spec in BASELINES:
-            continue                                   # already in
-        cls = controller_class(spec)
-        if cls is not None:
-            custom.append(cls)
-            continue
-        pol = LearnedPolicy.load(spec)
-        if any(pol.name == p.name for p in loaded):     # e.g. a new run of a shipped policy
-            pol.name = f"{pol.name}@{run_label(spec)}"
-        loaded.append(pol)
+    extra, custom = extras(policies or [])
+    loaded = [load_shipped(n) for n in shipped_names()] + extra
     entries = check_unique_names(_entries(loaded, custom))
     users = {c.name for c in custom}
     for e in [e for e in entries if e.name in users]:       # fail fast, before the sweep
@@ -426,9 +433,9 @@ def leaderboard_markdown(report: dict) -> str:
                   "stator contact |",
                   "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
         for i, e in enumerate([e for e in report["leaderboard"] if e["task"] == task], 1):
-            lines.append(f"| {i} | {e['controller']} | {e['score']:.1f} | "
-                         f"{fmt_or_dash(e['in_distribution_score'], '.1f')} | "
-                         f"{fmt_or_dash(e['out_of_distribution_score'], '.1f')} | {e['whirl_rate']:.2f} | "
+            lines.append(f"| {i} | {e['controller']} | {e['score']:.2f} | "
+                         f"{fmt_or_dash(e['in_distribution_score'], '.2f')} | "
+                         f"{fmt_or_dash(e['out_of_distribution_score'], '.2f')} | {e['whirl_rate']:.2f} | "
                          f"{fmt_or_dash(e['whirl_rate_where_passive_whirls'], '.2f')} | "
                          f"{e['force_ratio']:.2f}, {e['max_force_ratio']:.2f} | "
                          f"{e['displacement_ratio']:.2f} | {fmt_or_dash(e['relevitation_rate'], '.2f')} | "

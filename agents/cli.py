@@ -189,8 +189,8 @@ def register(sub) -> None:
                    help="a reduced suite: 5 scenarios x 2 phases (about 15 s)")
     p.add_argument("--policy", action="append", default=None,
                    help="extra policies or controllers to include (repeatable): a training "
-                        "directory or model .zip, or your own controller class as "
-                        "package.module:Class or file.py:Class (see docs/agents.md)")
+                        "directory or model .zip (shown as name@run), or your own controller "
+                        "class as package.module:Class or file.py:Class (see docs/agents.md)")
     p.add_argument("--power-return-ms", type=float, default=None,
                    help="power-return delay of the re-levitation tasks [ms] (default: the "
                         "environments' 50 ms; the 'power back at 0.15 s' scenario keeps its own)")
@@ -220,7 +220,8 @@ def register(sub) -> None:
     p.add_argument("--env", default="RotorDrop-Relevitate-v0",
                    help="RotorDrop-Relevitate-v0 (damper at the scene's C_s) or RotorDrop-Full-v0")
     p.add_argument("--policy", action="append", default=None,
-                   help="baseline or shipped policy name, a path, or a controller class "
+                   help="a re-levitating controller (one that sets the levitate or currents "
+                        "channel): baseline or shipped policy name, a path, or a controller class "
                         "module:Class / file.py:Class (repeatable; default: every re-levitating "
                         "baseline and the shipped policies of --env)")
     p.add_argument("--friction", type=float, action="append", default=None,

@@ -46,18 +46,25 @@ class Controller:
     constants (gains); **per-episode state** (integrators, filters, timers, flags) is (re)set in
     ``reset(n, which)``, which ``predict`` calls at episode starts: for all ``n`` environments
     when ``which`` is None, else where ``which`` is True. Override it, call
-    ``super().reset(n, which)`` first and give each state array ``n`` rows. ``self.t`` (n,) is
-    the time since each episode's start [s]. Errors in a controller, and commands of an unknown
+    ``super().reset(n, which)`` first and give each state array ``n`` rows. ``predict`` finds
+    the starts itself (:meth:`new_episodes`: ``episode_start``, or the ``time`` observation
+    going back), so one controller drives episode after episode without the caller's help.
+    ``self.t`` (n,) is the time since each episode's start [s]. Errors in a controller, and commands of an unknown
     channel, shape or range, raise :class:`~agents.plant.ControllerError` naming it.
     """
 
     name = "controller"
     #: channels the controller sets (a subset of Plant.channels); the rest stay passive
     needs: tuple[str, ...] = ()
+    #: reads the sensor observations (``agents.plant.SENSORS``), absent with full_state=True
+    sensors: bool = True
 
     def __init__(self, plant: Plant):
+        if self.sensors:
+            plant.require_sensors(describe(self))
         self.plant = plant
         self.n = 0
+        self.seen = np.zeros(0)
         self.t = np.zeros(0)
         self.fresh = np.zeros(0, dtype=bool)
         self.hold = np.zeros((0, 2))
@@ -70,6 +77,7 @@ class Controller:
         """Start new episodes (all of them, or those flagged in ``which``)."""
         if which is None or self.n != n:
             self.n = n
+            self.seen = np.full(n, np.nan)
             self.t = np.zeros(n)
             self.fresh = np.ones(n, dtype=bool)
             self.hold = np.zeros((n, 2))
@@ -99,13 +107,32 @@ class Controller:
         with blame(self, "reset(n, which)"):
             if self.n != len(obs):
                 self.reset(len(obs))
-            elif episode_start is not None and np.any(episode_start):
-                self.reset(len(obs), np.asarray(episode_start, dtype=bool).reshape(-1))
+            else:
+                new = self.new_episodes(obs, episode_start)
+                if new.any():
+                    self.reset(len(obs), new)
+        self.seen = self.episode_time(obs)
         if self.n != len(obs) or len(self.t) != len(obs):
             raise ControllerError(f"{describe(self)}: its reset(n, which) must call "
                                   f"super().reset(n, which)")
         action = self.act(obs)
         return (action[0] if single else action), state
+
+    def episode_time(self, obs: np.ndarray) -> np.ndarray:
+        """(n,) the ``time`` observation [s] (time since the fault), NaN if there is none."""
+        if "time" not in self.plant.obs_names:
+            return np.full(len(obs), np.nan)
+        return self.plant.get(obs, "time")
+
+    def new_episodes(self, obs: np.ndarray, episode_start=None) -> np.ndarray:
+        """(n,) rows that start an episode: flagged in ``episode_start`` (SB3), or whose time
+        observation went back (below the last one seen, or 0 after this episode's first
+        action): the environment was reset without the caller saying so."""
+        new = np.zeros(len(obs), dtype=bool)
+        if episode_start is not None:
+            new |= np.asarray(episode_start, dtype=bool).reshape(-1)
+        t, tol = self.episode_time(obs), 0.5 * self.plant.control_dt
+        return new | (t < self.seen - tol) | ((t < tol) & (self.t > 0.0))
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}({self.name!r})"
@@ -136,6 +163,7 @@ class Passive(Controller):
     """No control action: the scene's own support damping, AMBs never switched back on."""
 
     name = "passive"
+    sensors = False
 
 
 class MaxDamping(Controller):
@@ -143,6 +171,7 @@ class MaxDamping(Controller):
 
     name = "max-damping"
     needs = ("damping",)
+    sensors = False
 
     def commands(self, obs):
         return {"damping": np.ones((len(obs), 2))}
@@ -205,6 +234,7 @@ class BuiltinRelevitate(Controller):
 
     name = "builtin-relevitate"
     needs = ("levitate",)
+    sensors = False
 
     def commands(self, obs):
         return {"levitate": np.ones(len(obs))}

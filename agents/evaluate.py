@@ -30,8 +30,11 @@ def _merge_kwargs(base: dict, user: dict, randomize: bool) -> dict:
     kw["randomize"] = randomize
     kw.setdefault("terminate_on_failure", False)
     kw.update(monitor_kwargs(kw))              # KPI sampling every 0.2 ms at any control step
+    if not randomize:
+        kw.pop("randomization", None)          # the env refuses ranges it would not draw from
+        return kw
     fixed = [*(kw.get("overrides") or {}), *(["power_return_time"] if "power_return_time" in user else [])]
-    if randomize and fixed:
+    if fixed:
         kw["randomization"] = {**(kw.get("randomization") or {}), **{k: None for k in fixed}}
     return kw
 
@@ -92,9 +95,11 @@ def evaluate(policy: str, env_id: str | None, episodes: int, out: str | Path,
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     if plots:
+        from .plant import plant_of
         from .plots import plot_episode_comparison
         report["figures"] = [p.name for p in plot_episode_comparison(
-            eps[0], passive[0] if passive else None, name, out)]
+            eps[0], passive[0] if passive else None, name, out,
+            action_names=plant_of(env_id, **kwargs).action_names)]
     write_json(out / "kpis.json", report)
     report["out"] = str(out)
     return report

@@ -26,7 +26,8 @@ algorithm's constructor arguments a block may hold:
                    phases the benchmark does not use) instead of the highest evaluation reward
 =================  ===========================================================================
 
-``learning_rate``, ``clip_range`` accept ``lin_<value>`` (linear decay to zero, as in rl-zoo3).
+``learning_rate``, ``clip_range`` accept ``lin_<value>`` (linear decay to zero, as in rl-zoo3);
+``train_freq`` a list ``[1, "episode"]`` (made the tuple SB3 wants, as in rl-zoo3).
 Any other key must be a constructor argument of the algorithm (:func:`check_sb3` checks the
 keys against the signatures of the algorithm, ``VecNormalize`` and the environment before
 training starts).
@@ -59,6 +60,8 @@ INTEGERS = {"n_timesteps": 1, "n_envs": 1, "eval_freq": 0, "n_eval_episodes": 1,
             "n_steps": 1, "batch_size": 1, "n_epochs": 1, "buffer_size": 1, "learning_starts": 0}
 #: hyperparameters that are fractions in [0, 1]
 FRACTIONS = ("gamma", "gae_lambda", "tau")
+#: SB3 arguments that take a tuple, which YAML writes as a list (``train_freq: [1, episode]``)
+TUPLES = ("train_freq",)
 
 
 class ConfigError(ValueError):
@@ -193,6 +196,9 @@ def split(hp: dict) -> tuple[dict, dict]:
     for k in SCHEDULE_KEYS:
         if k in algo_kwargs:
             algo_kwargs[k] = schedule(algo_kwargs[k], k)
+    for k in TUPLES:
+        if isinstance(algo_kwargs.get(k), list):              # as rl-zoo3 converts it
+            algo_kwargs[k] = tuple(algo_kwargs[k])
     if "policy_kwargs" in meta:
         pk = parse_literal(meta["policy_kwargs"], "policy_kwargs")
         if not isinstance(pk, dict):
@@ -238,7 +244,17 @@ def split(hp: dict) -> tuple[dict, dict]:
     for k in FRACTIONS:
         if k in algo_kwargs and not (is_finite_number(algo_kwargs[k]) and 0.0 <= algo_kwargs[k] <= 1.0):
             raise ConfigError(f"{k} must be a number in [0, 1], got {algo_kwargs[k]!r}")
+    _check_episodic(algo_kwargs.get("train_freq"), meta.get("n_envs", 1))
     return meta, algo_kwargs
+
+
+def _check_episodic(train_freq: Any, n_envs: int) -> None:
+    """SB3 trains per episode (``train_freq: [k, episode]``) with one environment only."""
+    if isinstance(train_freq, tuple) and len(train_freq) == 2 and train_freq[1] == "episode" \
+            and n_envs != 1:
+        raise ConfigError(f"train_freq {list(train_freq)} (per episode) needs n_envs: 1 "
+                          f"(or --n-envs 1; SB3 trains per episode with one environment only), "
+                          f"got n_envs {n_envs}")
 
 
 def is_finite_number(value: Any) -> bool:

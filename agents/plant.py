@@ -31,6 +31,8 @@ import numpy as np
 from rotordrop_env.layout import CURRENT_ACTIONS as CURRENT_NAMES
 
 SENSORS = ("x1", "y1", "vx1", "vy1", "x2", "y2", "vx2", "vy2", "rotor_speed")
+#: the damper values of housing 1, 2: sensor observations, else those of the full state
+DAMPING_OBS = (("damping1", "damping2"), ("RB1.Cs", "RB2.Cs"))
 POSITIONS = ("x1", "y1", "x2", "y2")
 VELOCITIES = ("vx1", "vy1", "vx2", "vy2")
 #: columns per environment of each channel, and what its normalised value means
@@ -103,10 +105,6 @@ class Plant:
             u = u.venv
         if hasattr(u, "envs") and not hasattr(u, "obs_names"):     # batched VecEnv
             u = u.envs[0]
-        missing = [n for n in SENSORS if n not in u.obs_names]
-        if missing:
-            raise ValueError(f"controllers need the sensor observations {', '.join(missing)}; "
-                             f"create the environment without full_state=True")
         from physics.model import P_AMB_IFF1, P_AMB_IFF2
         s = u.base_scene
         P = u.model.P              # gravity feed-forward currents: 0 without actuator AMBs
@@ -120,6 +118,14 @@ class Plant:
                    liftoff_ramp=s.amb.liftoff_ramp_time)
 
     # ------------------------------------------------------------------ observations --
+    def require_sensors(self, who: str) -> None:
+        """:class:`ControllerError` naming ``who`` unless the environment observes the sensor
+        signals ``SENSORS`` (a ``full_state=True`` environment observes the state vector)."""
+        missing = [n for n in SENSORS if n not in self.obs_names]
+        if missing:
+            raise ControllerError(f"{who} needs the sensor observations {', '.join(missing)}; "
+                                  f"create the environment without full_state=True")
+
     @cached_property
     def _columns(self) -> dict[str, int]:
         return {n: j for j, n in enumerate(self.obs_names)}
@@ -170,7 +176,8 @@ class Plant:
     def damping_level(self, obs: np.ndarray) -> np.ndarray:
         """(n, 2) current damper values as commands in [-1, 1]."""
         lo, hi = self.damping_range
-        c = np.stack([self.get(obs, "damping1"), self.get(obs, "damping2")], axis=1)
+        names = next((d for d in DAMPING_OBS if set(d) <= set(self.obs_names)), DAMPING_OBS[0])
+        c = np.stack([self.get(obs, n) for n in names], axis=1)
         return np.clip(2.0 * (c - lo) / (hi - lo) - 1.0, -1.0, 1.0)
 
     def power_available(self, obs: np.ndarray) -> np.ndarray:

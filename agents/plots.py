@@ -70,8 +70,10 @@ def _finish_time_plot(plt, fig, ax, ylabel: str, title: str, path: Path) -> Path
     return Path(path)
 
 
-def plot_episode_comparison(ep, passive, name: str, out: Path) -> list[Path]:
-    """Orbits at both sensor planes, contact force and actions: ``name`` against passive."""
+def plot_episode_comparison(ep, passive, name: str, out: Path,
+                            action_names: tuple[str, ...] | None = None) -> list[Path]:
+    """Orbits at both sensor planes, contact force and actions (legend: ``action_names``):
+    ``name`` against passive."""
     plt = _plt()
     out = Path(out)
     runs = [(name, ep, "C0")] + ([("passive", passive, "C7")] if passive is not None else [])
@@ -106,11 +108,26 @@ def plot_episode_comparison(ep, passive, name: str, out: Path) -> list[Path]:
 
     if ep.actions is not None and ep.actions.size:
         fig, ax = plt.subplots(figsize=(9, 3.5))
-        for j in range(ep.actions.shape[1]):
-            ax.step(ep.t * 1e3, ep.actions[:, j], where="post", lw=0.8, label=f"action[{j}]")
+        names = action_names or [f"action[{j}]" for j in range(ep.actions.shape[1])]
+        colors = {}
+        for j, label in enumerate(names):
+            kind, style = action_style(label)
+            ax.step(ep.t * 1e3, ep.actions[:, j], where="post",
+                    color=colors.setdefault(kind, f"C{len(colors)}"), label=label, **style)
         paths.append(_finish_time_plot(plt, fig, ax, "action", f"actions of {name}",
                                        out / "actions.png"))
     return paths
+
+
+def action_style(name: str) -> tuple[str, dict]:
+    """(kind, line style) of an action's line: one colour per kind (the name without its
+    AMB/damper plane digit); plane 1 a wide pale band, plane 2 dashed on top of it, so that
+    equal commands of the two planes both show."""
+    for plane, style in (("2", dict(ls="--", lw=1.0)), ("1", dict(ls="-", lw=3.0, alpha=0.4))):
+        for tag in (f"amb{plane}", f"damping{plane}"):
+            if tag in name:
+                return name.replace(tag, tag[:-1]), style
+    return name, dict(ls="-", lw=1.0)
 
 
 def plot_benchmark(report: dict, out: Path) -> list[Path]:

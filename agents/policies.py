@@ -1,7 +1,8 @@
 """Learned policies (SB3 model + VecNormalize statistics) and name resolution for the CLI.
 
 A learned policy is a directory written by ``rotordrop train`` (``model.zip``,
-``vecnormalize.pkl``, ``config.yaml``), a model zip with those files next to it, or a policy
+``vecnormalize.pkl``, ``config.yaml``) or its ``best/`` (``best_model.zip``,
+``vecnormalize.pkl``), a model zip with those files next to it, or a policy
 shipped in ``agents/policies/`` (``<name>.zip``, ``<name>.pkl``, ``<name>.json``; the name
 starts with the algorithm: ``ppo-damping``). It answers ``predict`` like a controller.
 """
@@ -79,6 +80,8 @@ class LearnedPolicy:
     @classmethod
     def load(cls, path: str | Path, name: str | None = None) -> "LearnedPolicy":
         path = Path(path)
+        if path.is_dir() and not (path / "model.zip").is_file() and (path / "best_model.zip").is_file():
+            path = path / "best_model.zip"                  # a run's best/
         if path.is_dir():
             model_path = path / "model.zip"
             vn_paths = [path / "vecnormalize.pkl"]
@@ -91,7 +94,8 @@ class LearnedPolicy:
         else:
             raise FileNotFoundError(f"{path} is neither a training directory nor a model .zip")
         if not model_path.is_file():
-            raise FileNotFoundError(f"no model at {model_path}")
+            raise FileNotFoundError(f"no model at {model_path}" + (
+                " (nor best_model.zip: a run's best/)" if path.is_dir() else ""))
         algo = meta.get("algo") or _algo_from_zip(model_path)
         env_id = meta.get("env_id")
         if env_id is None:

@@ -8,7 +8,8 @@ benchmark's episode settings) and reports per cell the peak backward-whirl revol
 worst phase), the whirl rate, the peak contact force and the re-levitation rate. Its summary is
 the **ride-through time** per friction: the longest grid delay up to which (every shorter
 delay included) the controller re-levitates without a backward whirl in any phase. The passive
-drop (power never returns) is the reference column.
+drop (power never returns) is the reference column. A controller class that does not command
+re-levitation (no ``levitate`` or ``currents`` channel) is refused before the map starts.
 
 Delays must lie inside the episode (``EPISODE_TIME``). A ride-through time equal to the longest
 grid delay is a lower bound (``ride_through_lower_bound`` in the JSON, "≥" in the table): the map
@@ -49,6 +50,7 @@ def controllers_for(env_id: str) -> list[str]:
 def _entry(spec: str, env_id: str) -> Entry:
     cls = controller_class(spec)
     if cls is not None:
+        _check_relevitates(cls, spec)
         return controller_entry(cls, env_id)
     policy, trained_on = resolve(spec)
     if trained_on != env_id:
@@ -57,6 +59,15 @@ def _entry(spec: str, env_id: str) -> Entry:
                   f"a policy of {' or '.join(RELEVITATION_ENVS)})")
         raise ValueError(f"policy {spec!r} was trained on {trained_on}, not on {env_id}; {advice}")
     return Entry(policy_label(spec, policy), task_of(env_id), policy.bound, dict(policy.env_kwargs))
+
+
+def _check_relevitates(cls, spec: str) -> None:
+    """Refuse a controller class that does not command re-levitation (no ``levitate`` or
+    ``currents`` channel): the power return, which the map varies, does not reach it."""
+    if command_for(cls) is None:
+        raise ValueError(f"--policy {spec!r}: ride-through maps controllers that re-levitate "
+                         f"(set the 'levitate' or 'currents' channel); {cls.name} commands "
+                         f"{', '.join(cls.needs) + ' only' if cls.needs else 'nothing'}")
 
 
 def _check_grid(name: str, values, lo: float, hi: float, shown: float = 1.0, unit: str = "",

@@ -14,7 +14,7 @@ from typing import Callable
 import numpy as np
 
 from .controllers import Controller, check_controller
-from .plant import Plant, make_env
+from .plant import POSITIONS, Plant, make_env
 
 
 @dataclass
@@ -28,7 +28,7 @@ class Episode:
     obs: np.ndarray | None = None               # physical (SI) observations, (steps, n_obs)
     actions: np.ndarray | None = None
     contact_force: np.ndarray | None = None     # per step, (steps, n) [N]
-    obs_names: tuple[str, ...] = ()
+    obs_names: tuple[str, ...] = ()             # + x1, y1, x2, y2 for a full_state env
     scenario: dict | None = None                # the scenario drawn at reset (info["scenario"])
 
 
@@ -74,12 +74,14 @@ def _episode(env, plant: Plant, actor, seed: int, record: bool) -> Episode:
     total, steps = 0.0, 0
     rec_obs, rec_act, rec_f = [], [], []
     start, running = np.ones(1, dtype=bool), np.zeros(1, dtype=bool)
+    extra = () if not record or set(POSITIONS) <= set(plant.obs_names) else POSITIONS
     while True:
         action, _ = actor.predict(obs[None, :], episode_start=start, deterministic=True)
         start = running
         a = action[0]
         if record:
-            rec_obs.append(obs.astype(np.float64) * plant.obs_scale)
+            row = obs.astype(np.float64) * plant.obs_scale
+            rec_obs.append(np.concatenate([row, sensor_positions(env)]) if extra else row)
             rec_act.append(np.atleast_1d(np.asarray(a, dtype=np.float64)))
         obs, reward, terminated, truncated, info = env.step(a)
         if record:
@@ -88,10 +90,20 @@ def _episode(env, plant: Plant, actor, seed: int, record: bool) -> Episode:
         steps += 1
         if terminated or truncated:
             break
-    ep = Episode(seed, final_kpis(info), total, steps, obs_names=plant.obs_names, scenario=scenario)
+    ep = Episode(seed, final_kpis(info), total, steps, obs_names=plant.obs_names + extra,
+                 scenario=scenario)
     if record:
         ep.t = np.arange(steps) * plant.control_dt
         ep.obs = np.array(rec_obs)
         ep.actions = np.array(rec_act)
         ep.contact_force = np.array(rec_f)
     return ep
+
+
+def sensor_positions(env) -> np.ndarray:
+    """(4,) x1, y1, x2, y2 [m]: the rotor axis at the AMB (sensor) planes from the env's state,
+    for the orbit plots of a ``full_state=True`` environment, which does not observe them."""
+    from physics.model import P_Z_AMB1, axis_motion
+    u = env.unwrapped
+    return np.array([v for k in range(2) for v in axis_motion(u.state, u.model.I,
+                                                               u.model.P[P_Z_AMB1 + k])[:2]])

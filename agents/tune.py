@@ -11,8 +11,9 @@ the benchmark, so that ``rotordrop benchmark`` afterwards still measures the tun
 unseen cases. The search starts from the class's ``GAINS`` defaults where it has them (clipped
 into the range; else the middle of each range).
 
-Outputs: ``tune.json`` (gains, validation score before and after, per-scenario rows, the search
-history) and ``tune.png`` (best validation score per generation).
+Outputs: ``tune.json`` (gains, validation score before and after, per-scenario rows of the
+tuned controller and of the passive drop, each with its cost J, from which the validation score
+is recomputed; the search history) and ``tune.png`` (best validation score per generation).
 """
 from __future__ import annotations
 
@@ -119,6 +120,7 @@ def tune(spec: str, env_id: str, gains: list[str], out, iterations: int = 12,
     report = dict(controller=cls.name, spec=spec, env_id=env_id, ranges={n: [lo, hi] for n, lo, hi in ranges},
                   start=dict(zip(names, start.tolist())), start_validation_score=-history[0]["best_cost"],
                   gains=dict(zip(names, best.tolist())), validation_score=final, rows=rows,
+                  passive_rows=validator.passive,
                   history=[dict(iteration=h["iteration"], best_validation_score=-h["best_cost"],
                                 generation_best=-h["generation_best"],
                                 gains=dict(zip(names, h["best"].tolist()))) for h in history],

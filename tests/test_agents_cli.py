@@ -185,8 +185,9 @@ def test_a_users_controller_class_is_evaluated_and_benchmarked_like_a_baseline(t
     assert tasks == {"damping", "full"}                  # not in relevitate: it has no damper
     monkeypatch.chdir(tmp_path)                          # module:Class finds modules next to you
     assert load_controller("my_controllers:MidDamping").name == "mid-damping"
-    assert main(["ride-through", "--policy", spec, "--policy", f"{path}:SameName",
-                 "--out", str(tmp_path / "rt")]) == 2
+    monkeypatch.setattr("agents.benchmark.passive_threshold", None)      # fails before it
+    assert main(["benchmark", "--quick", "--quiet", "--policy", spec, "--policy",
+                 f"{path}:SameName", "--out", str(tmp_path / "b")]) == 2
     assert "two controllers are named mid-damping" in capsys.readouterr().err
     for bad, words in ((f"{path}:NotAController", "not a subclass"),
                        (f"{path}:Missing", "has no 'Missing'"),
@@ -307,3 +308,46 @@ def test_tune_moves_a_damper_level_towards_more_damping(tmp_path, capsys):
     assert main(["tune", "--policy", "ppo-damping", "--env", "RotorDrop-Damping-v0",
                  "--gain", "a=0:1", "--out", str(tmp_path / "x")]) == 2
     assert "not a learned policy" in capsys.readouterr().err
+
+
+def test_tune_json_holds_what_recomputes_its_validation_score(tmp_path):
+    """The passive rows are in tune.json: J and the score follow from the file alone."""
+    from agents.benchmark import EPISODE_TIME
+    from agents.score import overall_score, row_cost
+    out = tmp_path / "tune"
+    assert main(["tune", "--policy", "whirl-brake", "--env", "RotorDrop-Relevitate-v0",
+                 "--gain", "kp=0.8:0.9", "--iterations", "0", "--quiet", "--no-plots",
+                 "--out", str(out)]) == 0
+    r = json.loads((out / "tune.json").read_text())
+    passive = {p["scenario"]: p for p in r["passive_rows"]}
+    assert set(passive) == {x["scenario"] for x in r["rows"]} and len(passive) == 5
+    costs = [row_cost(x, passive[x["scenario"]], EPISODE_TIME, True) for x in r["rows"]]
+    p_costs = [row_cost(p, p, EPISODE_TIME, True) for p in passive.values()]
+    assert [x["cost"] for x in r["rows"]] == pytest.approx(costs, rel=1e-12)
+    assert [p["cost"] for p in passive.values()] == pytest.approx(p_costs, rel=1e-12)
+    assert overall_score(costs, p_costs) == pytest.approx(r["validation_score"], rel=1e-12)
+
+
+def test_evaluate_actions_are_named_and_the_planes_tell_apart(tmp_path, monkeypatch):
+    """actions.png: the legend names the actions (it said action[0..5]), and the plane-1 and
+    plane-2 lines of a channel share a colour but not a line style (whirl-brake commands
+    equal currents and dampers in both planes: one line hid the other)."""
+    import agents.plots as plots
+    seen = {}
+    finish = plots._finish_time_plot
+
+    def spy(plt, fig, ax, ylabel, title, path):
+        seen[path.name] = {line.get_label(): (line.get_color(), line.get_linestyle())
+                           for line in ax.get_lines()}
+        return finish(plt, fig, ax, ylabel, title, path)
+    monkeypatch.setattr(plots, "_finish_time_plot", spy)
+    assert main(["evaluate", "--policy", "whirl-brake", "--env", "RotorDrop-Full-v0", "--episodes",
+                 "1", "--fixed", "--no-passive", "--set", "contact.friction=0.45",
+                 "--out", str(tmp_path / "ev")]) == 0
+    lines = seen["actions.png"]
+    assert list(lines) == ["damping1", "damping2", "current_amb1_x", "current_amb1_y",
+                           "current_amb2_x", "current_amb2_y"]
+    for one, two in (("damping1", "damping2"), ("current_amb1_x", "current_amb2_x"),
+                     ("current_amb1_y", "current_amb2_y")):
+        assert lines[one][0] == lines[two][0] and lines[one][1] != lines[two][1]
+    assert len({color for color, _ in lines.values()}) == 3

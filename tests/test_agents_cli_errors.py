@@ -256,3 +256,98 @@ def test_a_broken_user_controller_fails_before_long_work(cmd, cls, patch, tmp_pa
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "broken on purpose" in err
     assert not (tmp_path / "o").exists() or not any((tmp_path / "o").iterdir())
+
+
+# ------------------------------------------------- review 2: names, refusals, table digits --
+def _named_run(tmp_path, run: str, name: str):
+    """A run directory holding the shipped ppo-damping under the policy name ``name``."""
+    from agents.hyperparams import dump_yaml
+    from agents.policies import shipped_dir
+    folder = tmp_path / run
+    folder.mkdir()
+    meta = json.loads((shipped_dir() / "ppo-damping.json").read_text())
+    dump_yaml(dict(algo="ppo", env_id=meta["env_id"], name=name, hyperparams=meta["hyperparams"]),
+              folder / "config.yaml")
+    shutil.copyfile(shipped_dir() / "ppo-damping.zip", folder / "model.zip")
+    shutil.copyfile(shipped_dir() / "ppo-damping.pkl", folder / "vecnormalize.pkl")
+    return str(folder)
+
+
+class _Stop(Exception):
+    pass
+
+
+def test_the_benchmark_names_every_run_name_at_run_as_evaluate_does(tmp_path, monkeypatch):
+    """Two runs of a policy no shipped one is named like: both are name@run (the first was
+    bare, the second got @run only because of the clash); evaluate's label is the same."""
+    from agents.benchmark import benchmark, policy_label
+    from agents.policies import LearnedPolicy
+    run_a, run_b = _named_run(tmp_path, "runA", "ppo-mine"), _named_run(tmp_path, "runB", "ppo-mine")
+    seen = []
+
+    def entries_then_stop(entries):
+        seen.extend(e.name for e in entries)
+        raise _Stop                                 # before the long work
+    monkeypatch.setattr("agents.benchmark.check_unique_names", entries_then_stop)
+    with pytest.raises(_Stop):
+        benchmark(tmp_path / "b", policies=[run_a, run_b, "ppo-damping"], progress=False)
+    mine = [n for n in seen if n.startswith("ppo-mine")]
+    assert mine == ["ppo-mine@runA", "ppo-mine@runB"]
+    assert "ppo-damping" in seen                    # a shipped policy keeps its bare name
+    assert policy_label(run_a, LearnedPolicy.load(run_a)) == "ppo-mine@runA"
+
+
+@pytest.mark.parametrize("argv, name, commands", [
+    (["--quick"], "max-damping", "damping only"),
+    (["--env", "RotorDrop-Full-v0"], "max-damping", "damping only"),
+    (["--env", "RotorDrop-Full-v0"], "whirl-switch", "damping only"),
+    ([], "passive", "nothing")])
+def test_ride_through_refuses_a_controller_that_cannot_relevitate_up_front(
+        argv, name, commands, tmp_path, capsys, monkeypatch):
+    """It failed after 6 of 24 episodes with a channels message (Relevitate) or printed a row
+    of "none" (Full): the power return the map varies never reaches such a controller."""
+    monkeypatch.setattr("agents.ride_through.run_episodes", _long_work)
+    assert main(["ride-through", *argv, "--policy", "whirl-brake", "--policy", name, "--quiet",
+                 "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == (f"rotordrop ride-through: error: --policy '{name}': ride-through maps "
+                   f"controllers that re-levitate (set the 'levitate' or 'currents' channel); "
+                   f"{name} commands {commands}")
+    assert not (tmp_path / "o").exists()
+
+
+def test_ride_through_refuses_a_users_damping_class_alike(tmp_path, capsys, monkeypatch):
+    path = tmp_path / "switch.py"
+    path.write_text(SWITCH_CONTROLLER)
+    monkeypatch.setattr("agents.ride_through.run_episodes", _long_work)
+    assert main(["ride-through", "--env", "RotorDrop-Full-v0", "--policy", f"{path}:Switch",
+                 "--quiet", "--out", str(tmp_path / "o")]) == 2
+    assert "switch-damping commands damping only" in capsys.readouterr().err
+
+
+def test_leaderboard_scores_show_the_digits_that_rank_them():
+    """13.08 and 13.07 rank apart: the table must not show both as 13.1."""
+    from agents.benchmark import leaderboard_markdown
+    entry = dict(task="damping", whirl_rate=0.73, whirl_rate_where_passive_whirls=0.97,
+                 force_ratio=0.75, max_force_ratio=1.09, displacement_ratio=0.84,
+                 relevitation_rate=None, stator_contact_rate=0.85)
+    board = [dict(entry, controller="max-damping", score=13.0809, in_distribution_score=11.444,
+                  out_of_distribution_score=13.7),
+             dict(entry, controller="ppo-damping", score=13.0749, in_distribution_score=11.436,
+                  out_of_distribution_score=None)]
+    md = leaderboard_markdown(dict(quick=False, passive_threshold=0.38, phases_deg=[0.0],
+                                   episode_time_s=0.3, power_return_s=0.05, leaderboard=board,
+                                   rows=[]))
+    assert "| 1 | max-damping | 13.08 | 11.44 | 13.70 |" in md
+    assert "| 2 | ppo-damping | 13.07 | 11.44 | - |" in md
+
+
+def test_a_shipped_policy_trained_on_randomised_scenes_evaluates_fixed(tmp_path):
+    """ppo-full carries its training ranges; --fixed must drop them (the env refuses ranges
+    without randomize=True) and run the scene as given."""
+    out = tmp_path / "ev"
+    assert main(["evaluate", "--policy", "ppo-full", "--fixed", "--episodes", "1", "--no-plots",
+                 "--no-passive", "--set", "contact.friction=0.3", "--out", str(out)]) == 0
+    r = _strict((out / "kpis.json").read_text())
+    assert "randomization" not in r["env_kwargs"] and not r["env_kwargs"]["randomize"]
+    assert r["episodes"][0]["scenario"]["contact.friction"] == 0.3
