@@ -49,8 +49,9 @@ class Controller:
     ``super().reset(n, which)`` first and give each state array ``n`` rows. ``predict`` finds
     the starts itself (:meth:`new_episodes`: ``episode_start``, or the ``time`` observation
     going back), so one controller drives episode after episode without the caller's help.
-    ``self.t`` (n,) is the time since each episode's start [s]. Errors in a controller, and commands of an unknown
-    channel, shape or range, raise :class:`~agents.plant.ControllerError` naming it.
+    ``self.t`` (n,) is the time since each episode's start [s]. Errors in a controller, and
+    commands of an unknown channel, shape or range, raise
+    :class:`~agents.plant.ControllerError` naming it.
     """
 
     name = "controller"
@@ -104,34 +105,29 @@ class Controller:
         obs = np.asarray(observation, dtype=np.float64)
         single = obs.ndim == 1
         obs = np.atleast_2d(obs)
+        t = self.plant.get(obs, "time")                # every env observes it (layout)
         with blame(self, "reset(n, which)"):
             if self.n != len(obs):
                 self.reset(len(obs))
             else:
-                new = self.new_episodes(obs, episode_start)
+                new = self.new_episodes(t, episode_start)
                 if new.any():
                     self.reset(len(obs), new)
-        self.seen = self.episode_time(obs)
+        self.seen = t
         if self.n != len(obs) or len(self.t) != len(obs):
             raise ControllerError(f"{describe(self)}: its reset(n, which) must call "
                                   f"super().reset(n, which)")
         action = self.act(obs)
         return (action[0] if single else action), state
 
-    def episode_time(self, obs: np.ndarray) -> np.ndarray:
-        """(n,) the ``time`` observation [s] (time since the fault), NaN if there is none."""
-        if "time" not in self.plant.obs_names:
-            return np.full(len(obs), np.nan)
-        return self.plant.get(obs, "time")
-
-    def new_episodes(self, obs: np.ndarray, episode_start=None) -> np.ndarray:
-        """(n,) rows that start an episode: flagged in ``episode_start`` (SB3), or whose time
-        observation went back (below the last one seen, or 0 after this episode's first
-        action): the environment was reset without the caller saying so."""
-        new = np.zeros(len(obs), dtype=bool)
+    def new_episodes(self, t: np.ndarray, episode_start=None) -> np.ndarray:
+        """(n,) rows that start an episode: flagged in ``episode_start`` (SB3), or whose
+        ``time`` observation ``t`` [s] went back (below the last one seen, or 0 after this
+        episode's first action): the environment was reset without the caller saying so."""
+        new = np.zeros(len(t), dtype=bool)
         if episode_start is not None:
             new |= np.asarray(episode_start, dtype=bool).reshape(-1)
-        t, tol = self.episode_time(obs), 0.5 * self.plant.control_dt
+        tol = 0.5 * self.plant.control_dt
         return new | (t < self.seen - tol) | ((t < tol) & (self.t > 0.0))
 
     def __repr__(self) -> str:

@@ -95,11 +95,9 @@ def evaluate(policy: str, env_id: str | None, episodes: int, out: str | Path,
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     if plots:
-        from .plant import plant_of
         from .plots import plot_episode_comparison
         report["figures"] = [p.name for p in plot_episode_comparison(
-            eps[0], passive[0] if passive else None, name, out,
-            action_names=plant_of(env_id, **kwargs).action_names)]
+            eps[0], passive[0] if passive else None, name, out)]
     write_json(out / "kpis.json", report)
     report["out"] = str(out)
     return report

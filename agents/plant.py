@@ -173,12 +173,16 @@ class Plant:
         """(4,) gravity feed-forward per AMB axis (x1, y1, x2, y2) / current limit."""
         return np.array([0.0, self.feedforward[0], 0.0, self.feedforward[1]]) / self.current_limit
 
+    @cached_property
+    def _damping(self):
+        return self._block_columns(next((d for d in DAMPING_OBS if set(d) <= set(self.obs_names)),
+                                        DAMPING_OBS[0]))
+
     def damping_level(self, obs: np.ndarray) -> np.ndarray:
         """(n, 2) current damper values as commands in [-1, 1]."""
         lo, hi = self.damping_range
-        names = next((d for d in DAMPING_OBS if set(d) <= set(self.obs_names)), DAMPING_OBS[0])
-        c = np.stack([self.get(obs, n) for n in names], axis=1)
-        return np.clip(2.0 * (c - lo) / (hi - lo) - 1.0, -1.0, 1.0)
+        j, scale = self._damping
+        return np.clip(2.0 * (obs[:, j] * scale - lo) / (hi - lo) - 1.0, -1.0, 1.0)
 
     def power_available(self, obs: np.ndarray) -> np.ndarray:
         if "amb_power" not in self.obs_names:

@@ -70,9 +70,8 @@ def _finish_time_plot(plt, fig, ax, ylabel: str, title: str, path: Path) -> Path
     return Path(path)
 
 
-def plot_episode_comparison(ep, passive, name: str, out: Path,
-                            action_names: tuple[str, ...] | None = None) -> list[Path]:
-    """Orbits at both sensor planes, contact force and actions (legend: ``action_names``):
+def plot_episode_comparison(ep, passive, name: str, out: Path) -> list[Path]:
+    """Orbits at both sensor planes, contact force and actions (legend: ``ep.action_names``):
     ``name`` against passive."""
     plt = _plt()
     out = Path(out)
@@ -108,7 +107,7 @@ def plot_episode_comparison(ep, passive, name: str, out: Path,
 
     if ep.actions is not None and ep.actions.size:
         fig, ax = plt.subplots(figsize=(9, 3.5))
-        names = action_names or [f"action[{j}]" for j in range(ep.actions.shape[1])]
+        names = ep.action_names or [f"action[{j}]" for j in range(ep.actions.shape[1])]
         colors = {}
         for j, label in enumerate(names):
             kind, style = action_style(label)

@@ -13,6 +13,8 @@ from typing import Callable
 
 import numpy as np
 
+from physics.model import P_Z_AMB1, axis_motion
+
 from .controllers import Controller, check_controller
 from .plant import POSITIONS, Plant, make_env
 
@@ -29,6 +31,7 @@ class Episode:
     actions: np.ndarray | None = None
     contact_force: np.ndarray | None = None     # per step, (steps, n) [N]
     obs_names: tuple[str, ...] = ()             # + x1, y1, x2, y2 for a full_state env
+    action_names: tuple[str, ...] = ()
     scenario: dict | None = None                # the scenario drawn at reset (info["scenario"])
 
 
@@ -91,7 +94,7 @@ def _episode(env, plant: Plant, actor, seed: int, record: bool) -> Episode:
         if terminated or truncated:
             break
     ep = Episode(seed, final_kpis(info), total, steps, obs_names=plant.obs_names + extra,
-                 scenario=scenario)
+                 action_names=plant.action_names, scenario=scenario)
     if record:
         ep.t = np.arange(steps) * plant.control_dt
         ep.obs = np.array(rec_obs)
@@ -103,7 +106,6 @@ def _episode(env, plant: Plant, actor, seed: int, record: bool) -> Episode:
 def sensor_positions(env) -> np.ndarray:
     """(4,) x1, y1, x2, y2 [m]: the rotor axis at the AMB (sensor) planes from the env's state,
     for the orbit plots of a ``full_state=True`` environment, which does not observe them."""
-    from physics.model import P_Z_AMB1, axis_motion
     u = env.unwrapped
     return np.array([v for k in range(2) for v in axis_motion(u.state, u.model.I,
                                                                u.model.P[P_Z_AMB1 + k])[:2]])

@@ -85,17 +85,22 @@ def static_max_ball_load(b, load: float) -> float:
     ring displacement by bisection). About 4.5 load / z at C_0 (Stribeck's 5 load / z at
     small loads, where the clearance leaves fewer balls loaded)."""
     K_tot = ball_stiffness(b)[2]
-    lo = b.clearance / 2.0
+    half_play = b.clearance / 2.0
+
+    def forces(u: float) -> tuple:                 # ring displaced by u towards the ball at 0
+        return ball_forces(u, 0.0, 0.0, b.balls, half_play, 0.0, K_tot)
+
+    lo = half_play
     hi = lo + (load / K_tot) ** (2.0 / 3.0)        # one ball alone carries the load
     for _ in range(200):
         mid = 0.5 * (lo + hi)
         if mid in (lo, hi):
             break
-        if ball_forces(mid, 0.0, 0.0, b.balls, b.clearance / 2.0, 0.0, K_tot)[0] < load:
+        if forces(mid)[0] < load:
             lo = mid
         else:
             hi = mid
-    return ball_forces(hi, 0.0, 0.0, b.balls, b.clearance / 2.0, 0.0, K_tot)[5]
+    return forces(hi)[5]
 
 
 def bearing_constants(b, static_load: float) -> BearingConstants:

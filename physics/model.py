@@ -422,7 +422,8 @@ def rhs(t, y, P, I, U, dy, aux):
             if I[F_FILM] and i_ws < 0:
                 # massless sleeve: the film follows the algebraic rolling speed, so the audit
                 # keeps the ball potential at zero film (mechanical_energy) and counts the
-                # film's share of the ball forces as a non-potential force
+                # film's share of the ball forces as a non-potential force (dV below: the
+                # zero-film cage derivative, to match)
                 qx0, qy0, _, dV, _, _ = ball_forces(ux, uy, cage, int(P[P_NB]), P[P_HALF_PLAY],
                                                     0.0, P[P_KTOT])
                 p_ext += (qx0 - qx) * uvx + (qy0 - qy) * uvy

@@ -39,6 +39,11 @@ def warning_counts(outcomes: Iterable[Outcome]) -> dict[str, int]:
     return counts
 
 
+def counts_text(counts: dict[str, int]) -> str:
+    """The flagged kinds in short: "stator_contact 2, coarse_output 1" ("" when none)."""
+    return ", ".join(f"{k} {n}" for k, n in counts.items() if n)
+
+
 def warnings_note(counts: dict[str, int]) -> str:
     """One line: "drop checks: 2 drops reaching the AMB stator, ..." ("" when no drop was flagged)."""
     parts = [f"{n} drop{'s' if n > 1 else ''} {WARNING_KINDS[k][1]}" for k, n in counts.items() if n]

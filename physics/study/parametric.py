@@ -30,7 +30,7 @@ import numpy as np
 from ..metrics import worst_plane
 from ..scene import SceneError, load_scene
 from ..sweep import Outcome, Run, plan_jobs, run_sweep
-from .checks import WARNING_KINDS, as_drop, warning_counts, warnings_note
+from .checks import WARNING_KINDS, as_drop, counts_text, warning_counts, warnings_note
 from .ensemble import ENSEMBLE_KEYS, perturbations
 
 MAX_KEYS = 3
@@ -219,7 +219,7 @@ def summary_table(report: dict) -> str:
     rows = []
     for c in report["cells"]:
         f, d = c["peak_contact_force_N"], c["max_displacement_um"]
-        flagged = ", ".join(f"{k} {n}" for k, n in c["warnings"].items() if n) or "-"
+        flagged = counts_text(c["warnings"]) or "-"
         rows.append("| " + " | ".join(value_label(c[k]) for k in keys)
                     + (f" | {c['whirl_probability']:.2f} | {f['median']:.0f} ({f['max']:.0f}) | "
                        f"{d['median']:.0f} ({d['max']:.0f})" if f else " | - | - | -")

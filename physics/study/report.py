@@ -11,7 +11,7 @@ import numpy as np  # noqa: E402
 
 from ..plots import RPM, orbit_panel, save_figure  # noqa: E402
 from ..results import Result  # noqa: E402
-from .checks import warnings_note  # noqa: E402
+from .checks import counts_text, warnings_note  # noqa: E402
 from .claims import PAPER_SOFT_Y_UM, PAPER_THRESHOLD  # noqa: E402
 from .paper import BASE, SOFT  # noqa: E402
 from .parametric import PLANE_KPIS, value_label  # noqa: E402
@@ -183,10 +183,9 @@ def _checks_text(a: dict) -> str:
     total = warnings_note(a["warnings"]["total"])
     if not total:
         return "Drop checks (the warnings `rotordrop drop` prints): no drop flagged.\n"
-    per = "; ".join(f"{study}: " + ", ".join(f"{k} {n}" for k, n in counts.items() if n)
-                    for study, counts in a["warnings"].items()
+    per = "; ".join(f"{study}: {counts_text(counts)}" for study, counts in a["warnings"].items()
                     if study != "total" and any(counts.values()))
-    return (f"D{total[1:]} (per study: {per}). These are the warnings `rotordrop drop` prints for the "
+    return (f"{total[0].upper()}{total[1:]} (per study: {per}). These are the warnings `rotordrop drop` prints for the "
             "run's command; the drops are in the statistics, except those without a fault, which "
             "count as failed.\n")
 
