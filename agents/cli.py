@@ -8,8 +8,11 @@ import argparse
 import sys
 from pathlib import Path
 
+from physics.cli import at_least
+
 
 ERRORS = (KeyError, ValueError, FileNotFoundError)      # bad input: one line, exit 2
+_SEED = at_least(0)                 # every --seed: what numpy and gymnasium accept
 
 
 def _fail(command: str, exc: Exception) -> int:
@@ -20,17 +23,6 @@ def _fail(command: str, exc: Exception) -> int:
 def _wrote(out: str, files: list[str], wall_s: float | None = None) -> None:
     print("wrote " + ", ".join(str(Path(out) / f) for f in files)
           + (f" in {wall_s:.0f} s" if wall_s is not None else ""))
-
-
-def _seed(text: str) -> int:
-    """argparse type of every --seed: an integer >= 0 (what numpy and gymnasium accept)."""
-    try:
-        seed = int(text)
-    except ValueError:
-        seed = None
-    if seed is None or seed < 0:
-        raise argparse.ArgumentTypeError(f"the seed must be an integer >= 0, got {text!r}")
-    return seed
 
 
 def _power_return_s(args) -> float | None:
@@ -149,7 +141,7 @@ def register(sub) -> None:
     p.add_argument("--config", default=None,
                    help="YAML with hyperparameters keyed by env id (rl-zoo3 style), applied over "
                         "the shipped agents/configs/<algo>.yaml")
-    p.add_argument("--seed", type=_seed, default=0)
+    p.add_argument("--seed", type=_SEED, default=0)
     p.add_argument("--resume", default=None, metavar="DIR|CHECKPOINT.zip",
                    help="continue from a checkpoint (or the newest one in a run directory)")
     p.add_argument("--threads", type=int, default=1,
@@ -171,7 +163,7 @@ def register(sub) -> None:
                                                "trained on; required for controller classes and "
                                                "baselines)")
     p.add_argument("--episodes", type=int, default=10)
-    p.add_argument("--seed", type=_seed, default=0, help="episode i uses seed + i")
+    p.add_argument("--seed", type=_SEED, default=0, help="episode i uses seed + i")
     p.add_argument("--scene", default=None, help="scene preset or TOML (default: the env's)")
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="scene override (repeatable), e.g. contact.friction=0.4")
@@ -211,7 +203,7 @@ def register(sub) -> None:
     p.add_argument("--iterations", type=int, default=12, help="generations (default 12)")
     p.add_argument("--population", type=int, default=24, help="candidates per generation")
     p.add_argument("--elite", type=int, default=6, help="best candidates the next generation is fitted to")
-    p.add_argument("--seed", type=_seed, default=0)
+    p.add_argument("--seed", type=_SEED, default=0)
     _output_args(p, "out/tune")
     p.set_defaults(func=cmd_tune)
 

@@ -422,13 +422,13 @@ def run_accuracy(source: str, overrides: dict, out_dir, quick: bool = False,
 
 
 def register(subparsers) -> None:
-    from .cli import add_scene_args
+    from .cli import add_scene_args, at_least
     p = subparsers.add_parser("accuracy", help="what accuracy costs in time: solver settings and "
                               "reduced models against a tight reference (Markdown, JSON, Pareto plot)")
     add_scene_args(p)
     p.add_argument("--out", default="out/accuracy", help="output directory")
     p.add_argument("--quick", action="store_true", help="2 drops of 0.3 s, fewer settings")
-    p.add_argument("--jobs", type=int, default=None, help="worker processes (default: all cores)")
+    p.add_argument("--jobs", type=at_least(1), default=None, help="worker processes (default: all cores)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_accuracy)
 

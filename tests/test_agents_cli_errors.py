@@ -104,7 +104,7 @@ def test_a_ride_through_time_at_the_end_of_the_grid_is_a_lower_bound(tmp_path):
     ["tune", "--policy", "whirl-brake", "--env", "RotorDrop-Relevitate-v0", "--gain", "kp=0:1"]])
 def test_a_negative_seed_is_a_flag_error(argv, capsys, tmp_path):
     err = _flag_error([*argv, "--seed", "-1"], capsys)
-    assert err == f"rotordrop {argv[0]}: error: argument --seed: the seed must be an integer >= 0, got '-1'"
+    assert err == f"rotordrop {argv[0]}: error: argument --seed: must be an integer >= 0, got '-1'"
 
 
 # ----------------------------------------------------------------------------------- tune --
