@@ -10,7 +10,10 @@ import math
 import numpy as np
 
 from ._jit import njit
-from .model import N_AUX, rhs
+from .model import A_FR, A_LOAD, A_QMAX, N_AUX, N_AUX_PLANE, rhs
+
+# step-resolved peaks per retainer plane k at peaks[k * N_PEAK + j]
+(P_FR, P_LOAD, P_QMAX, N_PEAK) = range(4)
 
 OK, STEP_COLLAPSE, TOO_MANY_STEPS, NOT_FINITE = 0, 1, 2, 3
 
@@ -39,13 +42,16 @@ _PD = np.array([
 
 @njit
 def integrate_segment(y, t0, t1, P, I, U, rtol, atol, h, h_max, h_min, fixed, max_steps,
-                      t_out, Y_out, out_pos, work):
+                      t_out, Y_out, out_pos, work, peaks=None):
     """Advance ``y`` (in place) from t0 to exactly t1.
 
     Samples the solution into ``Y_out[out_pos:]`` for every ``t_out[j]`` in (t0, t1].
     ``work`` is a (9, n) scratch array (stages and a trial state), so nothing is allocated per
-    step. Returns (status, t reached, next step size, output position, rhs calls, steps,
-    rejected steps).
+    step. ``peaks`` (optional, (2 N_PEAK,)) keeps the running maxima of the contact force,
+    bearing load and largest ball load per retainer plane at every accepted step end (the
+    first-same-as-last stage's diagnostics), whatever the output rate; without it the branch is
+    compiled out. Returns (status, t reached, next step size, output position, rhs calls,
+    steps, rejected steps).
     """
     n = y.shape[0]
     K = work[:7]
@@ -112,6 +118,12 @@ def integrate_segment(y, t0, t1, P, I, U, rtol, atol, h, h_max, h_min, fixed, ma
                 y[i] = ytry[i]
                 K[0, i] = K[6, i]
             t = t_new
+            if peaks is not None:               # aux holds the diagnostics at t_new (stage 7)
+                for k in range(2):
+                    o, q = k * N_AUX_PLANE, k * N_PEAK
+                    peaks[q + P_FR] = max(peaks[q + P_FR], aux[o + A_FR])
+                    peaks[q + P_LOAD] = max(peaks[q + P_LOAD], aux[o + A_LOAD])
+                    peaks[q + P_QMAX] = max(peaks[q + P_QMAX], aux[o + A_QMAX])
             if not fixed:
                 # PI step control (Hairer & Wanner, DOPRI5: beta = 0.04) limits step rejections
                 fac = 10.0 if err == 0.0 else min(10.0, max(0.2, 0.9 * err ** -0.17 * err_old ** 0.04))

@@ -9,6 +9,7 @@ import numpy as np
 
 from .amb import weight_shares
 from .ball_bearing import max_contact_pressure, static_max_ball_load
+from .integrate import P_FR, P_LOAD, P_QMAX
 from .model import F_RB, PLANES, RB_SM
 from .results import AMB_PLANES, Result
 
@@ -20,6 +21,10 @@ ISO76_C0_PRESSURE = 4.2e9       # Pa: ISO 76's nominal contact pressure at C_0 (
 ALIAS_ANGLE = 0.75 * math.pi    # orbit turn between two samples beyond which the whirl may alias
 SAMPLES_PER_PERIOD = 10         # a sinusoid sampled n times a period shows >= cos(pi/n) of its
                                 # peak: 95 % at n = 10 (see min_output_rate)
+PEAK_TOLERANCE = 1.0 - math.cos(math.pi / SAMPLES_PER_PERIOD)   # the same 5 %, measured: a
+                                # sampled peak this far below the step-resolved one is missed
+STEP_PEAK_KEYS = {"peak_contact_force_N": P_FR, "peak_bearing_load_N": P_LOAD,
+                  "max_ball_load_N": P_QMAX}      # metrics key -> physics.integrate peak column
 
 
 def first_contact_time(result: Result) -> float | None:
@@ -181,7 +186,28 @@ def check_metrics(result: Result, m: dict) -> dict:
     need, source = min_output_rate(result, m["planes"])
     out.update(output_rate_hz=rate, min_output_rate_hz=need, min_output_rate_source=source,
                output_rate_too_coarse=rate < need)
+    out["step_resolved_peaks"] = step_resolved_peaks(result)
+    out["sampled_peaks_missed"] = sampled_peaks_missed(m["planes"], out["step_resolved_peaks"])
     return out
+
+
+def step_resolved_peaks(result: Result) -> dict | None:
+    """Per plane, the post-fault maxima the integrator saw at every accepted step
+    (``Result.step_peaks``): independent of ``solver.output_rate``."""
+    if result.step_peaks is None:
+        return None
+    return {p: {key: float(result.step_peaks[k, j]) for key, j in STEP_PEAK_KEYS.items()}
+            for k, p in enumerate(PLANES)}
+
+
+def sampled_peaks_missed(planes: dict, stepped: dict | None) -> list[dict]:
+    """The sampled post-fault peaks that fall more than ``PEAK_TOLERANCE`` below the
+    step-resolved ones (the output samples missed the peak of an impact)."""
+    if stepped is None:
+        return []
+    return [dict(plane=p, key=key, sampled=planes[p][key], step_resolved=v)
+            for p, peaks in stepped.items() for key, v in peaks.items()
+            if planes[p][key] is not None and planes[p][key] < (1.0 - PEAK_TOLERANCE) * v]
 
 
 def warnings_of(m: dict, scene) -> list[str]:
@@ -208,6 +234,11 @@ def warnings_of(m: dict, scene) -> list[str]:
                    f"{m['min_output_rate_hz']:.0f} Hz ({SAMPLES_PER_PERIOD} samples per "
                    f"{m['min_output_rate_source']}): peaks, first contact and whirl come from the "
                    "output samples and are under-resolved; raise solver.output_rate")
+    if m["sampled_peaks_missed"]:
+        miss = ", ".join(f"{d['plane']} {d['key']} {d['sampled']:.0f} (steps: {d['step_resolved']:.0f})"
+                         for d in m["sampled_peaks_missed"])
+        out.append(f"the output samples miss impact peaks by more than {PEAK_TOLERANCE:.0%}: {miss} "
+                   f"(step_resolved_peaks in metrics.json); raise solver.output_rate")
     for p, v in m["planes"].items():
         if v["whirl_sampling_aliased"]:
             out.append(f"{p}: the orbit turns more than {ALIAS_ANGLE / math.pi:g}π between output "

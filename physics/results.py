@@ -29,6 +29,9 @@ class Result:
     aux: np.ndarray                # (N, N_AUX) per-plane diagnostics
     stats: RunStats = field(default_factory=RunStats)
     t_fault: float | None = None   # time the AMBs switched off (None: never on)
+    # after the fault, per plane (RB1, RB2): the contact force, bearing load and largest ball load
+    # at every accepted integrator step (physics.integrate.P_*), whatever the output rate
+    step_peaks: np.ndarray | None = None
 
     # -- rotor ----------------------------------------------------------------------------
     def state(self, name: str) -> np.ndarray:

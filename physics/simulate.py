@@ -6,7 +6,7 @@ import time
 import numpy as np
 
 from .equilibrium import levitated_state
-from .integrate import NOT_FINITE, OK, STEP_COLLAPSE, TOO_MANY_STEPS, integrate_segment
+from .integrate import N_PEAK, NOT_FINITE, OK, STEP_COLLAPSE, TOO_MANY_STEPS, integrate_segment
 from .model import N_AUX, AMB_NONE, F_AMB, Model, build_model, diagnostics
 from .results import Result, RunStats
 from .scene import Scene, SceneError, param_meta
@@ -41,14 +41,16 @@ class Integrator:
         self.stats = RunStats()
         self._no_out = np.empty(0)
         self._no_Y = np.empty((0, model.n_state))
+        self.peaks = None          # optional (2 N_PEAK,) step-resolved maxima (integrate_segment)
 
     def advance(self, y, t0, t1, U, t_out=None, Y_out=None, pos=0) -> int:
         if t_out is None:
             t_out, Y_out = self._no_out, self._no_Y
         budget = self.max_steps - self.stats.steps
-        status, t, h, pos, n_rhs, n_steps, n_rej = integrate_segment(
-            y, t0, t1, self.model.P, self.model.I, U, self.rtol, self.atol, self.h, self.h_max,
-            self.h_min, self.fixed, budget, t_out, Y_out, pos, self.work)
+        args = (y, t0, t1, self.model.P, self.model.I, U, self.rtol, self.atol, self.h,
+                self.h_max, self.h_min, self.fixed, budget, t_out, Y_out, pos, self.work)
+        status, t, h, pos, n_rhs, n_steps, n_rej = (
+            integrate_segment(*args) if self.peaks is None else integrate_segment(*args, self.peaks))
         st = self.stats
         st.rhs_evaluations += n_rhs
         st.steps += n_steps
@@ -122,14 +124,17 @@ def segments(model: Model, t_end: float) -> list[tuple[float, float, bool]]:
 
 
 def run_segments(integ: Integrator, y: np.ndarray, t_end: float, t_out=None, Y=None,
-                 bar=None) -> None:
+                 bar=None, peaks=None) -> None:
     """Advance ``y`` from t = 0 to ``t_end`` through the AMB-powered/unpowered segments in
-    chunks of ``CHUNK_S`` (so a progress bar moves), filling ``Y`` at ``t_out[1:]`` if given.
+    chunks of ``CHUNK_S`` (so a progress bar moves), filling ``Y`` at ``t_out[1:]`` if given,
+    and the step-resolved maxima ``peaks[int(powered)]`` if given (row 0: AMBs off).
     The drop driver and the environments' fault state both use it, so they are bit-identical."""
     model = integ.model
     pos = 1
     for a, b, powered in segments(model, t_end):
         U = model.controls(powered)
+        if peaks is not None:
+            integ.peaks = peaks[int(powered)]
         edges = np.append(np.arange(a, b, CHUNK_S), b)
         for c0, c1 in zip(edges[:-1], edges[1:]):
             if c1 - c0 <= 0.0:
@@ -153,8 +158,9 @@ def simulate(scene: Scene, t_end: float | None = None, progress: bool = False) -
     Y[0] = y
     integ = Integrator(model)
     bar = _progress(progress, t_end, scene.name)
+    peaks = np.zeros((2, 2 * N_PEAK))
     wall0 = time.perf_counter()
-    run_segments(integ, y, t_end, t_out, Y, bar)
+    run_segments(integ, y, t_end, t_out, Y, bar, peaks)
     integ.stats.wall_time_s = time.perf_counter() - wall0
     integ.stats.compile_time_s = compile_s
     if bar is not None:
@@ -166,7 +172,8 @@ def simulate(scene: Scene, t_end: float | None = None, progress: bool = False) -
         diagnostics(t_out[sel], Y[sel], model.P, model.I, model.controls(powered), chunk)
         aux[sel] = chunk
     t_fault = next((a for a, _, powered in segments(model, t_end) if not powered), None)
-    return Result(model, t_out, Y, aux, integ.stats, t_fault)
+    return Result(model, t_out, Y, aux, integ.stats, t_fault,
+                  step_peaks=peaks[0].reshape(2, N_PEAK) if t_fault is not None else None)
 
 
 def output_times(model: Model) -> np.ndarray:

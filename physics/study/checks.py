@@ -19,6 +19,7 @@ WARNING_KINDS: dict[str, tuple[Callable[[dict], bool], str]] = {
     "pre_fault_contact": (lambda m: m["contact_before_fault"], "in contact before the fault"),
     "stator_contact": (lambda m: m["stator_contact"], "reaching the AMB stator"),
     "coarse_output": (lambda m: m["output_rate_too_coarse"], "with too coarse an output rate"),
+    "missed_peaks": (lambda m: bool(m["sampled_peaks_missed"]), "whose samples miss impact peaks"),
     "aliased_whirl": (lambda m: any(p["whirl_sampling_aliased"] for p in m["planes"].values()),
                       "with an aliased whirl"),
 }
