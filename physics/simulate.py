@@ -41,16 +41,16 @@ class Integrator:
         self.stats = RunStats()
         self._no_out = np.empty(0)
         self._no_Y = np.empty((0, model.n_state))
-        self.peaks = None          # optional (2 N_PEAK,) step-resolved maxima (integrate_segment)
 
-    def advance(self, y, t0, t1, U, t_out=None, Y_out=None, pos=0) -> int:
+    def advance(self, y, t0, t1, U, t_out=None, Y_out=None, pos=0, peaks=None) -> int:
+        """Integrate t0 -> t1 (``peaks``: optional (2 N_PEAK,) step-resolved maxima to update)."""
         if t_out is None:
             t_out, Y_out = self._no_out, self._no_Y
         budget = self.max_steps - self.stats.steps
         args = (y, t0, t1, self.model.P, self.model.I, U, self.rtol, self.atol, self.h,
                 self.h_max, self.h_min, self.fixed, budget, t_out, Y_out, pos, self.work)
         status, t, h, pos, n_rhs, n_steps, n_rej = (
-            integrate_segment(*args) if self.peaks is None else integrate_segment(*args, self.peaks))
+            integrate_segment(*args) if peaks is None else integrate_segment(*args, peaks))
         st = self.stats
         st.rhs_evaluations += n_rhs
         st.steps += n_steps
@@ -127,19 +127,18 @@ def run_segments(integ: Integrator, y: np.ndarray, t_end: float, t_out=None, Y=N
                  bar=None, peaks=None) -> None:
     """Advance ``y`` from t = 0 to ``t_end`` through the AMB-powered/unpowered segments in
     chunks of ``CHUNK_S`` (so a progress bar moves), filling ``Y`` at ``t_out[1:]`` if given,
-    and the step-resolved maxima ``peaks[int(powered)]`` if given (row 0: AMBs off).
+    and the step-resolved maxima after the fault into ``peaks`` if given.
     The drop driver and the environments' fault state both use it, so they are bit-identical."""
     model = integ.model
     pos = 1
     for a, b, powered in segments(model, t_end):
         U = model.controls(powered)
-        if peaks is not None:
-            integ.peaks = peaks[int(powered)]
+        seg_peaks = None if powered else peaks
         edges = np.append(np.arange(a, b, CHUNK_S), b)
         for c0, c1 in zip(edges[:-1], edges[1:]):
             if c1 - c0 <= 0.0:
                 continue
-            pos = integ.advance(y, c0, c1, U, t_out, Y, pos)
+            pos = integ.advance(y, c0, c1, U, t_out, Y, pos, seg_peaks)
             if bar is not None:
                 bar.update(c1 - c0)
 
@@ -158,7 +157,7 @@ def simulate(scene: Scene, t_end: float | None = None, progress: bool = False) -
     Y[0] = y
     integ = Integrator(model)
     bar = _progress(progress, t_end, scene.name)
-    peaks = np.zeros((2, 2 * N_PEAK))
+    peaks = np.zeros(2 * N_PEAK)
     wall0 = time.perf_counter()
     run_segments(integ, y, t_end, t_out, Y, bar, peaks)
     integ.stats.wall_time_s = time.perf_counter() - wall0
@@ -173,7 +172,7 @@ def simulate(scene: Scene, t_end: float | None = None, progress: bool = False) -
         aux[sel] = chunk
     t_fault = next((a for a, _, powered in segments(model, t_end) if not powered), None)
     return Result(model, t_out, Y, aux, integ.stats, t_fault,
-                  step_peaks=peaks[0].reshape(2, N_PEAK) if t_fault is not None else None)
+                  step_peaks=peaks.reshape(2, N_PEAK) if t_fault is not None else None)
 
 
 def output_times(model: Model) -> np.ndarray:

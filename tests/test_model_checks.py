@@ -59,7 +59,7 @@ def test_rating_pressure_line_is_where_s0_is_one():
     assert 4.37 < q * b.balls / C0 < 5.0
     p = rating_pressure(b)
     assert p == pytest.approx(max_contact_pressure(b, q))
-    assert p == pytest.approx(3.655e9, rel=1e-3)
+    assert p == pytest.approx(3.655e9, rel=1e-3)        # the figure docs/physics.md quotes
     levels = pressure_levels(b)
     assert levels["s0 = 1 (C0 = 40 kN): 3655 MPa"] == pytest.approx(p * 1e-6)
     assert levels["ISO 76 nominal C0 level 4200 MPa"] == 4200.0
