@@ -13,6 +13,7 @@ reaches a numba kernel: errors name the key and the allowed range.
 from __future__ import annotations
 
 import dataclasses
+import json
 import math
 import tomllib
 from dataclasses import dataclass, field, fields
@@ -253,6 +254,33 @@ class Scene:
     def flat(self) -> dict[str, Any]:
         return {key: value for key, value, _ in _leaves(self)}
 
+    def to_json(self) -> str:
+        """The scene as JSON: ``{"name": ..., group: {key: value}}`` (the ``dataclasses.asdict``
+        form, as in a Gymnasium ``env.spec.to_json()``); :meth:`from_json` gives the same scene."""
+        return json.dumps({"name": self.name, **self.to_dict()})
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any], name: str = "custom") -> "Scene":
+        """A scene from ``{"name": ..., group: {key: value}}`` (:meth:`to_dict`, :meth:`to_json`,
+        ``dataclasses.asdict``); groups and keys left out keep the defaults. Every value is
+        checked as a TOML value is."""
+        data = dict(data)
+        given = data.pop("name", name)
+        if not isinstance(given, str):
+            raise SceneError(f"scene name = {given!r} must be a string")
+        return dataclasses.replace(cls().with_overrides(_flatten(data, given)), name=given)
+
+    @classmethod
+    def from_json(cls, text: str) -> "Scene":
+        """The scene written by :meth:`to_json`."""
+        try:
+            data = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise SceneError(f"malformed scene JSON: {exc}") from None
+        if not isinstance(data, dict):
+            raise SceneError(f"scene JSON must be an object {{group: {{key: value}}}}, got {data!r}")
+        return cls.from_dict(data)
+
 
 # ---------------------------------------------------------------------------------------------
 # Presets, TOML and the public loading function
@@ -304,15 +332,20 @@ def scene_from_toml(text: str, name: str = "custom", base_dir: Path | None = Non
         raise SceneError(f"scene {name!r}: base = {base_name!r} must be a string: a preset name or"
                          " a TOML file path")
     base = _load_base(base_name, _chain, base_dir) if base_name else Scene()
+    scene = base.with_overrides(_flatten(data, name))
+    return dataclasses.replace(scene, name=name)
+
+
+def _flatten(data: Mapping[str, Any], name: str) -> dict[str, Any]:
+    """``{group: {key: value}}`` -> ``{"group.key": value}`` (a TOML file's or a JSON scene's)."""
     flat: dict[str, Any] = {}
     for group, vals in data.items():
-        if not isinstance(vals, dict):
+        if not isinstance(vals, Mapping):
             raise SceneError(f"scene {name!r}: top-level key {group!r} must be a table "
                              f"[{group}] (one of {', '.join(GROUPS)})")
         for k, v in vals.items():
             flat[f"{group}.{k}"] = v
-    scene = base.with_overrides(flat)
-    return dataclasses.replace(scene, name=name)
+    return flat
 
 
 def parse_assignment(text: str) -> tuple[str, str]:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 import numbers
 import operator
+from os import PathLike
 from typing import Mapping
 
 import gymnasium as gym
@@ -13,7 +14,7 @@ import numpy as np
 from physics.amb import static_weight_share
 from physics.metrics import WHIRL_MIN_REVOLUTIONS, WHIRL_RADIUS_FRACTION
 from physics.ball_bearing import max_contact_pressure
-from physics.model import F_RB, P_Z_RB1, RB_SM, axis_motion
+from physics.model import F_RB, I_CS, P_Z_RB1, RB_SM, S_W, axis_motion
 from physics.scene import Scene, SceneError, load_scene
 from physics.simulate import IntegrationError, _explain
 
@@ -26,6 +27,22 @@ from .scenario import (POWER_RETURN, POWER_RETURN_LIMITS, fault_state, resolve_r
 REWARD_TERMS = ("whirl", "contact", "displacement", "effort", "success", "failure")
 _O_TERMS = (K.O_R_WHIRL, K.O_R_CONTACT, K.O_R_DISP, K.O_R_EFFORT, K.O_R_SUCCESS, K.O_R_FAILURE)
 DEFAULT_POWER_RETURN = 0.05
+#: reward weight -> its slot in the kernel configuration: settable at any time, used from the
+#: next step on (``env.w_whirl = 5``, ``vec_env.set_attr("w_whirl", 5)``)
+WEIGHT_SLOTS = {"w_whirl": K.C_W_WHIRL, "w_contact": K.C_W_CONTACT, "w_displacement": K.C_W_DISP,
+                "w_effort": K.C_W_EFFORT, "w_success": K.C_W_SUCCESS, "w_failure": K.C_W_FAILURE}
+#: settings fixed at construction: assigning one raises (it would silently change nothing)
+FIXED_SETTINGS = frozenset(("control_dt", "dt", "episode_time", "n_steps", "randomize",
+                            "randomization", "ranges", "fixed_keys", "full_state", "command",
+                            "power_return_time", "samples_per_step", "relevitation_hold",
+                            "terminate_on_failure", "render_mode", "base_scene", "overrides",
+                            "obs_names", "obs_scale", "action_names", "weights"))
+
+
+def _weight(name: str, doc: str) -> property:
+    """A reward weight attribute: validated, written to the kernel, used from the next step."""
+    return property(lambda self: self.weights[name], lambda self, v: self._set_weight(name, v),
+                    doc=f"{doc} (settable: used from the next step)")
 
 
 class RotorDropEnv(gym.Env):
@@ -143,6 +160,33 @@ class RotorDropEnv(gym.Env):
         self._renderer = None
         self._scenario: dict = {}
         self._needs_reset = True
+        self._closed = False
+        self._ended = False                 # the episode has ended (until the next reset)
+        self._warned = False                # a step after the end was warned about
+        self._made = True                   # from here on FIXED_SETTINGS cannot be assigned
+
+    # ------------------------------------------------------------ attributes and weights --
+    def __setattr__(self, name: str, value) -> None:
+        if name in FIXED_SETTINGS and self.__dict__.get("_made"):
+            raise AttributeError(f"{name} is fixed when the environment is made; make a new one "
+                                 f"(gym.make(id, {name}=...)). Settable at any time: "
+                                 f"{', '.join(WEIGHT_SLOTS)}")
+        if name.startswith("w_") and name not in WEIGHT_SLOTS:
+            raise AttributeError(f"{name!r} is not a reward weight; the weights are "
+                                 f"{', '.join(WEIGHT_SLOTS)}")
+        super().__setattr__(name, value)
+
+    def _set_weight(self, name: str, value) -> None:
+        _positive(name, value, 0.0, 1e9)
+        self.weights[name] = float(value)
+        self._b.C[WEIGHT_SLOTS[name]] = value
+
+    w_whirl = _weight("w_whirl", "reward weight per backward orbit revolution")
+    w_contact = _weight("w_contact", "reward weight of the normalised contact force")
+    w_displacement = _weight("w_displacement", "reward weight of the normalised displacement")
+    w_effort = _weight("w_effort", "reward weight of the control effort")
+    w_success = _weight("w_success", "re-levitation bonus")
+    w_failure = _weight("w_failure", "penalty per remaining control step on termination")
 
     # ------------------------------------------------------------------------- set-up --
     def _check_options(self, command, power_return_time, render_mode):
@@ -162,10 +206,15 @@ class RotorDropEnv(gym.Env):
                              f"{self.metadata['render_modes']}")
 
     def _make_scene(self, scene, overrides) -> Scene:
+        if isinstance(scene, Mapping):          # Scene.to_dict / to_json form (a JSON env spec)
+            scene = Scene.from_dict(scene)
         if isinstance(scene, Scene):
             base = scene.with_overrides(overrides) if overrides else scene
-        else:
+        elif isinstance(scene, (str, PathLike)):
             base = load_scene(scene, overrides)
+        else:
+            raise ValueError(f"scene = {scene!r} must be a preset name, a TOML path, a "
+                             "physics.Scene or its dict (Scene.to_dict(), as in a JSON env spec)")
         forced = {}
         if self._damping:
             forced["effects.semi_active_damper"] = True
@@ -235,6 +284,7 @@ class RotorDropEnv(gym.Env):
 
     # ------------------------------------------------------------------------ episode --
     def reset(self, *, seed: int | None = None, options: dict | None = None):
+        self._check_open("reset")
         super().reset(seed=seed)
         values = sample(self.ranges, self.np_random, self.fixed_keys) if self.randomize else {}
         fixed = (options or {}).get("scenario") or {}
@@ -271,8 +321,10 @@ class RotorDropEnv(gym.Env):
         K.observe_now(b.y, b.P, b.I, b.U, b.C, b.M, b.work, b.aux, b.cur, b.scale, b.obs)
         self._scenario = self._scenario_report(values, pr is not None)
         self._needs_reset = False
+        self._ended = self._warned = False
         if self.render_mode is not None:            # record from the first step of the episode
-            self._ensure_renderer().reset()
+            self._ensure_renderer().reset(scene.contact.friction, scene.contact.clearance,
+                                          scene.amb.air_gap)
             self._record()
         return b.obs.astype(np.float32), {"scenario": dict(self._scenario), "time_s": 0.0}
 
@@ -287,25 +339,43 @@ class RotorDropEnv(gym.Env):
         return out
 
     def step(self, action):
-        if self._needs_reset:
-            raise gym.error.ResetNeeded("call reset() before step() (and after a batched VecEnv "
-                                        "took over this environment's arrays)")
+        if self._needs_reset or self._ended:
+            self._check_steppable()
         b = self._b
         self._load_action(action, b.act)
         K.step_one(*self._args)
         return self._finish(action)
 
+    def _check_open(self, what: str) -> None:
+        if self._closed:
+            raise gym.error.ClosedEnvironmentError(f"{what}() on a closed environment: make a "
+                                                   "new one (gym.make)")
+
+    def _check_steppable(self) -> None:
+        """Before a step that needs a look: closed (raise), not reset (raise), or after the
+        episode's end (warn once, as Gymnasium's own environments do; the step then runs)."""
+        self._check_open("step")
+        if self._needs_reset:
+            raise gym.error.ResetNeeded("call reset() before step() (and after a batched VecEnv "
+                                        "took over this environment's arrays)")
+        if not self._warned:
+            gym.logger.warn("You are calling 'step()' even though this environment has already "
+                            "returned terminated = True or truncated = True. You should always "
+                            "call 'reset()' once you receive 'terminated = True' or 'truncated = "
+                            "True' -- any further steps are undefined behavior.")
+            self._warned = True
+
     def _load_action(self, action, act: np.ndarray) -> None:
+        a = real_action(action, self.action_space, self.action_names)
         if self._discrete:
-            a = np.asarray(action)
-            if a.size != 1 or not np.issubdtype(a.dtype, np.number):
+            if a.size != 1:
                 raise ValueError(f"action {action!r} is not in {self.action_space}: give 0 or 1")
             act[0] = a.item()
             return
-        if np.shape(action) != self._act_shape:
-            raise ValueError(f"action {action!r} has shape {np.shape(action)}; "
+        if a.shape != self._act_shape:
+            raise ValueError(f"action {action!r} has shape {a.shape}; "
                              f"{self.action_space} needs {self._act_shape} ({', '.join(self.action_names)})")
-        act[:] = action
+        act[:] = a
 
     def _finish(self, action):
         """Turn the kernel's outputs into Gymnasium's (obs, reward, terminated, truncated, info)."""
@@ -317,6 +387,7 @@ class RotorDropEnv(gym.Env):
             raise IntegrationError(_explain(int(out[K.O_STATUS]), b.M[K.M_T], b.M[K.M_H], self.model))
         terminated = bool(out[K.O_TERM])
         truncated = bool(out[K.O_TRUNC])
+        self._ended |= terminated or truncated
         info = self._step_info(terminated or truncated)
         self._show_step()
         return b.obs.astype(np.float32), float(out[K.O_REWARD]), terminated, truncated, info
@@ -362,13 +433,18 @@ class RotorDropEnv(gym.Env):
 
     # ---------------------------------------------------------------------- rendering --
     def _record(self) -> None:
-        y, I, P = self._b.y, self._b.I, self._b.P
-        orbit = []
-        for k in range(2):
-            orbit += axis_motion(y, I, P[P_Z_RB1 + k])[:2]
-        self._renderer.add(self.time, orbit, float(self._b.out[K.O_FORCE]))
+        """One row of the episode view (``rotordrop_env.render.COLUMNS``)."""
+        b = self._b
+        y, I, P, M = b.y, b.I, b.P, b.M
+        x1, y1 = axis_motion(y, I, P[P_Z_RB1])[:2]
+        x2, y2 = axis_motion(y, I, P[P_Z_RB1 + 1])[:2]
+        damping = (y[I[I_CS]], y[I[I_CS] + 1]) if I[I_CS] >= 0 else (math.nan, math.nan)
+        amb = (M[K.M_POWER], M[K.M_CTRL_ON]) if self._relevitate else (math.nan, math.nan)
+        self._renderer.add((self.time, x1, y1, x2, y2, b.out[K.O_FORCE], y[I[S_W]], M[K.M_REV1],
+                            M[K.M_REV2], M[K.M_WHIRL], *damping, *amb))
 
     def render(self):
+        self._check_open("render")
         if self.render_mode is None:
             gym.logger.warn("render() called without a render_mode; pass render_mode='rgb_array' "
                             "or 'human' to gym.make")
@@ -378,13 +454,21 @@ class RotorDropEnv(gym.Env):
     def _ensure_renderer(self):
         if self._renderer is None:
             from .render import Renderer
-            self._renderer = Renderer(self.render_mode, self.scene, self.episode_time)
+            title = f"{self.spec.id if self.spec is not None else type(self).__name__}  ·  " \
+                    f"{self.base_scene.name} scene"
+            self._renderer = Renderer(self.render_mode, title, self.episode_time, self.n_steps,
+                                      self._damping, self._relevitate)
+            self._renderer.reset(self.scene.contact.friction, self.scene.contact.clearance,
+                                 self.scene.amb.air_gap)
         return self._renderer
 
     def close(self):
+        """Release the view; afterwards reset(), step() and render() raise
+        ``gymnasium.error.ClosedEnvironmentError`` (closing twice is fine)."""
         if self._renderer is not None:
             self._renderer.close()
             self._renderer = None
+        self._closed = self._needs_reset = True
 
     # ---------------------------------------------------------------------- helpers --
     @property
@@ -434,6 +518,16 @@ def step_infos(out: np.ndarray, M: np.ndarray, C: np.ndarray, relevitate: bool) 
     """:func:`step_info` of N environments from their (N, ...) kernel arrays."""
     return [step_info(o, m, tf, relevitate)
             for o, m, tf in zip(out.tolist(), M.tolist(), C[:, K.C_T_FAULT].tolist())]
+
+
+def real_action(action, space: gym.Space, names) -> np.ndarray:
+    """``action`` as an array of real numbers; a bool, complex, string or object action raises
+    ValueError naming the action space (numpy would cast it silently)."""
+    a = np.asarray(action)
+    if a.dtype.kind not in "fiu":
+        raise ValueError(f"action {action!r} ({a.dtype} values) is not in {space}: give real "
+                         f"numbers ({', '.join(names)})")
+    return a
 
 
 def _positive(name: str, value, lo: float, hi: float) -> None:

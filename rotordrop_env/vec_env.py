@@ -32,7 +32,7 @@ from stable_baselines3.common.vec_env.base_vec_env import VecEnv
 
 from . import kernels as K
 from .buffers import Buffers
-from .env import RotorDropEnv, peak_kpis, step_infos
+from .env import RotorDropEnv, peak_kpis, real_action, step_infos
 
 
 class BatchedRotorDropVecEnv(VecEnv):
@@ -88,9 +88,11 @@ class BatchedRotorDropVecEnv(VecEnv):
 
     def step_wait(self):
         if any(env._needs_reset for env in self.envs):
+            for env in self.envs:
+                env._check_open("step")
             raise gym.error.ResetNeeded("call reset() on the VecEnv before step()")
         act = self.stack.act
-        a = np.asarray(self.actions)
+        a = real_action(self.actions, self.action_space, self.envs[0].action_names)
         try:
             if self._discrete:
                 act[:, 0] = a.reshape(self.num_envs)
@@ -148,6 +150,9 @@ class BatchedRotorDropVecEnv(VecEnv):
         return [getattr(self.envs[i], attr_name) for i in self._get_indices(indices)]
 
     def set_attr(self, attr_name: str, value: Any, indices=None) -> None:
+        """As SB3's ``DummyVecEnv``: ``setattr`` on each environment. A reward weight
+        (``w_whirl``...) takes effect from the next step; a setting fixed at construction
+        (``control_dt``...) or an unknown ``w_*`` name raises AttributeError."""
         for i in self._get_indices(indices):
             setattr(self.envs[i], attr_name, value)
 
