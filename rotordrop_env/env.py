@@ -14,7 +14,7 @@ import numpy as np
 from physics.amb import static_weight_share
 from physics.metrics import WHIRL_MIN_REVOLUTIONS, WHIRL_RADIUS_FRACTION
 from physics.ball_bearing import max_contact_pressure
-from physics.model import F_RB, I_CS, P_Z_RB1, RB_SM, S_W, axis_motion
+from physics.model import F_RB, I_CS, P_Z_RB1, RB_SM, S_A, S_B, S_W, S_X, S_Y
 from physics.scene import Scene, SceneError, load_scene
 from physics.simulate import IntegrationError, _explain
 
@@ -27,6 +27,7 @@ from .scenario import (POWER_RETURN, POWER_RETURN_LIMITS, fault_state, resolve_r
 REWARD_TERMS = ("whirl", "contact", "displacement", "effort", "success", "failure")
 _O_TERMS = (K.O_R_WHIRL, K.O_R_CONTACT, K.O_R_DISP, K.O_R_EFFORT, K.O_R_SUCCESS, K.O_R_FAILURE)
 DEFAULT_POWER_RETURN = 0.05
+_AXIS = np.array([S_X, S_Y, S_A, S_B])     # the rotor's centre and tilt, for the episode view
 #: reward weight -> its slot in the kernel configuration: settable at any time, used from the
 #: next step on (``env.w_whirl = 5``, ``vec_env.set_attr("w_whirl", 5)``)
 WEIGHT_SLOTS = {"w_whirl": K.C_W_WHIRL, "w_contact": K.C_W_CONTACT, "w_displacement": K.C_W_DISP,
@@ -323,9 +324,8 @@ class RotorDropEnv(gym.Env):
         self._needs_reset = False
         self._ended = self._warned = False
         if self.render_mode is not None:            # record from the first step of the episode
-            self._ensure_renderer().reset(scene.contact.friction, scene.contact.clearance,
-                                          scene.amb.air_gap)
-            self._record()
+            self._reset_view()
+            self._record(step=False)
         return b.obs.astype(np.float32), {"scenario": dict(self._scenario), "time_s": 0.0}
 
     def _scenario_report(self, values: dict, power: bool) -> dict:
@@ -432,16 +432,17 @@ class RotorDropEnv(gym.Env):
                 "kpi_episode_time_s": self.time}
 
     # ---------------------------------------------------------------------- rendering --
-    def _record(self) -> None:
-        """One row of the episode view (``rotordrop_env.render.COLUMNS``)."""
+    def _record(self, step: bool = True) -> None:
+        """One row of the episode view (``rotordrop_env.render.COLUMNS``) and the orbit at the
+        step's monitor samples (at reset: the present state only)."""
         b = self._b
-        y, I, P, M = b.y, b.I, b.P, b.M
-        x1, y1 = axis_motion(y, I, P[P_Z_RB1])[:2]
-        x2, y2 = axis_motion(y, I, P[P_Z_RB1 + 1])[:2]
+        y, I, M = b.y, b.I, b.M
+        axis = I[_AXIS]                                 # x, y, a, b of the rotor
         damping = (y[I[I_CS]], y[I[I_CS] + 1]) if I[I_CS] >= 0 else (math.nan, math.nan)
         amb = (M[K.M_POWER], M[K.M_CTRL_ON]) if self._relevitate else (math.nan, math.nan)
-        self._renderer.add((self.time, x1, y1, x2, y2, b.out[K.O_FORCE], y[I[S_W]], M[K.M_REV1],
-                            M[K.M_REV2], M[K.M_WHIRL], *damping, *amb))
+        self._renderer.add((self.time, b.out[K.O_FORCE], y[I[S_W]], M[K.M_REV1], M[K.M_REV2],
+                            M[K.M_WHIRL], *damping, *amb),
+                           b.Y_sub[:, axis] if step else y[None, axis])
 
     def render(self):
         self._check_open("render")
@@ -457,10 +458,14 @@ class RotorDropEnv(gym.Env):
             title = f"{self.spec.id if self.spec is not None else type(self).__name__}  ·  " \
                     f"{self.base_scene.name} scene"
             self._renderer = Renderer(self.render_mode, title, self.episode_time, self.n_steps,
-                                      self._damping, self._relevitate)
-            self._renderer.reset(self.scene.contact.friction, self.scene.contact.clearance,
-                                 self.scene.amb.air_gap)
+                                      self._b.dims[3], self._damping, self._relevitate)
+            self._reset_view()
         return self._renderer
+
+    def _reset_view(self) -> None:
+        s, P = self.scene, self._b.P
+        self._ensure_renderer().reset(s.contact.friction, s.contact.clearance, s.amb.air_gap,
+                                      (P[P_Z_RB1], P[P_Z_RB1 + 1]))
 
     def close(self):
         """Release the view; afterwards reset(), step() and render() raise

@@ -18,10 +18,12 @@ from pathlib import Path
 
 import numpy as np
 
+from physics.rotor import axis_at
+
 #: one recorded row per control step (SI units, NaN where the environment lacks the quantity)
-COLUMNS = ("t", "x1", "y1", "x2", "y2", "force", "speed", "rev1", "rev2", "whirl",
-           "damping1", "damping2", "amb_power", "controller_on")
-(T, X1, Y1, X2, Y2, FORCE, SPEED, REV1, REV2, WHIRL, DAMP1, DAMP2, POWER, CTRL) = range(len(COLUMNS))
+COLUMNS = ("t", "force", "speed", "rev1", "rev2", "whirl", "damping1", "damping2", "amb_power",
+           "controller_on")
+(T, FORCE, SPEED, REV1, REV2, WHIRL, DAMP1, DAMP2, POWER, CTRL) = range(len(COLUMNS))
 
 WIDTH, HEIGHT = 768, 432                    # multiples of 16: MP4 encoders take them unscaled
 ORBIT = 248                                 # side of an orbit panel [px]
@@ -29,7 +31,7 @@ ORBIT_TOP = 58
 PANELS = (12, 12 + ORBIT + 14)              # left edge of the RB1 and RB2 orbit panels
 FORCE_BOX = (52, 338, WIDTH - 14, HEIGHT - 26)   # contact-force trace: left, top, right, bottom
 TEXT_X = PANELS[1] + ORBIT + 18
-TRAIL = 25                                  # most recent steps drawn bold
+TRAIL = 10                                  # most recent steps drawn bold
 
 #: the numbers beside the orbits (then "damping" and "AMB" where the environment has them)
 LABELS = ("friction μ", "rotor speed", "contact force", "  peak so far", "whirl", "  backward revs")
@@ -45,15 +47,21 @@ class Renderer:
     """Records the episode (``add`` per step) and draws it (``draw``)."""
 
     def __init__(self, mode: str, title: str, episode_time: float, n_steps: int,
-                 damping: bool = False, amb: bool = False):
+                 samples_per_step: int = 1, damping: bool = False, amb: bool = False):
         self.mode = mode
         self.title = title
         self.labels = LABELS + (("damping [kN s/m]",) if damping else ()) + (("AMB",) if amb else ())
         self.episode_time = episode_time
         self.rows = np.full((n_steps + 1, len(COLUMNS)), np.nan)
         self.n = 0
+        #: the rotor's centre and tilt (x, y, a, b: physics.model's state entries) at the
+        #: monitor samples, samples_per_step per step: the orbit at any axial station
+        self.orbit = np.full((n_steps * samples_per_step + 1, 4), np.nan)
+        self.n_orbit = 0
+        self.trail = TRAIL * samples_per_step
         self.friction = math.nan
         self.geometry = (0.0, 0.0)          # (clearance, air gap) [m] of this episode
+        self.planes = (0.0, 0.0)            # axial stations of the retainer bearings [m]
         self._cache: dict = {}              # fonts, background, human window: never copied
 
     def __getstate__(self) -> dict:
@@ -62,19 +70,27 @@ class Renderer:
         return state
 
     # ------------------------------------------------------------------------ recording --
-    def reset(self, friction: float, clearance: float, air_gap: float) -> None:
-        """Start a new episode view (μ and the circles of this episode's scene)."""
-        self.n = 0
+    def reset(self, friction: float, clearance: float, air_gap: float,
+              planes: tuple[float, float]) -> None:
+        """Start a new episode view (μ, the circles and the retainer planes of the scene)."""
+        self.n = self.n_orbit = 0
         self.rows[:] = np.nan
+        self.orbit[:] = np.nan
         self.friction = float(friction)
         self.geometry = (float(clearance), float(air_gap))
+        self.planes = (float(planes[0]), float(planes[1]))
 
-    def add(self, row) -> None:
-        """One step's values in :data:`COLUMNS` order."""
+    def add(self, row, orbit: np.ndarray) -> None:
+        """One step's values in :data:`COLUMNS` order, and the rotor's (x, y, a, b) at the
+        step's monitor samples ((k, 4))."""
         if self.n == self.rows.shape[0]:    # stepping on after the episode's end
-            self.rows = np.concatenate([self.rows, np.full_like(self.rows, np.nan)])
+            self.rows = _grow(self.rows)
+        while self.n_orbit + len(orbit) > self.orbit.shape[0]:
+            self.orbit = _grow(self.orbit)
         self.rows[self.n] = row
         self.n += 1
+        self.orbit[self.n_orbit:self.n_orbit + len(orbit)] = orbit
+        self.n_orbit += len(orbit)
 
     @property
     def recorded(self) -> np.ndarray:
@@ -96,7 +112,7 @@ class Renderer:
         d = ImageDraw.Draw(img)
         rows = self.recorded
         if len(rows):
-            self._orbits(d, rows)
+            self._orbits(d, self.orbit[:self.n_orbit])
             self._force(img, d, rows)
         self._labels(img, rows[-1] if len(rows) else np.full(len(COLUMNS), np.nan))
         return np.asarray(img)
@@ -152,20 +168,22 @@ class Renderer:
         """Pixels per metre: the stator circle fills the panel with a small margin."""
         return 0.5 * ORBIT / (1.08 * max(self.geometry[1], self.geometry[0], 1e-9))
 
-    def _orbits(self, d, rows: np.ndarray) -> None:
+    def _orbits(self, d, orbit: np.ndarray) -> None:
         scale = self._orbit_scale()
         cy = ORBIT_TOP + ORBIT / 2
+        n, trail = len(orbit), self.trail
         for k, left in enumerate(PANELS):
             cx = left + ORBIT / 2
-            pts = np.empty((len(rows), 2))
-            pts[:, 0] = cx + rows[:, X1 + 2 * k] * scale
-            pts[:, 1] = cy - rows[:, Y1 + 2 * k] * scale
+            x, y = axis_at.py_func(self.planes[k], *orbit.T)
+            pts = np.empty((n, 2))
+            pts[:, 0] = cx + x * scale
+            pts[:, 1] = cy - y * scale
             np.clip(pts[:, 0], left, left + ORBIT, out=pts[:, 0])     # stay in the panel
             np.clip(pts[:, 1], ORBIT_TOP, ORBIT_TOP + ORBIT, out=pts[:, 1])
             flat = pts.ravel().tolist()
-            if len(rows) > TRAIL:
-                d.line(flat[:2 * (len(rows) - TRAIL + 1)], fill=PALE[k], width=1)
-            recent = flat[-2 * TRAIL:]
+            if n > trail:
+                d.line(flat[:2 * (n - trail + 1)], fill=PALE[k], width=1)
+            recent = flat[-2 * trail:]
             if len(recent) >= 4:
                 d.line(recent, fill=PLANE_COLOURS[k], width=2)
             x, y = flat[-2:]
@@ -284,6 +302,10 @@ def _force_text(force: float) -> str:
     if not math.isfinite(force):
         return "–"
     return f"{force * 1e-3:.2f} kN" if force >= 1000.0 else f"{force:.0f} N"
+
+
+def _grow(a: np.ndarray) -> np.ndarray:
+    return np.concatenate([a, np.full_like(a, np.nan)])
 
 
 def _axis_text(force: float) -> str:

@@ -49,7 +49,8 @@ def test_a_frame_shows_orbits_at_both_planes_and_the_whirl_state(friction, whirl
     assert img.shape == (R.HEIGHT, R.WIDTH, 3) and img.dtype == np.uint8
     for k, left in enumerate(R.PANELS):                             # each plane's orbit, own colour
         box = (left, R.ORBIT_TOP, left + R.ORBIT, R.ORBIT_TOP + R.ORBIT)
-        assert _pixels(img, box, R.PLANE_COLOURS[k]) > 100
+        assert _pixels(img, box, R.PLANE_COLOURS[k]) > 40             # recent trace and dot
+        assert _pixels(img, box, R.PALE[k], 20) > 100                   # the trace since the fault
         assert _pixels(img, box, R.PLANE_COLOURS[1 - k]) == 0
     state = _value_box(R.LABELS.index("whirl"))
     assert (_pixels(img, state, R.RED) > 20) is whirl
