@@ -102,6 +102,7 @@ class RotorDropEnv(gym.Env):
     """
 
     metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 30}
+    fixed_settings = FIXED_SETTINGS
     _damping = False
     _relevitate = False
 

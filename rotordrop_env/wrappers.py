@@ -20,9 +20,10 @@ class EpisodeKPIs(gym.Wrapper, gym.utils.RecordConstructorArgs):
         gym.Wrapper.__init__(self, env)
 
     def __setattr__(self, name: str, value) -> None:
-        from .env import FIXED_SETTINGS
-        if name.startswith("w_") or name in FIXED_SETTINGS:
-            setattr(self.env.unwrapped, name, value)    # validated there (or refused)
+        env = self.__dict__.get("env")
+        if env is not None and (name.startswith("w_") or
+                                name in getattr(env.unwrapped, "fixed_settings", ())):
+            setattr(env.unwrapped, name, value)     # validated there (or refused)
         else:
             super().__setattr__(name, value)
 
