@@ -59,6 +59,9 @@ class Controller:
     needs: tuple[str, ...] = ()
     #: reads the sensor observations (``agents.plant.SENSORS``), absent with full_state=True
     sensors: bool = True
+    #: the action is a function of the present observation alone (no per-episode state, every
+    #: damper channel set): a residual policy on it runs under plain SB3 (agents.sb3_policy)
+    memoryless: bool = False
 
     def __init__(self, plant: Plant):
         if self.sensors:
@@ -168,6 +171,7 @@ class MaxDamping(Controller):
     name = "max-damping"
     needs = ("damping",)
     sensors = False
+    memoryless = True
 
     def commands(self, obs):
         return {"damping": np.ones((len(obs), 2))}
@@ -303,6 +307,7 @@ class WhirlBrake(Controller):
 
     name = "whirl-brake"
     needs = ("currents",)
+    memoryless = True
     GAINS = dict(kp=0.86, kd=4.88, kc=2.47, kt=0.44, kr=0.21, ff=1.10, r_on=0.5)
 
     def __init__(self, plant: Plant, **gains):

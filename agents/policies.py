@@ -5,6 +5,10 @@ A learned policy is a directory written by ``rotordrop train`` (``model.zip``,
 ``vecnormalize.pkl``), a model zip with those files next to it, or a policy
 shipped in ``agents/policies/`` (``<name>.zip``, ``<name>.pkl``, ``<name>.json``; the name
 starts with the algorithm: ``ppo-damping``). It answers ``predict`` like a controller.
+
+A self-contained zip (:mod:`agents.sb3_policy`: what ``rotordrop train`` writes as ``model.zip``
+and ``best/best_model.zip``, and what ships) carries its normalisation and residual itself: it
+is run as it is, and the statistics next to it are not applied a second time.
 """
 from __future__ import annotations
 
@@ -21,6 +25,7 @@ from .controllers import BASELINES, controller_class, make_baseline, make_contro
 from .plant import Plant
 from .hyperparams import ALGOS as ALGO_NAMES, algo_class, parse_literal
 from .residual import RESIDUAL_SCALE, residual_action
+from .sb3_policy import export_self_contained, is_self_contained
 from .score import write_json
 
 
@@ -55,15 +60,21 @@ class LearnedPolicy:
             self.base = make_baseline(self.residual, plant)
         return self
 
+    @property
+    def self_contained(self) -> bool:
+        return is_self_contained(self.model)
+
     def predict(self, observation, state=None, episode_start=None, deterministic: bool = True):
+        if self.residual is not None and self.base is None:
+            raise RuntimeError(f"{self.name} corrects the {self.residual} controller: call "
+                               f".bound(Plant.from_env(env)) before predict")
+        if self.self_contained:                 # normalisation, network, residual: one path
+            return self.model.policy.act(observation, state, episode_start, deterministic, self.base)
         raw = np.asarray(observation, dtype=np.float32)
         obs = self.vecnormalize.normalize_obs(raw) if self.vecnormalize is not None else raw
         action, state = self.model.predict(obs, state=state, episode_start=episode_start,
                                            deterministic=deterministic)
         if self.residual is not None:
-            if self.base is None:
-                raise RuntimeError(f"{self.name} corrects the {self.residual} controller: call "
-                                   f".bound(Plant.from_env(env)) before predict")
             action = residual_action(self.base, raw, action, self.residual_scale, episode_start)
         return action, state
 
@@ -103,9 +114,14 @@ class LearnedPolicy:
                                     f"no config.yaml or .json next to it")
         hp = meta.get("hyperparams", {})
         env_kwargs = dict(meta.get("env_kwargs") or hp.get("env_kwargs") or {})
-        vn = _load_stats(model_path, vn_paths, hp.get("normalize", False))
         model = algo_class(algo).load(str(model_path), device="cpu")
         task = env_id.split("-")[1].lower() if env_id.count("-") >= 2 else "policy"
+        if is_self_contained(model):        # normalisation and residual are inside the zip
+            inside = model.policy.rotordrop
+            return cls(name or meta.get("name") or f"{algo}-{task}", algo, env_id, env_kwargs,
+                       model, None, meta, inside.get("residual"),
+                       float(inside.get("residual_scale") or RESIDUAL_SCALE))
+        vn = _load_stats(model_path, vn_paths, hp.get("normalize", False))
         residual = hp.get("residual")
         scale = float(hp.get("residual_scale") or RESIDUAL_SCALE)
         return cls(name or meta.get("name") or f"{algo}-{task}", algo, env_id, env_kwargs, model,
@@ -184,9 +200,28 @@ def resolve(spec: str, plant: Plant | None = None):
                    f"a controller class (package.module:Class, file.py:Class)")
 
 
+def export_policy(source: str | Path, out: str | Path) -> Path:
+    """``rotordrop export-policy``: the policy at ``source`` (a run directory, its ``best/``, a
+    checkpoint or model zip with its statistics next to it, or a shipped name) as one
+    self-contained zip (:func:`agents.sb3_policy.export_self_contained`) at ``out``."""
+    pol = load_shipped(str(source)) if str(source) in shipped_names() else LearnedPolicy.load(source)
+    return export_learned(pol, out)
+
+
+def export_learned(pol: LearnedPolicy, out: str | Path) -> Path:
+    """A loaded :class:`LearnedPolicy` as a self-contained zip (see :func:`export_policy`)."""
+    if pol.self_contained:
+        pol.model.save(out)
+        return Path(out).with_suffix(".zip")
+    return export_self_contained(pol.model, pol.vecnormalize, out, env_id=pol.env_id,
+                                 env_kwargs=pol.env_kwargs, residual=pol.residual,
+                                 residual_scale=pol.residual_scale)
+
+
 def ship_policy(run_dir: str | Path, name: str, which: str = "final", dest: Path | None = None,
                 notes: str = "", command: str | None = None) -> Path:
-    """Copy a training run's model and statistics into ``agents/policies/<name>.*``.
+    """Export a training run's model (self-contained, :func:`export_policy`) and copy its
+    statistics into ``agents/policies/<name>.*``.
 
     ``which`` = ``final`` (``model.zip``) or ``best`` (``best/best_model.zip``). The JSON records
     the command and seed that reproduce the run (``command`` overrides the recorded one, e.g.
@@ -203,7 +238,7 @@ def ship_policy(run_dir: str | Path, name: str, which: str = "final", dest: Path
     model, vn = ((run / "model.zip", run / "vecnormalize.pkl") if which == "final"
                  else (run / "best" / "best_model.zip", run / "best" / "vecnormalize.pkl"))
     info = json.loads((run / "training.json").read_text())
-    shutil.copyfile(model, dest / f"{name}.zip")
+    export_policy(model, dest / f"{name}.zip")            # runs under plain SB3 as it is
     shutil.copyfile(vn, dest / f"{name}.pkl")
     curve = info.get("learning_curve", [])
     summary = [{k: (round(v, 4) if isinstance(v, float) else v) for k, v in h.items()

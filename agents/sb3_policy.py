@@ -1,0 +1,187 @@
+"""Self-contained policy zips: plain ``PPO.load`` / ``SAC.load`` / ``TD3.load`` act like the
+project's loader.
+
+A policy trained by ``rotordrop train`` needs two things besides its network: the observation
+normalisation (``VecNormalize`` statistics) and, for a residual policy (config ``residual:``),
+the baseline controller whose action it corrects. :func:`export_self_contained` writes a zip
+whose policy class (one of :data:`POLICY_CLASSES`, subclasses of SB3's own) carries both:
+
+* the statistics as buffers of the policy's ``state_dict`` (``obs_mean``, ``obs_var``), applied
+  in ``predict`` exactly as ``VecNormalize.normalize_obs`` does (float64, clipped, to float32);
+* the residual's baseline by name and scale, applied in ``predict`` as
+  :func:`agents.residual.residual_action` does, on a :class:`~agents.plant.Plant` of the
+  training environment (``env_id`` and ``env_kwargs`` in the zip).
+
+SB3 saves the policy class by reference, so loading the zip imports this module (the
+``rotordrop`` package must be installed). A baseline that keeps per-episode state
+(``Controller.memoryless`` False) cannot be rebuilt from single observations: the zip then
+refuses ``predict`` under plain SB3, with a message that says how to load it.
+
+The exported policy is for acting (``predict``); to continue training, resume the run from its
+checkpoints (``rotordrop train --resume``).
+"""
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch as th
+from stable_baselines3.common.policies import ActorCriticPolicy
+from stable_baselines3.sac.policies import SACPolicy
+from stable_baselines3.td3.policies import TD3Policy
+
+#: the ``policy_kwargs`` entry that carries the environment, normalisation and residual
+KEY = "rotordrop"
+
+
+class SelfContained:
+    """Mixin of the exported policy classes (see the module docstring).
+
+    ``rotordrop`` (a ``policy_kwargs`` entry): ``env_id``, ``env_kwargs``, ``normalize``
+    (``{"epsilon", "clip_obs"}`` or None), ``residual`` (baseline name or None),
+    ``residual_scale``, ``memoryless`` (the baseline keeps no per-episode state).
+    """
+
+    def _setup_rotordrop(self, meta: dict[str, Any] | None) -> None:
+        self.rotordrop = dict(meta or {})
+        n = int(np.prod(self.observation_space.shape))
+        self.register_buffer("obs_mean", th.zeros(n, dtype=th.float64))
+        self.register_buffer("obs_var", th.ones(n, dtype=th.float64))
+        self._base = None
+
+    # ------------------------------------------------------------------------ acting --
+    def normalize_obs(self, raw: np.ndarray) -> np.ndarray:
+        """``VecNormalize.normalize_obs`` of the training run, from the buffers."""
+        norm = self.rotordrop.get("normalize")
+        if not norm:
+            return raw
+        mean, var = self.obs_mean.cpu().numpy(), self.obs_var.cpu().numpy()
+        clip = norm["clip_obs"]
+        return np.clip((raw - mean) / np.sqrt(var + norm["epsilon"]), -clip, clip).astype(np.float32)
+
+    def network_predict(self, observation, state=None, episode_start=None, deterministic=False):
+        """SB3's own ``predict`` of the network (normalised observations in, its actions out)."""
+        return super().predict(observation, state, episode_start, deterministic)
+
+    def act(self, observation, state, episode_start, deterministic: bool, base):
+        """Raw environment observations in, environment actions out: normalisation, network,
+        then the residual on ``base`` (a baseline controller, or None without a residual)."""
+        raw = np.asarray(observation, dtype=np.float32)
+        action, state = self.network_predict(self.normalize_obs(raw), state, episode_start,
+                                             deterministic)
+        if base is not None:
+            from .residual import residual_action
+            action = residual_action(base, raw, action, float(self.rotordrop["residual_scale"]),
+                                     episode_start)
+        return action, state
+
+    def predict(self, observation, state=None, episode_start=None, deterministic=False):
+        """SB3's ``predict`` as ``rotordrop evaluate`` runs the policy (:meth:`act`); the
+        residual's baseline is built for the training environment on first use."""
+        residual = self.rotordrop.get("residual")
+        if residual and not self.rotordrop.get("memoryless"):
+            raise RuntimeError(
+                f"this policy corrects the {residual!r} controller, which keeps per-episode state "
+                "that single observations do not carry, so plain SB3 cannot run it; load it with "
+                "agents.policies.LearnedPolicy.load(path).bound(Plant.from_env(env)), or run "
+                "`rotordrop evaluate --policy path`")
+        return self.act(observation, state, episode_start, deterministic,
+                        self.training_base() if residual else None)
+
+    def training_base(self):
+        """The residual's baseline on the training environment (``env_id``, ``env_kwargs``)."""
+        if self._base is None:
+            from .controllers import make_baseline
+            from .plant import plant_of
+            self._base = make_baseline(self.rotordrop["residual"],
+                                       plant_of(self.rotordrop["env_id"],
+                                                **self.rotordrop.get("env_kwargs", {})))
+        return self._base
+
+
+class RotorDropActorCriticPolicy(SelfContained, ActorCriticPolicy):
+    """PPO's ``MlpPolicy`` with the normalisation and residual inside (see module docstring)."""
+
+    def __init__(self, *args, rotordrop: dict | None = None, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._setup_rotordrop(rotordrop)
+
+
+class RotorDropSACPolicy(SelfContained, SACPolicy):
+    """SAC's ``MlpPolicy`` with the normalisation and residual inside."""
+
+    def __init__(self, *args, rotordrop: dict | None = None, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._setup_rotordrop(rotordrop)
+
+
+class RotorDropTD3Policy(SelfContained, TD3Policy):
+    """TD3's ``MlpPolicy`` with the normalisation and residual inside."""
+
+    def __init__(self, *args, rotordrop: dict | None = None, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._setup_rotordrop(rotordrop)
+
+
+#: SB3 policy class -> its self-contained subclass
+POLICY_CLASSES = {ActorCriticPolicy: RotorDropActorCriticPolicy, SACPolicy: RotorDropSACPolicy,
+                  TD3Policy: RotorDropTD3Policy}
+
+
+def _exported_class(policy) -> type:
+    for base, cls in POLICY_CLASSES.items():
+        if type(policy) in (base, cls):
+            return cls
+    raise ValueError(f"cannot export a {type(policy).__name__}: only the MlpPolicy of PPO, SAC "
+                     "and TD3 is supported")
+
+
+def export_self_contained(model, vecnormalize, out_path: str | Path, *, env_id: str,
+                          env_kwargs: dict | None = None, residual: str | None = None,
+                          residual_scale: float | None = None) -> Path:
+    """Write ``model`` (a PPO / SAC / TD3 with an ``MlpPolicy``) as a zip that plain SB3 loads
+    and runs like the project's loader: ``vecnormalize`` (a ``VecNormalize`` or None) and the
+    ``residual`` baseline (name, ``residual_scale``) go inside the policy. ``env_id`` and
+    ``env_kwargs`` name the training environment (the residual's plant). The model passed in
+    is left as it was."""
+    from .controllers import BASELINES
+    from .residual import RESIDUAL_SCALE
+    cls = _exported_class(model.policy)
+    if residual is not None and residual not in BASELINES:
+        raise ValueError(f"residual = {residual!r} is not a baseline ({', '.join(BASELINES)})")
+    norm = None
+    if vecnormalize is not None and vecnormalize.norm_obs:
+        norm = {"epsilon": float(vecnormalize.epsilon), "clip_obs": float(vecnormalize.clip_obs)}
+    meta = dict(env_id=env_id, env_kwargs=copy.deepcopy(dict(env_kwargs or {})), normalize=norm,
+                residual=residual,
+                residual_scale=float(RESIDUAL_SCALE if residual_scale is None else residual_scale),
+                memoryless=bool(residual is None or BASELINES[residual].memoryless))
+    kwargs = {k: v for k, v in model.policy_kwargs.items() if k != KEY}
+    policy = cls(model.observation_space, model.action_space, model.lr_schedule,
+                 **kwargs, **{KEY: meta}).to(model.device)
+    missing, unexpected = policy.load_state_dict(model.policy.state_dict(), strict=False)
+    if set(missing) - {"obs_mean", "obs_var"} or unexpected:
+        raise ValueError(f"cannot export: state_dict mismatch (missing {missing}, unexpected {unexpected})")
+    if norm is not None:
+        policy.obs_mean.copy_(th.as_tensor(vecnormalize.obs_rms.mean, dtype=th.float64))
+        policy.obs_var.copy_(th.as_tensor(vecnormalize.obs_rms.var, dtype=th.float64))
+    if hasattr(model.policy, "optimizer"):
+        policy.optimizer.load_state_dict(model.policy.optimizer.state_dict())
+    out_path = Path(out_path)
+    out_path.parent.mkdir(parents=True, exist_ok=True)
+    saved = {k: getattr(model, k) for k in ("policy", "policy_class", "policy_kwargs")}
+    try:
+        model.policy, model.policy_class = policy, cls
+        model.policy_kwargs = {**kwargs, KEY: meta}
+        model.save(out_path)
+    finally:
+        for k, v in saved.items():
+            setattr(model, k, v)
+    return out_path if out_path.suffix == ".zip" else out_path.with_suffix(".zip")
+
+
+def is_self_contained(model) -> bool:
+    """The model's policy applies its own normalisation and residual (an exported zip)."""
+    return isinstance(model.policy, SelfContained)
