@@ -103,8 +103,8 @@ class Plant:
         u = env.unwrapped if hasattr(env, "unwrapped") else env
         while hasattr(u, "venv") and not hasattr(u, "envs"):      # SB3 VecEnv wrappers
             u = u.venv
-        if hasattr(u, "envs") and not hasattr(u, "obs_names"):     # batched VecEnv
-            u = u.envs[0]
+        if hasattr(u, "envs") and not hasattr(u, "obs_names"):     # batched or DummyVecEnv
+            u = u.envs[0].unwrapped
         from physics.model import P_AMB_IFF1, P_AMB_IFF2
         s = u.base_scene
         P = u.model.P              # gravity feed-forward currents: 0 without actuator AMBs

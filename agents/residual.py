@@ -9,6 +9,7 @@ policy (a ≈ 0) is the baseline controller and learning changes it only where t
 from __future__ import annotations
 
 import numpy as np
+from stable_baselines3.common.vec_env import VecEnvWrapper
 
 RESIDUAL_SCALE = 2.0
 
@@ -21,34 +22,37 @@ def residual_action(base, raw_obs: np.ndarray, a: np.ndarray, scale: float,
     return np.clip(b + scale * np.asarray(a), -1.0, 1.0).astype(np.float32)
 
 
-def make_residual(venv, base: str, scale: float = RESIDUAL_SCALE):
-    """Residual actions (config key ``residual: <baseline>``) on an SB3 VecEnv: see
-    :func:`residual_action`. A freshly initialised policy (a ≈ 0) reproduces the baseline;
+class ResidualAction(VecEnvWrapper):
+    """Residual actions on an SB3 VecEnv (config key ``residual: <baseline>``; in an rl-zoo3
+    config ``vec_env_wrapper: [{agents.residual.ResidualAction: {base: NAME, scale: S}}]``):
+    see :func:`residual_action`. A freshly initialised policy (a ≈ 0) reproduces the baseline;
     learning changes it only where that pays (residual policy learning, Johannink et al.
-    2019). Box action spaces only."""
-    from stable_baselines3.common.vec_env import VecEnvWrapper
+    2019). Box action spaces only. Works on the batched VecEnv and on SB3's DummyVecEnv of
+    ``gym.make`` environments (rl-zoo3's default)."""
 
-    from .controllers import make_baseline
-    from .plant import Plant
+    def __init__(self, venv, base: str, scale: float = RESIDUAL_SCALE):
+        from .controllers import make_baseline
+        from .plant import Plant
+        super().__init__(venv)
+        self.base_name, self.scale = base, float(scale)
+        self.base = make_baseline(base, Plant.from_env(venv))
+        self.obs = None
+        self.starts = np.ones(self.num_envs, dtype=bool)
 
-    class ResidualAction(VecEnvWrapper):
-        def __init__(self, venv):
-            super().__init__(venv)
-            self.base = make_baseline(base, Plant.from_env(venv))
-            self.obs = None
-            self.starts = np.ones(self.num_envs, dtype=bool)
+    def reset(self):
+        self.obs = self.venv.reset()
+        self.starts[:] = True
+        return self.obs
 
-        def reset(self):
-            self.obs = self.venv.reset()
-            self.starts[:] = True
-            return self.obs
+    def step_async(self, actions):
+        self.venv.step_async(residual_action(self.base, self.obs, actions, self.scale, self.starts))
 
-        def step_async(self, actions):
-            self.venv.step_async(residual_action(self.base, self.obs, actions, scale, self.starts))
+    def step_wait(self):
+        obs, rewards, dones, infos = self.venv.step_wait()
+        self.obs, self.starts = obs, np.asarray(dones, dtype=bool)
+        return obs, rewards, dones, infos
 
-        def step_wait(self):
-            obs, rewards, dones, infos = self.venv.step_wait()
-            self.obs, self.starts = obs, np.asarray(dones, dtype=bool)
-            return obs, rewards, dones, infos
 
-    return ResidualAction(venv)
+def make_residual(venv, base: str, scale: float = RESIDUAL_SCALE) -> ResidualAction:
+    """:class:`ResidualAction` around ``venv``."""
+    return ResidualAction(venv, base, scale)

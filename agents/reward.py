@@ -22,6 +22,7 @@ so that the episode's return also holds the score's ``(1 − R) + T_R / T_episod
 from __future__ import annotations
 
 import numpy as np
+from stable_baselines3.common.vec_env import VecEnvWrapper
 
 from physics.metrics import WHIRL_MIN_REVOLUTIONS
 
@@ -51,39 +52,51 @@ def kpi_potential(revs, force_N, disp_um, w_whirl: float, w_force: float, w_disp
             + w_force * np.asarray(force_N) / force_ref + w_disp * np.asarray(disp_um) / disp_ref_um)
 
 
-def make_kpi_reward(venv, **kwargs):
-    """Wrap an SB3 VecEnv of rotor-drop environments (see module docstring)."""
-    from stable_baselines3.common.vec_env import VecEnvWrapper
+class KpiReward(VecEnvWrapper):
+    """The KPI-aligned reward (see module docstring) on an SB3 VecEnv of rotor-drop
+    environments: the batched VecEnv (config ``reward: kpi``) or SB3's DummyVecEnv /
+    SubprocVecEnv of ``gym.make`` environments (rl-zoo3: ``vec_env_wrapper:
+    agents.reward.KpiReward``, weights as its keyword arguments)."""
 
-    class KpiReward(VecEnvWrapper):
-        def __init__(self, venv, **weights):
-            super().__init__(venv)
-            check_reward_kwargs(weights)
-            w = {**WEIGHTS, **weights}
-            self.w_relevitate = w.pop("w_relevitate")
-            dt, horizon = (np.asarray(venv.get_attr(a), dtype=float) for a in ("dt", "episode_time"))
-            self.time_cost = w.pop("w_time") * dt / horizon
-            self.w = w
-            self.phi = np.zeros(self.num_envs)
+    def __init__(self, venv, **weights):
+        super().__init__(venv)
+        check_reward_kwargs(weights)
+        w = {**WEIGHTS, **weights}
+        self.w_relevitate = w.pop("w_relevitate")
+        dt, horizon = (np.asarray(venv.get_attr(a), dtype=float) for a in ("dt", "episode_time"))
+        self.time_cost = w.pop("w_time") * dt / horizon
+        self.w = w
+        self.phi = np.zeros(self.num_envs)
 
-        def reset(self):
-            obs = self.venv.reset()
-            self.phi[:] = 0.0
-            return obs
+    def reset(self):
+        obs = self.venv.reset()
+        self.phi[:] = 0.0
+        return obs
 
-        def step_wait(self):
-            obs, _, dones, infos = self.venv.step_wait()
-            peaks = self.venv.unwrapped.running_kpis()
-            for i in np.flatnonzero(dones):                # a done env is already reset
-                for key in PEAK_KEYS:
-                    peaks[key][i] = infos[i][key]
-            phi = kpi_potential(*(peaks[key] for key in PEAK_KEYS), **self.w)
-            rewards = self.phi - phi
-            if "relevitated" in infos[0]:
-                success = np.array([i.get("reward_success", 0.0) > 0.0 for i in infos])
-                pending = np.array([not i["relevitated"] for i in infos]) & ~success
-                rewards += self.w_relevitate * success - self.time_cost * pending
-            self.phi = np.where(dones, 0.0, phi)
-            return obs, rewards.astype(np.float32), dones, infos
+    def running_kpis(self) -> dict[str, np.ndarray]:
+        """Every environment's running-maximum KPIs (the batched VecEnv has them as arrays)."""
+        base = self.venv.unwrapped
+        if hasattr(base, "running_kpis"):
+            return base.running_kpis()
+        kpis = self.venv.env_method("kpis")
+        return {k: np.array([d[k] for d in kpis], dtype=float) for k in PEAK_KEYS}
 
+    def step_wait(self):
+        obs, _, dones, infos = self.venv.step_wait()
+        peaks = self.running_kpis()
+        for i in np.flatnonzero(dones):                # a done env is already reset
+            for key in PEAK_KEYS:
+                peaks[key][i] = infos[i][key]
+        phi = kpi_potential(*(peaks[key] for key in PEAK_KEYS), **self.w)
+        rewards = self.phi - phi
+        if "relevitated" in infos[0]:
+            success = np.array([i.get("reward_success", 0.0) > 0.0 for i in infos])
+            pending = np.array([not i["relevitated"] for i in infos]) & ~success
+            rewards += self.w_relevitate * success - self.time_cost * pending
+        self.phi = np.where(dones, 0.0, phi)
+        return obs, rewards.astype(np.float32), dones, infos
+
+
+def make_kpi_reward(venv, **kwargs) -> KpiReward:
+    """:class:`KpiReward` around ``venv``."""
     return KpiReward(venv, **kwargs)

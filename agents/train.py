@@ -3,12 +3,14 @@
 One run writes into ``--out``:
 
 ===========================  ================================================================
-``model.zip``                the final model (``ALGO.load``)
+``model.zip``                the final model, self-contained: ``ALGO.load`` + ``predict`` runs it
+                             as ``rotordrop evaluate`` does (normalisation, residual inside)
 ``vecnormalize.pkl``         the observation (and reward) normalisation statistics
 ``config.yaml``              the exact hyperparameters, env kwargs, seed and command used
 ``training.json``            wall time, steps/s, learning curve (evaluation reward and KPIs)
 ``learning_curve.png``       evaluation reward and backward-whirl rate against steps
-``best/``                    the best model by evaluation reward, with its ``vecnormalize.pkl``
+``best/``                    the best model by evaluation reward (self-contained), with its
+                             ``vecnormalize.pkl``
 ``checkpoints/``             periodic checkpoints (model, VecNormalize, replay buffer)
 ``eval/evaluations.npz``     ``EvalCallback`` log; ``tb/`` TensorBoard logs; ``monitor.csv``
 ===========================  ================================================================
@@ -77,17 +79,16 @@ def _callbacks():
     from .rollout import final_kpis
     from .score import mean_finite, write_json
 
-    class SaveVecNormalize(BaseCallback):
-        """Saves the VecNormalize statistics next to the best model."""
+    class SaveBest(BaseCallback):
+        """On a new best evaluation: the model in ``best/`` as a self-contained zip (over the
+        plain one EvalCallback wrote) and its VecNormalize statistics next to it."""
 
-        def __init__(self, path: Path):
+        def __init__(self, best_dir: Path, env_id: str, meta: dict):
             super().__init__()
-            self.path = path
+            self.best_dir, self.env_id, self.meta = best_dir, env_id, meta
 
         def _on_step(self) -> bool:
-            vn = self.model.get_vec_normalize_env()
-            if vn is not None:
-                vn.save(str(self.path))
+            save_policy(self.model, self.best_dir / "best_model.zip", self.env_id, self.meta)
             return True
 
     class KpiEvalCallback(EvalCallback):
@@ -175,19 +176,16 @@ def _callbacks():
             if len(self.eval_cb.kpi_history) == self.seen:
                 return True
             self.seen = len(self.eval_cb.kpi_history)
-            from .policies import LearnedPolicy
+            from .validation import validation_score
             vn = self.model.get_vec_normalize_env()
-            pol = LearnedPolicy("candidate", self.algo, self.env_id, self.env_kwargs, self.model, vn)
-            if self.meta.get("residual") is not None:
-                pol.residual, pol.residual_scale = self.meta["residual"], self.meta["residual_scale"]
-            score, _ = self.validator.score(pol.bound, self.env_kwargs)
+            score = validation_score(self.validator, self.model, self.algo, self.env_id,
+                                     self.env_kwargs, vn, self.meta.get("residual"),
+                                     self.meta.get("residual_scale"))
             self.eval_cb.kpi_history[-1]["validation_score"] = score
             self.logger.record("eval/validation_score", score)
             if score > self.best:
                 self.best = score
-                self.model.save(str(self.best_dir / "best_model.zip"))
-                if vn is not None:
-                    vn.save(str(self.best_dir / "vecnormalize.pkl"))
+                save_policy(self.model, self.best_dir / "best_model.zip", self.env_id, self.meta)
             return True
 
         def _on_training_end(self):
@@ -229,8 +227,20 @@ def _callbacks():
             write_json(self.path, summary)                # strict JSON, as every report
             return wall
 
-    return (SaveVecNormalize, KpiEvalCallback, TqdmCallback, ValidationCallback, FinalCheckpoint,
+    return (SaveBest, KpiEvalCallback, TqdmCallback, ValidationCallback, FinalCheckpoint,
             RecordCallback)
+
+
+def save_policy(model, path: Path, env_id: str, meta: dict) -> None:
+    """``model`` at ``path`` as a self-contained zip that plain SB3 runs like ``rotordrop
+    evaluate`` (:func:`agents.sb3_policy.export_self_contained`), and its VecNormalize statistics
+    as ``vecnormalize.pkl`` next to it (for rl-zoo3 and to continue training)."""
+    from .sb3_policy import export_self_contained
+    vn = model.get_vec_normalize_env()
+    export_self_contained(model, vn, path, env_id=env_id, env_kwargs=meta["env_kwargs"],
+                          residual=meta.get("residual"), residual_scale=meta.get("residual_scale"))
+    if vn is not None:
+        vn.save(str(Path(path).parent / "vecnormalize.pkl"))
 
 
 def _run_now(cb, freq_attr: str) -> None:
@@ -325,9 +335,7 @@ def train(env_id: str, algo: str, out: str | Path, timesteps: int | None = None,
                 reset_num_timesteps=ckpt is None, progress_bar=False)
     model_path = out / "model.zip"
     vn_path = out / "vecnormalize.pkl"
-    model.save(str(model_path))
-    if model.get_vec_normalize_env() is not None:
-        model.get_vec_normalize_env().save(str(vn_path))
+    save_policy(model, model_path, env_id, meta)
     wall = record_cb.write(finished=True)
     from .plots import plot_learning_curve
     plot_learning_curve(sorted(eval_cb.kpi_history, key=lambda h: h["timesteps"]),
@@ -360,7 +368,7 @@ def _training_callbacks(env_id: str, algo: str, meta: dict, seed: int, out: Path
                         record: dict, curve: list[dict], eval_log: dict, progress_total: int | None):
     """(evaluation, record, all callbacks): evaluation with KPIs continuing ``curve`` and
     ``eval_log`` from their best score, validation, checkpoints, progress bar, training.json."""
-    SaveVecNormalize, KpiEvalCallback, TqdmCallback, ValidationCallback, FinalCheckpoint, \
+    SaveBest, KpiEvalCallback, TqdmCallback, ValidationCallback, FinalCheckpoint, \
         RecordCallback = _callbacks()
     n = meta.get("n_envs", 1)
     eval_freq = max(meta.get("eval_freq", 10_000) // n, 1) if meta.get("eval_freq", 1) else -1
@@ -369,7 +377,7 @@ def _training_callbacks(env_id: str, algo: str, meta: dict, seed: int, out: Path
         eval_venv, n_eval_episodes=meta.get("n_eval_episodes", 5), eval_freq=eval_freq,
         best_model_save_path=str(out / "best") if keep_best else None,
         log_path=str(out / "eval") if eval_freq > 0 else None, deterministic=True, verbose=0,
-        callback_on_new_best=SaveVecNormalize(out / "best" / "vecnormalize.pkl") if keep_best else None,
+        callback_on_new_best=SaveBest(out / "best", env_id, meta) if keep_best else None,
         eval_seed=seed + 10_000)
     eval_cb.kpi_history = list(curve)
     for key, values in eval_log.items():
