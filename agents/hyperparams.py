@@ -26,6 +26,25 @@ algorithm's constructor arguments a block may hold:
                    phases the benchmark does not use) instead of the highest evaluation reward
 =================  ===========================================================================
 
+The same file trains with rl-zoo3 (``python -m rl_zoo3.train --algo ppo --env ID --gym-packages
+rotordrop_env -conf agents/configs/ppo.yaml``): there, the project's options are entries rl-zoo3
+understands, and ``rotordrop train`` reads them as the keys above (:func:`project_keys`):
+
+=====================================================================  ===========================
+rl-zoo3 entry                                                          means
+=====================================================================  ===========================
+``vec_env_wrapper: [{agents.residual.ResidualAction: {base: B, scale: S}}]``  ``residual: B``,
+                                                                       ``residual_scale: S``
+``vec_env_wrapper: [{agents.reward.KpiReward: {weights...}}]``         ``reward: kpi``,
+                                                                       ``reward_kwargs``
+``callback: [agents.validation.ValidationCallback]``                   ``validation: true``
+=====================================================================  ===========================
+
+(residual first: the list is applied inside out). ``eval_freq``, ``n_eval_episodes`` and
+``checkpoint_freq`` are ``rotordrop train``'s ``--eval-freq``, ``--eval-episodes`` and
+``--save-freq`` (rl-zoo3's flags of the same names), default :data:`RUN_DEFAULTS`; the keys
+still work in a config for ``rotordrop train`` alone.
+
 ``learning_rate``, ``clip_range`` accept ``lin_<value>`` (linear decay to zero, as in rl-zoo3);
 ``train_freq`` a list ``[1, "episode"]`` (made the tuple SB3 wants, as in rl-zoo3).
 Any other key must be a constructor argument of the algorithm (:func:`check_sb3` checks the
@@ -50,6 +69,17 @@ META_KEYS = ("n_timesteps", "n_envs", "policy", "policy_kwargs", "normalize", "e
              "eval_freq", "n_eval_episodes", "checkpoint_freq", "noise_type", "noise_std",
              "reward", "reward_kwargs", "residual", "residual_scale", "validation")
 REWARDS = ("env", "kpi")
+#: evaluation and checkpoint intervals [environment steps] and evaluation episodes of a run
+#: when neither the command line nor the config sets them (rl-zoo3's eval_freq too)
+RUN_DEFAULTS = dict(eval_freq=25_000, n_eval_episodes=8, checkpoint_freq=100_000)
+#: rl-zoo3 entries (class path -> the project keys they set)
+RESIDUAL_WRAPPER = "agents.residual.ResidualAction"
+KPI_WRAPPER = "agents.reward.KpiReward"
+VALIDATION_CALLBACK = "agents.validation.ValidationCallback"
+WRAPPER_KEYS = ("residual", "residual_scale", "reward", "reward_kwargs")
+#: rl-zoo3 keys rotordrop train cannot honour (the batched VecEnv steps unwrapped envs)
+ZOO_ONLY = {"env_wrapper": "gym wrappers around each environment",
+            "frame_stack": "frame stacking", "monitor_kwargs": "Monitor arguments"}
 SCHEDULE_KEYS = ("learning_rate", "clip_range")
 #: constructor arguments ``rotordrop train`` sets itself, and where they come from instead
 SET_BY_TRAIN = {"policy": "the config key policy", "env": "--env", "seed": "--seed",
@@ -122,23 +152,93 @@ def read_yaml(path: str | Path) -> dict:
 
 
 def load_hyperparams(algo: str, env_id: str, config: str | Path | None = None) -> dict:
-    """The hyperparameters for (algo, env id): shipped defaults, then ``config`` on top."""
+    """The hyperparameters for (algo, env id): shipped defaults, then ``config`` on top (both
+    read with :func:`project_keys`; a ``vec_env_wrapper`` / ``callback`` entry of ``config``
+    replaces what the defaults' entries set)."""
     shipped = read_yaml(default_config_path(algo))
     if env_id not in shipped:
         raise ConfigError(f"no {algo} hyperparameters for {env_id} in {default_config_path(algo)}; "
                           f"known ids: {', '.join(shipped)}")
-    hp = copy.deepcopy(shipped[env_id])
+    hp = project_keys(copy.deepcopy(shipped[env_id]))
     if config is not None:
         user = read_yaml(config)
         block = user.get(env_id, user if not any(k.startswith("RotorDrop-") for k in user) else None)
         if block is None:
             raise ConfigError(f"config file {config} has no block for {env_id} (has {', '.join(user)})")
-        for key, value in block.items():
+        if not isinstance(block, dict):
+            raise ConfigError(f"config file {config}: the {env_id} block must be a mapping")
+        for entry, keys in (("vec_env_wrapper", WRAPPER_KEYS), ("callback", ("validation",))):
+            if entry in block:
+                for key in keys:
+                    hp.pop(key, None)
+        for key, value in project_keys(block).items():
             if key == "env_kwargs" and isinstance(value, dict):
                 hp.setdefault("env_kwargs", {}).update(value)
             else:
                 hp[key] = value
     return hp
+
+
+def project_keys(block: dict) -> dict:
+    """A config block with its rl-zoo3 entries (``vec_env_wrapper``, ``callback``; module
+    docstring) turned into the project's keys. ConfigError for an entry ``rotordrop train``
+    cannot run, and for an option given both ways."""
+    out = {k: v for k, v in block.items() if k not in ("vec_env_wrapper", "callback")}
+    for key, what in ZOO_ONLY.items():
+        if key in out:
+            raise ConfigError(f"{key} ({what}) is an rl-zoo3 option that rotordrop train cannot "
+                              f"apply (its batched VecEnv steps the environments unwrapped): "
+                              f"train with python -m rl_zoo3.train, or remove it")
+    found = {}
+    for name, kwargs in _entries(block.get("vec_env_wrapper"), "vec_env_wrapper"):
+        if name == RESIDUAL_WRAPPER:
+            check_keys(name, kwargs, ("base", "scale"))
+            if "base" not in kwargs:
+                raise ConfigError(f"vec_env_wrapper {name} needs base: <baseline controller>")
+            found["residual"] = kwargs["base"]
+            if "scale" in kwargs:
+                found["residual_scale"] = kwargs["scale"]
+        elif name == KPI_WRAPPER:
+            found["reward"] = "kpi"
+            if kwargs:
+                found["reward_kwargs"] = dict(kwargs)
+        else:
+            raise ConfigError(f"vec_env_wrapper {name}: rotordrop train knows {RESIDUAL_WRAPPER} "
+                              f"and {KPI_WRAPPER}; other wrappers run under python -m rl_zoo3.train")
+    for name, kwargs in _entries(block.get("callback"), "callback"):
+        if name != VALIDATION_CALLBACK:
+            raise ConfigError(f"callback {name}: rotordrop train knows {VALIDATION_CALLBACK} "
+                              "(validation: true); other callbacks run under python -m rl_zoo3.train")
+        check_keys(name, kwargs, ("eval_freq", "save_path", "verbose"))
+        found["validation"] = True
+        if "eval_freq" in kwargs:
+            found["eval_freq"] = kwargs["eval_freq"]
+    for key, value in found.items():
+        if key in out and out[key] != value:
+            raise ConfigError(f"{key} is given twice, as {key}: {out[key]!r} and by an rl-zoo3 "
+                              f"entry ({value!r}); keep one")
+        out[key] = value
+    return out
+
+
+def _entries(value: Any, key: str) -> list[tuple[str, dict]]:
+    """rl-zoo3's ``NAME`` / ``{NAME: kwargs}`` / a list of those -> [(NAME, kwargs)]."""
+    if value is None:
+        return []
+    items = value if isinstance(value, list) else [value]
+    out = []
+    for item in items:
+        if isinstance(item, str):
+            out.append((item, {}))
+        elif isinstance(item, dict) and len(item) == 1:
+            name, kwargs = next(iter(item.items()))
+            if kwargs is not None and not isinstance(kwargs, dict):
+                raise ConfigError(f"{key} {name}: its arguments must be a mapping, got {kwargs!r}")
+            out.append((str(name), dict(kwargs or {})))
+        else:
+            raise ConfigError(f"{key}: each entry is a class path or {{class path: {{arguments}}}}, "
+                              f"got {item!r}")
+    return out
 
 
 def parse_literal(text: Any, key: str) -> Any:
@@ -230,6 +330,8 @@ def split(hp: dict) -> tuple[dict, dict]:
         raise ConfigError(f"validation must be true or false, got {meta['validation']!r}")
     if not isinstance(meta.setdefault("reward_kwargs", {}) or {}, dict):
         raise ConfigError(f"reward_kwargs must be a mapping, got {meta['reward_kwargs']!r}")
+    for key, value in RUN_DEFAULTS.items():
+        meta.setdefault(key, value)
     meta["env_kwargs"] = meta.get("env_kwargs") or {}
     if not isinstance(meta["env_kwargs"], dict):
         raise ConfigError(f"env_kwargs must be a mapping, got {meta['env_kwargs']!r}")

@@ -208,6 +208,19 @@ def export_policy(source: str | Path, out: str | Path) -> Path:
     return export_learned(pol, out)
 
 
+def export_zoo(source: str | Path, folder: str | Path) -> Path:
+    """The policy at ``source`` (as :func:`export_policy`) laid out as an rl-zoo3 run in
+    ``folder`` (``<algo>/<env id>.zip`` and ``<algo>/<env id>/config.yml`` with its env kwargs),
+    so that ``python -m rl_zoo3.enjoy --algo ALGO --env ID --gym-packages rotordrop_env -f
+    FOLDER --exp-id -1`` plays it. The zip is self-contained: no VecNormalize is applied."""
+    from .hyperparams import dump_yaml
+    pol = load_shipped(str(source)) if str(source) in shipped_names() else LearnedPolicy.load(source)
+    run = Path(folder) / pol.algo
+    (run / pol.env_id).mkdir(parents=True, exist_ok=True)
+    dump_yaml({"env_kwargs": pol.env_kwargs, "normalize": False}, run / pol.env_id / "config.yml")
+    return export_learned(pol, run / f"{pol.env_id}.zip")
+
+
 def export_learned(pol: LearnedPolicy, out: str | Path) -> Path:
     """A loaded :class:`LearnedPolicy` as a self-contained zip (see :func:`export_policy`)."""
     if pol.self_contained:

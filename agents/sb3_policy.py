@@ -158,23 +158,49 @@ def export_self_contained(model, vecnormalize, out_path: str | Path, *, env_id: 
                 residual=residual,
                 residual_scale=float(RESIDUAL_SCALE if residual_scale is None else residual_scale),
                 memoryless=bool(residual is None or BASELINES[residual].memoryless))
-    kwargs = {k: v for k, v in model.policy_kwargs.items() if k != KEY}
-    policy = cls(model.observation_space, model.action_space, model.lr_schedule,
-                 **kwargs, **{KEY: meta}).to(model.device)
-    missing, unexpected = policy.load_state_dict(model.policy.state_dict(), strict=False)
-    if set(missing) - {"obs_mean", "obs_var"} or unexpected:
-        raise ValueError(f"cannot export: state_dict mismatch (missing {missing}, unexpected {unexpected})")
+    policy, kwargs = _rebuilt(model, cls, meta)
     if norm is not None:
         policy.obs_mean.copy_(th.as_tensor(vecnormalize.obs_rms.mean, dtype=th.float64))
         policy.obs_var.copy_(th.as_tensor(vecnormalize.obs_rms.var, dtype=th.float64))
+    return _save_with(model, policy, kwargs, out_path)
+
+
+def save_plain(model, out_path: str | Path) -> Path:
+    """The network of a self-contained ``model`` as SB3's own ``MlpPolicy`` zip: what training
+    continues from (with the run's VecNormalize statistics and residual wrapper around the env)."""
+    plain = {cls: base for base, cls in POLICY_CLASSES.items()}
+    if type(model.policy) not in plain:
+        raise ValueError(f"{type(model.policy).__name__} is not a self-contained rotordrop policy")
+    return _save_with(model, *_rebuilt(model, plain[type(model.policy)], None), out_path)
+
+
+def _rebuilt(model, cls: type, meta: dict | None) -> tuple:
+    """(a ``cls`` policy with ``model``'s weights and optimizer state, its ``policy_kwargs``);
+    ``meta``: the ``rotordrop`` entry of a self-contained class, None for SB3's own."""
+    kwargs = {k: v for k, v in model.policy_kwargs.items() if k != KEY}
+    if meta is not None:
+        kwargs[KEY] = meta
+    policy = cls(model.observation_space, model.action_space, model.lr_schedule, **kwargs).to(model.device)
+    buffers = {"obs_mean", "obs_var"}
+    state = {k: v for k, v in model.policy.state_dict().items() if k not in buffers}
+    missing, unexpected = policy.load_state_dict(state, strict=False)
+    if set(missing) - buffers or unexpected:
+        raise ValueError(f"cannot rebuild {cls.__name__}: state_dict mismatch (missing {missing}, "
+                         f"unexpected {unexpected})")
     if hasattr(model.policy, "optimizer"):
         policy.optimizer.load_state_dict(model.policy.optimizer.state_dict())
+    return policy, kwargs
+
+
+def _save_with(model, policy, kwargs: dict, out_path: str | Path) -> Path:
+    """``model.save(out_path)`` with ``policy`` (and its ``policy_kwargs``) in place of its own
+    (restored afterwards)."""
     out_path = Path(out_path)
     out_path.parent.mkdir(parents=True, exist_ok=True)
     saved = {k: getattr(model, k) for k in ("policy", "policy_class", "policy_kwargs")}
     try:
-        model.policy, model.policy_class = policy, cls
-        model.policy_kwargs = {**kwargs, KEY: meta}
+        model.policy, model.policy_class = policy, type(policy)
+        model.policy_kwargs = kwargs
         model.save(out_path)
     finally:
         for k, v in saved.items():
