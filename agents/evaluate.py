@@ -3,7 +3,8 @@
 Writes ``kpis.json`` (per-episode scenario and KPIs, and their summary, for the policy and for
 the passive drop on the same seeds at the policy's control step, so that the returns compare;
 strict JSON, null where a KPI is undefined) and ``orbits.png`` / ``contact_force.png`` / ``actions.png`` (first
-episode, policy against passive).
+episode, policy against passive); with ``video`` the first episode as ``episode.mp4`` (the
+environment's labelled frames; ``episode.gif`` where no ffmpeg is installed).
 """
 from __future__ import annotations
 
@@ -61,7 +62,7 @@ def _episode_rows(eps) -> list[dict]:
 
 def evaluate(policy: str, env_id: str | None, episodes: int, out: str | Path,
              env_kwargs: dict | None = None, seed: int = 0, plots: bool = True,
-             compare_passive: bool = True, randomize: bool = True) -> dict:
+             compare_passive: bool = True, randomize: bool = True, video: bool = False) -> dict:
     """Run ``episodes`` seeded episodes of ``policy`` (and of the passive drop on the same
     scenarios). With ``randomize`` every seed draws a scenario from the env's randomisation
     ranges (keys given in ``env_kwargs["overrides"]`` stay fixed); episodes run their full
@@ -98,9 +99,22 @@ def evaluate(policy: str, env_id: str | None, episodes: int, out: str | Path,
         from .plots import plot_episode_comparison
         report["figures"] = [p.name for p in plot_episode_comparison(
             eps[0], passive[0] if passive else None, name, out)]
+    if video:
+        report["video"] = _write_video(env_id, make_actor, seeds[0], kwargs, out)
     write_json(out / "kpis.json", report)
     report["out"] = str(out)
     return report
+
+
+def _write_video(env_id: str, make_actor, seed: int, kwargs: dict, out: Path) -> str:
+    """The first episode again, rendered (same seed, deterministic actor): ``episode.mp4``, or
+    ``episode.gif`` without ffmpeg. Returns the file name."""
+    from rotordrop_env.env import RotorDropEnv
+    from rotordrop_env.video import default_suffix, write_video
+    frames: list = []
+    run_episodes(env_id, make_actor, [seed], {**kwargs, "render_mode": "rgb_array"}, frames=frames)
+    path = write_video(frames, out / f"episode{default_suffix()}", RotorDropEnv.metadata["render_fps"])
+    return path.name
 
 
 def print_summary(report: dict) -> None:
@@ -121,5 +135,6 @@ def print_summary(report: dict) -> None:
               f"{fmt_or_dash(t * 1e3 if t is not None else None, '.1f'):>14}{fmt_or_dash(s['control_effort'], '.3g'):>9}"
               f"{fmt_or_dash(s['mean_return'], '.1f'):>9}")
     print(f"wrote {Path(report['out']) / 'kpis.json'}"
-          + "".join(f", {f}" for f in report.get("figures", [])))
+          + "".join(f", {f}" for f in report.get("figures", []))
+          + (f", {report['video']}" if "video" in report else ""))
 

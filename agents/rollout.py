@@ -41,9 +41,10 @@ def final_kpis(info: dict) -> dict:
 
 
 def run_episodes(env_id: str, make_actor: Callable[[Plant], object], seeds, env_kwargs=None,
-                 record: bool = False) -> list[Episode]:
+                 record: bool = False, frames: list | None = None) -> list[Episode]:
     """Run one episode per seed with the actor built by ``make_actor(plant)`` (a controller
-    anew for each episode)."""
+    anew for each episode). ``frames``: a list that gets ``env.render()`` after the reset and
+    after every step (the env kwargs must set ``render_mode="rgb_array"``)."""
     env = make_env(env_id, **(env_kwargs or {}))
     try:
         plant = Plant.from_env(env)
@@ -52,7 +53,7 @@ def run_episodes(env_id: str, make_actor: Callable[[Plant], object], seeds, env_
         for i, s in enumerate(seeds):
             if i and isinstance(actor, Controller):
                 actor = make_actor(plant)
-            episodes.append(_episode(env, plant, actor, int(s), record))
+            episodes.append(_episode(env, plant, actor, int(s), record, frames))
         return episodes
     finally:
         env.close()
@@ -71,8 +72,10 @@ def check_actor(env_id: str, make_actor: Callable[[Plant], object], env_kwargs=N
         env.close()
 
 
-def _episode(env, plant: Plant, actor, seed: int, record: bool) -> Episode:
+def _episode(env, plant: Plant, actor, seed: int, record: bool, frames: list | None = None) -> Episode:
     obs, info = env.reset(seed=seed)
+    if frames is not None:
+        frames.append(env.render())
     scenario = info.get("scenario")
     total, steps = 0.0, 0
     rec_obs, rec_act, rec_f = [], [], []
@@ -87,6 +90,8 @@ def _episode(env, plant: Plant, actor, seed: int, record: bool) -> Episode:
             rec_obs.append(np.concatenate([row, sensor_positions(env)]) if extra else row)
             rec_act.append(np.atleast_1d(np.asarray(a, dtype=np.float64)))
         obs, reward, terminated, truncated, info = env.step(a)
+        if frames is not None:
+            frames.append(env.render())
         if record:
             rec_f.append(np.atleast_1d(np.asarray(info.get("contact_force_N", np.nan), dtype=float)))
         total += float(reward)

@@ -34,7 +34,8 @@ TEXT_X = PANELS[1] + ORBIT + 18
 TRAIL = 10                                  # most recent steps drawn bold
 
 #: the numbers beside the orbits (then "damping" and "AMB" where the environment has them)
-LABELS = ("friction μ", "rotor speed", "contact force", "  peak so far", "whirl", "  backward revs")
+LABELS = ("friction μ", "rotor speed", "contact force", "  peak so far", "whirl so far",
+          "  net backward revs")
 LINE = 28                                   # their spacing [px]
 
 WHITE, BLACK, GREY, LIGHT = (255, 255, 255), (20, 20, 20), (120, 120, 120), (225, 225, 225)

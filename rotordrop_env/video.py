@@ -45,8 +45,12 @@ def write_video(frames: Sequence[np.ndarray], path: str | Path, fps: float) -> P
 
 
 def _write_gif(frames, path: Path, fps: float) -> None:
+    """One palette for all frames, from the last (the fullest) frame: the views use few
+    colours, so this is fast and does not flicker."""
     from PIL import Image
-    images = [Image.fromarray(np.asarray(f, dtype=np.uint8)) for f in frames]
+    palette = Image.fromarray(np.asarray(frames[-1], dtype=np.uint8)).quantize(colors=128)
+    images = [Image.fromarray(np.asarray(f, dtype=np.uint8)).quantize(
+        palette=palette, dither=Image.Dither.NONE) for f in frames]
     images[0].save(path, save_all=True, append_images=images[1:], loop=0,
                    duration=max(int(round(1000.0 / fps)), 20))
 

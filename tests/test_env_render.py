@@ -52,7 +52,7 @@ def test_a_frame_shows_orbits_at_both_planes_and_the_whirl_state(friction, whirl
         assert _pixels(img, box, R.PLANE_COLOURS[k]) > 40             # recent trace and dot
         assert _pixels(img, box, R.PALE[k], 20) > 100                   # the trace since the fault
         assert _pixels(img, box, R.PLANE_COLOURS[1 - k]) == 0
-    state = _value_box(R.LABELS.index("whirl"))
+    state = _value_box(R.LABELS.index("whirl so far"))
     assert (_pixels(img, state, R.RED) > 20) is whirl
     assert (_pixels(img, state, R.GREEN) > 20) is not whirl
     left, top, right, bottom = R.FORCE_BOX                          # force trace drawn
@@ -114,3 +114,23 @@ def test_write_video_round_trip(tmp_path, suffix):
         write_video(frames, tmp_path / "drop.avi", fps=10)
     with pytest.raises(ValueError, match="no frames"):
         write_video([], tmp_path / "drop.gif", fps=10)
+
+
+def test_evaluate_video_writes_the_first_episode(tmp_path, monkeypatch):
+    """``rotordrop evaluate --video``: the first episode, one frame per step and the reset; a
+    GIF through Pillow when ffmpeg is missing."""
+    from agents.evaluate import evaluate
+    from rotordrop_env import video
+    for suffix in ([".mp4"] if mp4_available() else []) + [".gif"]:
+        monkeypatch.setattr(video, "default_suffix", lambda s=suffix: s)
+        report = evaluate("ppo-damping", None, 1, tmp_path / suffix[1:], plots=False,
+                          compare_passive=False, video=True)
+        path = tmp_path / suffix[1:] / report["video"]
+        assert path.name == f"episode{suffix}" and report["episodes"][0]["length"] == 60
+        if suffix == ".gif":
+            from PIL import Image
+            with Image.open(path) as im:
+                assert im.n_frames == 61
+        else:
+            import imageio.v2 as imageio
+            assert sum(1 for _ in imageio.get_reader(path)) == 61
