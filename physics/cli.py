@@ -205,3 +205,8 @@ def run(args) -> int:
     except BrokenPipeError:                  # `rotordrop params | head`: the reader left
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
+
+
+if __name__ == "__main__":        # the dispatcher sits in the top layer (docs/architecture.md)
+    sys.exit("rotordrop: the command line starts in the top layer: run `rotordrop ...` "
+             "or `python -m agents.cli ...`")
