@@ -1,5 +1,5 @@
 """The ``rotordrop`` command line (entry point :func:`main`) and agents' commands ``train |
-evaluate | benchmark | tune | ride-through`` (and ``research``, :mod:`agents.research`).
+evaluate | benchmark | tune | ride-through | export-policy`` (and ``research``, :mod:`agents.research`).
 
 This top-layer module builds the parser from every layer's ``register(subparsers)``: physics'
 ``drop``, ``params`` (:mod:`physics.cli`), ``study`` and ``accuracy``, then agents' own. Registration
@@ -77,7 +77,8 @@ def cmd_train(args) -> int:
         res = train(args.env, args.algo, args.out, timesteps=args.timesteps, n_envs=args.n_envs,
                     config=args.config, seed=args.seed, resume=args.resume, threads=args.threads,
                     progress=not args.quiet, verbose=args.verbose, command=command_line(),
-                    overwrite=args.overwrite)
+                    overwrite=args.overwrite, eval_freq=args.eval_freq,
+                    n_eval_episodes=args.eval_episodes, checkpoint_freq=args.save_freq)
     except (ConfigError, *ERRORS) as exc:
         return _fail("train", exc)
     print(res.summary())
@@ -89,10 +90,22 @@ def cmd_evaluate(args) -> int:
     try:
         report = evaluate(args.policy, args.env, args.episodes, args.out, env_kwargs=_env_kwargs(args),
                           seed=args.seed, plots=not args.no_plots, compare_passive=not args.no_passive,
-                          randomize=not args.fixed)
+                          randomize=not args.fixed, video=args.video)
     except ERRORS as exc:
         return _fail("evaluate", exc)
     print_summary(report)
+    return 0
+
+
+def cmd_export_policy(args) -> int:
+    from .policies import export_policy, export_zoo
+    try:
+        path = export_zoo(args.source, args.zoo) if args.zoo else export_policy(args.source, args.out)
+    except ERRORS as exc:
+        return _fail("export-policy", exc)
+    print(f"wrote {path}" + (f" and its config.yml: python -m rl_zoo3.enjoy --algo "
+                             f"{path.parent.name} --env {path.stem} --gym-packages rotordrop_env "
+                             f"-f {args.zoo} --exp-id -1" if args.zoo else ""))
     return 0
 
 
@@ -161,7 +174,24 @@ def register(sub) -> None:
                    help="delete the previous run's files in --out first")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--verbose", type=int, default=0, help="SB3 verbosity (0, 1, 2)")
+    p.add_argument("--eval-freq", type=at_least(0), default=None,
+                   help="environment steps between evaluations (0: none; default: the config's, "
+                        "else 25000), as rl_zoo3.train's flag")
+    p.add_argument("--eval-episodes", type=at_least(1), default=None,
+                   help="episodes per evaluation (default: the config's, else 8)")
+    p.add_argument("--save-freq", type=at_least(0), default=None,
+                   help="environment steps between checkpoints (0: none; default: the config's, "
+                        "else 100000)")
     p.set_defaults(func=cmd_train)
+
+    p = sub.add_parser("export-policy", help="a trained policy as one zip that plain SB3 "
+                                             "(PPO.load / SAC.load / TD3.load) runs as rotordrop does")
+    p.add_argument("source", help="run directory, its best/, a model or checkpoint zip, or a "
+                                  "shipped policy name")
+    where = p.add_mutually_exclusive_group(required=True)
+    where.add_argument("--out", help="the zip to write")
+    where.add_argument("--zoo", metavar="DIR", help="write an rl-zoo3 run folder for rl_zoo3.enjoy")
+    p.set_defaults(func=cmd_export_policy)
 
     p = sub.add_parser("evaluate", help="KPIs and plots of a policy or baseline controller")
     p.add_argument("--policy", required=True,
@@ -183,6 +213,8 @@ def register(sub) -> None:
     p.add_argument("--power-return-ms", type=float, default=None,
                    help="re-levitation environments: power back this long after the fault [ms] "
                         "(default: the env's 50 ms, or randomised without --fixed)")
+    p.add_argument("--video", action="store_true",
+                   help="the first episode as episode.mp4 (episode.gif without ffmpeg)")
     p.set_defaults(func=cmd_evaluate)
 
     p = sub.add_parser("benchmark", help="every baseline and shipped policy on a fixed scenario suite")

@@ -280,19 +280,25 @@ def _steps_of(p: Path) -> int:
     return int(m.group(1)) if m else -1
 
 
-def resolve_config(env_id: str, algo: str, config=None, timesteps=None, n_envs=None) -> dict:
+def resolve_config(env_id: str, algo: str, config=None, timesteps=None, n_envs=None,
+                   **run: int | None) -> dict:
+    """The hyperparameters with the command line's overrides (``run``: ``eval_freq``,
+    ``n_eval_episodes``, ``checkpoint_freq``; None keeps the config's)."""
     hp = load_hyperparams(algo, env_id, config)
     if timesteps is not None:
         hp["n_timesteps"] = int(timesteps)
     if n_envs is not None:
         hp["n_envs"] = int(n_envs)
+    hp.update({k: int(v) for k, v in run.items() if v is not None})
     return hp
 
 
 def train(env_id: str, algo: str, out: str | Path, timesteps: int | None = None,
           n_envs: int | None = None, config: str | Path | None = None, seed: int = 0,
           resume: str | Path | None = None, threads: int = 1, progress: bool = True,
-          verbose: int = 0, command: str | None = None, overwrite: bool = False) -> TrainResult:
+          verbose: int = 0, command: str | None = None, overwrite: bool = False,
+          eval_freq: int | None = None, n_eval_episodes: int | None = None,
+          checkpoint_freq: int | None = None) -> TrainResult:
     """Train ``algo`` on ``env_id`` and save model, statistics, config and learning curve
     (module docstring: resuming, an existing ``out``, the final evaluation)."""
     if algo not in ALGOS:
@@ -302,7 +308,8 @@ def train(env_id: str, algo: str, out: str | Path, timesteps: int | None = None,
     from stable_baselines3.common.callbacks import CallbackList
 
     out = Path(out)
-    hp = resolve_config(env_id, algo, config, timesteps, n_envs)
+    hp = resolve_config(env_id, algo, config, timesteps, n_envs, eval_freq=eval_freq,
+                        n_eval_episodes=n_eval_episodes, checkpoint_freq=checkpoint_freq)
     meta, algo_kwargs = split(hp)
     check_sb3(algo, env_id, meta, algo_kwargs)
     ckpt = find_checkpoint(resume) if resume is not None else None

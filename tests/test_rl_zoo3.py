@@ -122,3 +122,22 @@ def test_every_shipped_yaml_has_only_keys_rl_zoo3_passes_on_correctly():
         args = set(inspect.signature(algo_class(algo).__init__).parameters)
         for env_id, block in yaml.safe_load(default_config_path(algo).read_text()).items():
             assert set(block) <= zoo | args, (algo, env_id, set(block) - zoo - args)
+
+
+def test_the_run_flags_override_the_config(tmp_path):
+    from agents.train import resolve_config
+    hp = resolve_config("RotorDrop-Damping-v0", "ppo", eval_freq=1000, n_eval_episodes=2,
+                        checkpoint_freq=0)
+    meta, _ = split(hp)
+    assert (meta["eval_freq"], meta["n_eval_episodes"], meta["checkpoint_freq"]) == (1000, 2, 0)
+
+
+def test_export_policy_command(tmp_path, capsys):
+    from agents.cli import main
+    assert main(["export-policy", "ppo-relevitate", "--out", str(tmp_path / "p.zip")]) == 0
+    assert PPO.load(tmp_path / "p.zip", device="cpu").policy.rotordrop["residual"] == "whirl-brake"
+    assert main(["export-policy", "ppo-relevitate", "--zoo", str(tmp_path / "zoo")]) == 0
+    assert "rl_zoo3.enjoy --algo ppo --env RotorDrop-Relevitate-v0" in capsys.readouterr().out
+    assert (tmp_path / "zoo" / "ppo" / "RotorDrop-Relevitate-v0" / "config.yml").is_file()
+    assert main(["export-policy", "no-such-policy", "--out", str(tmp_path / "x.zip")]) == 2
+    assert "no-such-policy" in capsys.readouterr().err
