@@ -56,3 +56,13 @@ class ResidualAction(VecEnvWrapper):
 def make_residual(venv, base: str, scale: float = RESIDUAL_SCALE) -> ResidualAction:
     """:class:`ResidualAction` around ``venv``."""
     return ResidualAction(venv, base, scale)
+
+
+def residual_of(venv) -> tuple[str | None, float | None]:
+    """(baseline, scale) of the :class:`ResidualAction` wrapper in ``venv``'s wrapper chain, or
+    (None, None)."""
+    while isinstance(venv, VecEnvWrapper):
+        if isinstance(venv, ResidualAction):
+            return venv.base_name, venv.scale
+        venv = venv.venv
+    return None, None

@@ -138,17 +138,27 @@ def _exported_class(policy) -> type:
                      "and TD3 is supported")
 
 
-def export_self_contained(model, vecnormalize, out_path: str | Path, *, env_id: str,
+def export_self_contained(model, vecnormalize, out_path: str | Path, *, env_id: str | None = None,
                           env_kwargs: dict | None = None, residual: str | None = None,
                           residual_scale: float | None = None) -> Path:
     """Write ``model`` (a PPO / SAC / TD3 with an ``MlpPolicy``) as a zip that plain SB3 loads
     and runs like the project's loader: ``vecnormalize`` (a ``VecNormalize`` or None) and the
     ``residual`` baseline (name, ``residual_scale``) go inside the policy. ``env_id`` and
-    ``env_kwargs`` name the training environment (the residual's plant). The model passed in
-    is left as it was."""
+    ``env_kwargs`` name the training environment (the residual's plant); without ``env_id``
+    all four are read from the model's own training env (its spec and its
+    :class:`~agents.residual.ResidualAction` wrapper, if any). The model passed in is left as
+    it was."""
     from .controllers import BASELINES
-    from .residual import RESIDUAL_SCALE
+    from .residual import RESIDUAL_SCALE, residual_of
     cls = _exported_class(model.policy)
+    if env_id is None:
+        venv = model.get_env()
+        if venv is None:
+            raise ValueError("export_self_contained: give env_id= (and env_kwargs, residual): "
+                             "the model has no training environment to read them from")
+        spec = venv.get_attr("spec", [0])[0]
+        env_id, env_kwargs = spec.id, dict(spec.kwargs)
+        residual, residual_scale = residual_of(venv)
     if residual is not None and residual not in BASELINES:
         raise ValueError(f"residual = {residual!r} is not a baseline ({', '.join(BASELINES)})")
     norm = None

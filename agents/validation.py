@@ -16,7 +16,6 @@ from pathlib import Path
 
 import numpy as np
 from stable_baselines3.common.callbacks import BaseCallback
-from stable_baselines3.common.vec_env import VecEnvWrapper
 
 #: rl-zoo3's default evaluation interval [environment steps]
 EVAL_FREQ = 25_000
@@ -32,17 +31,6 @@ def validation_score(validator, model, algo: str, env_id: str, env_kwargs: dict,
         pol.residual, pol.residual_scale = residual, residual_scale
     score, _ = validator.score(pol.bound, env_kwargs)
     return score
-
-
-def residual_of(venv) -> tuple[str | None, float | None]:
-    """(baseline, scale) of the :class:`agents.residual.ResidualAction` wrapper in ``venv``'s
-    wrapper chain, or (None, None)."""
-    from .residual import ResidualAction
-    while isinstance(venv, VecEnvWrapper):
-        if isinstance(venv, ResidualAction):
-            return venv.base_name, venv.scale
-        venv = venv.venv
-    return None, None
 
 
 class ValidationCallback(BaseCallback):
@@ -78,6 +66,7 @@ class ValidationCallback(BaseCallback):
 
     def validate(self) -> float:
         vn = self.model.get_vec_normalize_env()
+        from .residual import residual_of
         residual, scale = residual_of(self.training_env)
         score = validation_score(self.validator, self.model, self.algo, self.env_id,
                                  self.env_kwargs, vn, residual, scale)

@@ -127,3 +127,21 @@ def test_export_policy_of_a_run_writes_a_zip_plain_sb3_runs(tmp_path):
     b = algo_class("ppo").load(shipped_dir() / "ppo-damping.zip", device="cpu")
     obs = np.random.default_rng(1).normal(size=(16, a.observation_space.shape[0])).astype(np.float32)
     assert np.array_equal(a.predict(obs, deterministic=True)[0], b.predict(obs, deterministic=True)[0])
+
+
+def test_export_reads_env_and_residual_from_the_models_training_env(tmp_path):
+    """export_self_contained(model, vecnormalize, path): what the run's env says is inside."""
+    from stable_baselines3 import PPO
+    from stable_baselines3.common.vec_env import VecNormalize
+    from agents.residual import ResidualAction
+    from rotordrop_env import make_batched
+    kw = dict(command="continuous", episode_time=0.02)
+    venv = VecNormalize(ResidualAction(make_batched("RotorDrop-Relevitate-v0", 2, seed=0,
+                                                    n_threads=1, **kw), base="whirl-brake", scale=0.5))
+    model = PPO("MlpPolicy", venv, n_steps=32, batch_size=32, seed=0, device="cpu")
+    model.learn(64)
+    out = export_self_contained(model, venv, tmp_path / "p.zip")
+    inside = PPO.load(out, device="cpu").policy.rotordrop
+    assert (inside["env_id"], inside["residual"], inside["residual_scale"]) == \
+        ("RotorDrop-Relevitate-v0", "whirl-brake", 0.5)
+    assert inside["env_kwargs"] == kw and inside["normalize"]["clip_obs"] == 10.0
