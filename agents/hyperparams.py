@@ -206,6 +206,10 @@ def project_keys(block: dict) -> dict:
             raise ConfigError(f"callback {name}: rotordrop train knows {VALIDATION_CALLBACK} "
                               "(validation: true); other callbacks run under python -m rl_zoo3.train")
         check_keys(name, kwargs, ("eval_freq", "save_path", "verbose"))
+        if kwargs.get("save_path") is not None:
+            raise ConfigError(f"callback {name}: save_path is where rl-zoo3 keeps the best model; "
+                              "rotordrop train keeps it in --out/best/: remove save_path (or pass "
+                              "it with rl_zoo3.train's -params)")
         found["validation"] = True
         if "eval_freq" in kwargs:
             found["eval_freq"] = kwargs["eval_freq"]

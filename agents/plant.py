@@ -85,6 +85,9 @@ class Plant:
             u = u.venv
         if hasattr(u, "envs") and not hasattr(u, "obs_names"):     # batched or DummyVecEnv
             u = u.envs[0].unwrapped
+        elif hasattr(u, "get_attr") and not hasattr(u, "obs_names"):   # SubprocVecEnv
+            spec = u.get_attr("spec", [0])[0]
+            return plant_of(spec.id, **spec.kwargs)
         from physics.model import P_AMB_IFF1, P_AMB_IFF2
         s = u.base_scene
         P = u.model.P              # gravity feed-forward currents: 0 without actuator AMBs

@@ -27,8 +27,8 @@ class ResidualAction(VecEnvWrapper):
     config ``vec_env_wrapper: [{agents.residual.ResidualAction: {base: NAME, scale: S}}]``):
     see :func:`residual_action`. A freshly initialised policy (a ≈ 0) reproduces the baseline;
     learning changes it only where that pays (residual policy learning, Johannink et al.
-    2019). Box action spaces only. Works on the batched VecEnv and on SB3's DummyVecEnv of
-    ``gym.make`` environments (rl-zoo3's default)."""
+    2019). Box action spaces only. Works on the batched VecEnv and on SB3's DummyVecEnv (rl-zoo3's
+    default) or SubprocVecEnv of ``gym.make`` environments."""
 
     def __init__(self, venv, base: str, scale: float = RESIDUAL_SCALE):
         from .controllers import make_baseline

@@ -90,6 +90,8 @@ def test_a_user_config_overrides_the_entries_in_either_form(tmp_path):
     ({"callback": "sb3.Other"}, "callback sb3.Other: rotordrop train knows"),
     ({"frame_stack": 4}, "frame_stack .* is an rl-zoo3 option"),
     ({"vec_env_wrapper": [{"a": 1, "b": 2}]}, "each entry is a class path"),
+    ({"callback": [{"agents.validation.ValidationCallback": {"save_path": "x"}}]},
+     "save_path is where rl-zoo3 keeps"),
 ])
 def test_entries_rotordrop_train_cannot_run_are_named(block, match):
     with pytest.raises(ConfigError, match=match):
