@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import amb as amb_mod
-from .ball_bearing import (ball_forces, bearing_constants, cage_ratio, drag_torque_magnitude,
+from .ball_bearing import (ball_forces, ball_forces_with_dry, bearing_constants, cage_ratio, drag_torque_magnitude,
                            film_thickness)
 from .contact import contact_potential, friction_force, geometry, normal_force, smooth_sign
 from ._jit import njit
@@ -413,20 +413,21 @@ def rhs(t, y, P, I, U, dy, aux):
             if I[F_FILM]:
                 h, dh_dw = film_thickness(ws, P[P_FILM])
             cage = P[P_CAGE] * y[i_th]
-            qx, qy, V, dV, qsum, qmax = ball_forces(ux, uy, cage, int(P[P_NB]), P[P_HALF_PLAY], h,
-                                                    P[P_KTOT])
+            if I[F_FILM] and i_ws < 0:
+                # massless sleeve: the film follows the algebraic rolling speed, so the audit
+                # keeps the ball potential at zero film (mechanical_energy) and counts the
+                # film's share of the ball forces as a non-potential force (dV: the zero-film
+                # cage derivative, to match); one pass over the balls gives both
+                qx, qy, _, _, qsum, qmax, qx0, qy0, dV = ball_forces_with_dry(
+                    ux, uy, cage, int(P[P_NB]), P[P_HALF_PLAY], h, P[P_KTOT])
+                p_ext += (qx0 - qx) * uvx + (qy0 - qy) * uvy
+            else:
+                qx, qy, _, dV, qsum, qmax = ball_forces(ux, uy, cage, int(P[P_NB]),
+                                                        P[P_HALF_PLAY], h, P[P_KTOT])
             bfx = -qx - P[P_CB] * uvx
             bfy = -qy - P[P_CB] * uvy
             load = math.sqrt(qx * qx + qy * qy)
             p_diss += P[P_CB] * (uvx * uvx + uvy * uvy)
-            if I[F_FILM] and i_ws < 0:
-                # massless sleeve: the film follows the algebraic rolling speed, so the audit
-                # keeps the ball potential at zero film (mechanical_energy) and counts the
-                # film's share of the ball forces as a non-potential force (dV below: the
-                # zero-film cage derivative, to match)
-                qx0, qy0, _, dV, _, _ = ball_forces(ux, uy, cage, int(P[P_NB]), P[P_HALF_PLAY],
-                                                    0.0, P[P_KTOT])
-                p_ext += (qx0 - qx) * uvx + (qy0 - qy) * uvy
             p_ext += dV * P[P_CAGE] * ws          # cage rotation under load (no torque in the model)
             dy[i_th] = ws
         elif I[F_RB] == RB_LINEAR:
