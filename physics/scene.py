@@ -114,6 +114,35 @@ class Sleeve:
 
 
 @dataclass(frozen=True)
+class Thermal:
+    """Lumped heating of each sleeve + inner ring by the contact friction and the friction
+    coefficient's temperature law (effects.thermal; docs/physics.md "Friction heat")."""
+    specific_heat: float = param(475.0, "J/(kg K)", 100.0, 2000.0,
+                                 "specific heat c of the sleeve + inner ring (bearing steel"
+                                 " 100Cr6 / AISI 52100: ~475); heat capacity sleeve.mass x c", "A")
+    conductance: float = param(0.5, "W/K", 0.0, 1e4,
+                               "heat loss G from a sleeve to the housing per kelvin (ball set,"
+                               " air); 0 = adiabatic; time constant sleeve.mass c / G = 741 s"
+                               " at the defaults", "A")
+    heat_partition: float = param(0.5, "-", 0.0, 1.0,
+                                  "share of the rotor-sleeve friction heat entering the sleeve"
+                                  " (the rest heats the rotor, counted as lost)", "A")
+    mu_slope: float = param(-1e-3, "1/K", -0.02, 0.02,
+                            "relative change kappa of the friction coefficient per kelvin of"
+                            " sleeve temperature rise: mu = contact.friction x clamp(1 + kappa"
+                            " theta, mu_ratio_min, mu_ratio_max); < 0: oxide films (default),"
+                            " > 0: the paper's rise with heat and wear", "A")
+    mu_ratio_min: float = param(0.5, "-", 0.0, 1.0,
+                                "floor of mu / contact.friction under heating", "A")
+    mu_ratio_max: float = param(2.0, "-", 1.0, 10.0,
+                                "ceiling of mu / contact.friction under heating (mu_slope > 0)",
+                                "A")
+    initial_rise: float = param(0.0, "K", 0.0, 1000.0,
+                                "sleeve temperature rise above ambient at t = 0 (e.g. after an"
+                                " earlier drop)", "A")
+
+
+@dataclass(frozen=True)
 class Bearing:
     """Retainer ball bearing 6016 (spec §4)."""
     pitch_diameter: float = param(0.110, "m", 1e-3, 2.0, "pitch diameter d_m")
@@ -183,6 +212,10 @@ class Effects:
                                  doc="sleeve spin inertia; off = massless-sleeve limit (no spin state,"
                                      " the sleeve rolls with the rotor and transmits only the bearing"
                                      " drag)")
+    thermal: bool = param(False, "-",
+                          doc="friction heat warms each sleeve (one temperature state per plane"
+                              " and two heat quadratures); the friction coefficient follows the"
+                              " temperature (thermal.*)")
     friction: str = param("paper", "-", doc="rotor-sleeve friction slip definition",
                           choices=("none", "paper", "kinematic"))
     semi_active_damper: bool = param(False, "-",
@@ -192,7 +225,7 @@ class Effects:
 
 GROUPS: dict[str, type] = {
     "rotor": Rotor, "positions": Positions, "unbalance": Unbalance, "world": World, "amb": Amb,
-    "contact": Contact, "sleeve": Sleeve, "bearing": Bearing, "support": Support,
+    "contact": Contact, "sleeve": Sleeve, "thermal": Thermal, "bearing": Bearing, "support": Support,
     "solver": Solver, "effects": Effects,
 }
 
@@ -208,6 +241,7 @@ class Scene:
     amb: Amb = field(default_factory=Amb)
     contact: Contact = field(default_factory=Contact)
     sleeve: Sleeve = field(default_factory=Sleeve)
+    thermal: Thermal = field(default_factory=Thermal)
     bearing: Bearing = field(default_factory=Bearing)
     support: Support = field(default_factory=Support)
     solver: Solver = field(default_factory=Solver)
