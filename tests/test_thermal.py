@@ -133,3 +133,28 @@ def test_thermal_constants_out_of_range_are_refused_naming_key_and_range(key, va
     with pytest.raises(SceneError, match=key.replace(".", r"\.") + ".*" + allowed) as exc:
         load_scene("paper", {**HEAT, key: value})
     assert "\n" not in str(exc.value)
+
+
+def test_a_rotor_sliding_to_rest_in_seized_retainers_turns_its_spin_energy_into_heat():
+    """Seized retainers (seal torque 50 N m, ten times the friction torque), kinematic slip: the
+    rotor rests at atan mu up the sleeve wall and slides to a stop, so the friction work is its
+    whole spin energy 1/2 I_p Omega_0^2 (less the sleeves' creep, < 0.2 %). The sleeves warm by
+    ~137 K, the default law lowers mu to 0.26, and the stop comes well after the Coulomb estimate
+    at the ambient mu (rotor weight W shared by the planes: torque r mu W / sqrt(1 + mu^2))."""
+    scene = load_scene("paper", {**HEAT, "bearing.seal_torque": 50.0, "effects.friction": "kinematic",
+                                 "contact.friction": 0.3, "solver.output_rate": 200.0,
+                                 "solver.t_end": 60.0})
+    r = simulate(scene)
+    rotor, mu = scene.rotor, 0.3
+    omega0 = rotor.speed_rpm * math.pi / 30
+    e = r.energy()
+    assert abs(r.rotor_speed[-1]) < 1e-3 * omega0                        # at rest
+    assert e["friction_work"][-1] == pytest.approx(0.5 * rotor.polar_inertia * omega0 ** 2,
+                                                   rel=2e-3)
+    assert e["heat_stored"][-1] + e["heat_lost"][-1] == pytest.approx(e["friction_work"][-1],
+                                                                      rel=1e-9)
+    assert 120.0 < r.temperature_rise("RB1").max() < 160.0
+    torque = rotor.journal_radius * mu * rotor.mass * scene.world.gravity / math.sqrt(1 + mu * mu)
+    coulomb_stop = scene.amb.off_time + rotor.polar_inertia * 0.99 * omega0 / torque
+    stop = r.t[np.flatnonzero(r.rotor_speed < 0.01 * omega0)[0]]
+    assert stop > 1.05 * coulomb_stop
