@@ -171,4 +171,6 @@ class Result:
                          f"{p}_bearing_load": self.bearing_load(p),
                          f"{p}_friction_power": self.friction_power(p),
                          f"{p}_max_ball_load": self.max_ball_load(p)})
+            if self.has_thermal:
+                cols[f"{p}_temperature_rise"] = self.temperature_rise(p)
         np.savez_compressed(path, states=self.Y, state_names=np.array(self.model.names), **cols)

@@ -158,3 +158,28 @@ def test_a_rotor_sliding_to_rest_in_seized_retainers_turns_its_spin_energy_into_
     coulomb_stop = scene.amb.off_time + rotor.polar_inertia * 0.99 * omega0 / torque
     stop = r.t[np.flatnonzero(r.rotor_speed < 0.01 * omega0)[0]]
     assert stop > 1.05 * coulomb_stop
+
+
+def test_drop_cli_reports_plots_and_saves_the_sleeve_heating(tmp_path, capsys):
+    import json
+
+    from physics.cli import main
+    out = tmp_path / "drop"
+    assert main(["drop", "--t-end", "0.3", "--set", "effects.thermal=true", "--set",
+                 "thermal.initial_rise=20", "--set", "thermal.mu_slope=-0.01", "--out", str(out),
+                 "--quiet"]) == 0
+    m = json.loads((out / "metrics.json").read_text())
+    rb1 = m["planes"]["RB1"]
+    assert 20.3 < rb1["max_temperature_rise_K"] < 22.0            # 20 K start + ~1 K spin-up heat
+    # it cools by ~3 mK through G while levitated, then warms
+    assert rb1["max_friction_coefficient"] == pytest.approx(0.25 * (1 - 0.01 * 20.0), rel=1e-4)
+    assert rb1["min_friction_coefficient"] == pytest.approx(
+        0.25 * (1 - 0.01 * rb1["max_temperature_rise_K"]))
+    assert "sleeve heating: RB1 +" in capsys.readouterr().out
+    assert (out / "thermal.png").stat().st_size > 10_000
+    ts = np.load(out / "timeseries.npz")
+    assert ts["RB2_temperature_rise"][0] == 20.0
+    plain = tmp_path / "plain"
+    assert main(["drop", "--t-end", "0.15", "--out", str(plain), "--quiet"]) == 0
+    assert not (plain / "thermal.png").exists()
+    assert "max_temperature_rise_K" not in json.loads((plain / "metrics.json").read_text())["planes"]["RB1"]
