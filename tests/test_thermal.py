@@ -100,7 +100,10 @@ def test_a_warm_sleeve_without_friction_cools_with_the_stated_time_constant():
 @pytest.mark.parametrize("overrides", [
     {"contact.friction": 0.5, "effects.friction": "kinematic", "thermal.mu_slope": 0.02},
     {"contact.friction": 0.3, "effects.sleeve_inertia": False, "effects.friction": "kinematic"},
-    {"thermal.conductance": 200.0, "thermal.heat_partition": 0.3, "thermal.initial_rise": 50.0}])
+    {"thermal.conductance": 200.0, "thermal.heat_partition": 0.3, "thermal.initial_rise": 50.0},
+    # the heat states after every other optional block of the layout
+    {"effects.amb": "actuator", "amb.coil_time_constant": 1e-3, "effects.semi_active_damper": True,
+     "effects.retainer_bearing": "linear"}])
 def test_heat_audit_closes_and_the_mechanical_audit_still_does(overrides):
     """heat stored + heat lost = friction work (to round-off: the quadratures are states), and
     E_mech + E_dissipated - W_external stays constant with mu following the temperature."""
