@@ -215,7 +215,7 @@ class Effects:
     thermal: bool = param(False, "-",
                           doc="friction heat warms each sleeve (one temperature state per plane"
                               " and two heat quadratures); the friction coefficient follows the"
-                              " temperature (thermal.*)")
+                              " temperature (thermal.*); beyond the paper", tag="A")
     friction: str = param("paper", "-", doc="rotor-sleeve friction slip definition",
                           choices=("none", "paper", "kinematic"))
     semi_active_damper: bool = param(False, "-",
