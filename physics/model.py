@@ -19,8 +19,8 @@ import numpy as np
 
 from . import amb as amb_mod
 from . import thermal
-from .ball_bearing import (ball_forces, ball_forces_with_dry, bearing_constants, cage_ratio, drag_torque_magnitude,
-                           film_thickness)
+from .ball_bearing import (ball_forces, ball_forces_with_dry, bearing_constants, cage_ratio,
+                           drag_torque_magnitude, film_thickness)
 from .contact import contact_potential, friction_force, geometry, normal_force, smooth_sign
 from ._jit import njit
 from .rotor import axis_at, tilt_accelerations, unbalance_force

@@ -81,7 +81,8 @@ def main() -> None:
     axes[2].set_ylabel("RB1 friction coefficient μ")
     axes[2].set_xlabel("time [s]")
     axes[0].legend(fontsize=8)
-    axes[0].set_title(f"spin-down in seized retainers, μ0 = {args.mu:g} (paper preset, kinematic slip)")
+    axes[0].set_title(f"spin-down in seized retainers, μ0 = {args.mu:g} (paper preset, "
+                      "kinematic slip)")
     for ax in axes:
         ax.grid(alpha=0.3)
     fig.savefig(out / "thermal-spin-down.png", dpi=110)
