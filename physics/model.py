@@ -43,9 +43,9 @@ from .support import housing_force
  # semi-active support damper (spec §6): C_min, C_max, lag time constant
  P_CS_MIN, P_CS_MAX, P_CS_TAU, N_P) = range(57)
 
-# sleeve heating (effects.thermal, physics/thermal.py): heat capacity, loss conductance, heat
-# partition, relative mu slope, mu ratio floor and ceiling
-P_TH_C, P_TH_G, P_TH_A, P_TH_SLOPE, P_TH_RMIN, P_TH_RMAX, N_P = range(N_P, N_P + 7)
+# sleeve heating (effects.thermal, physics/thermal.py): heat capacity, loss conductance, contact
+# heat partition, relative mu slope, mu ratio floor and ceiling, bearing heat partition
+P_TH_C, P_TH_G, P_TH_A, P_TH_SLOPE, P_TH_RMIN, P_TH_RMAX, P_TH_B, N_P = range(N_P, N_P + 8)
 
 # ------------------------------------------------------------------- flags and indices I --
 (F_GRAV, F_UNB, F_GYRO, F_AMB, F_RB, F_FILM, F_BFRIC, F_HOUSING, F_SLEEVE_J, F_FRIC, F_AUDIT,
@@ -240,7 +240,7 @@ def build_model(scene: Scene) -> Model:
     P[P_CS_MIN], P[P_CS_MAX] = s.support.damping_min, s.support.damping_max
     P[P_CS_TAU] = s.support.damper_time_constant
     if fx.thermal:
-        P[P_TH_C:P_TH_RMAX + 1] = thermal.parameters(s)
+        P[P_TH_C:P_TH_B + 1] = thermal.parameters(s)
     return Model(scene, P, I, tuple(names), np.asarray(scale), np.asarray(obs_scale))
 
 
@@ -515,11 +515,17 @@ def rhs(t, y, P, I, U, dy, aux):
         q_lost = 0.0
         w_fric = 0.0
         for k in range(2):
-            p = aux[k * N_AUX_PLANE + A_PFRIC]
-            dy[i_heat + k], q = thermal.heat_rates(p, y[i_heat + k], P[P_TH_C], P[P_TH_G],
-                                                   P[P_TH_A])
+            o = k * N_AUX_PLANE
+            p = aux[o + A_PFRIC]
+            # bearing friction power M omega_s; a massless sleeve passes its drag on as F_mu R
+            if I[I_PLANES + k * N_PLANE_IDX + J_WS] >= 0:
+                d = aux[o + A_DRAG] * aux[o + A_WS]
+            else:
+                d = aux[o + A_FMU] * P[P_RS] * aux[o + A_WS]
+            dy[i_heat + k], q = thermal.heat_rates(p, d, y[i_heat + k], P[P_TH_C], P[P_TH_G],
+                                                   P[P_TH_A], P[P_TH_B])
             q_lost += q
-            w_fric += p
+            w_fric += p + d
         dy[i_heat + 2] = q_lost
         dy[i_heat + 3] = w_fric
 

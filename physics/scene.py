@@ -127,6 +127,10 @@ class Thermal:
     heat_partition: float = param(0.5, "-", 0.0, 1.0,
                                   "share of the rotor-sleeve friction heat entering the sleeve"
                                   " (the rest heats the rotor, counted as lost)", "A")
+    drag_heat_partition: float = param(0.5, "-", 0.0, 1.0,
+                                       "share of the retainer bearing's friction heat (drag torque x"
+                                       " sleeve speed) entering the inner ring (the outer ring,"
+                                       " balls and oil take the rest, counted as lost)", "A")
     mu_slope: float = param(-1e-3, "1/K", -0.02, 0.02,
                             "relative change kappa of the friction coefficient per kelvin of"
                             " sleeve temperature rise: mu = contact.friction x clamp(1 + kappa"

@@ -6,13 +6,15 @@ limitation. Here each retainer plane k's sleeve + inner ring is one lumped body 
 temperature rise theta_k above ambient, heat capacity C = m_s c (``sleeve.mass`` x
 ``thermal.specific_heat``). It takes the share a (``thermal.heat_partition``) of the rotor-sleeve
 friction power P_k (``Result.friction_power``; the rest heats the rotor, whose ~45 kJ/K leave it
-practically cold, so it counts as lost) and loses G theta_k to the housing:
+practically cold, so it counts as lost) and the share b (``thermal.drag_heat_partition``) of its
+ball bearing's friction power D_k = M omega_s (the drag torque times the sleeve speed; the outer
+ring, balls and oil take the rest), and loses G theta_k to the housing:
 
-    C dtheta_k/dt = a P_k - G theta_k,        mu_k = mu_0 clamp(1 + kappa theta_k, r_min, r_max)
+    C dtheta_k/dt = a P_k + b D_k - G theta_k,   mu_k = mu_0 clamp(1 + kappa theta_k, r_min, r_max)
 
 Heat audit (states ``heat_lost`` and ``friction_work``): C (theta_1 + theta_2 - 2 theta_0) +
-Q_lost = W_fric = integral of P_1 + P_2, with Q_lost = integral of (1 - a)(P_1 + P_2) + G (theta_1 +
-theta_2). W_fric is part of the mechanical audit's E_dissipated.
+Q_lost = W_fric = integral of sum_k (P_k + D_k), with Q_lost = integral of sum_k [(1 - a) P_k +
+(1 - b) D_k + G theta_k]. W_fric is part of the mechanical audit's E_dissipated.
 """
 from __future__ import annotations
 
@@ -35,10 +37,10 @@ def time_constant(scene) -> float:
 
 
 def parameters(scene) -> tuple[float, ...]:
-    """(C, G, a, kappa, r_min, r_max) in the order of the kernel arguments."""
+    """(C, G, a, kappa, r_min, r_max, b) in the order of the model's P_TH_* entries."""
     t = scene.thermal
     return (heat_capacity(scene), t.conductance, t.heat_partition, t.mu_slope, t.mu_ratio_min,
-            t.mu_ratio_max)
+            t.mu_ratio_max, t.drag_heat_partition)
 
 
 @njit
@@ -54,7 +56,8 @@ def friction_coefficient(mu0, theta, kappa, r_min, r_max):
 
 
 @njit
-def heat_rates(p_fric, theta, C, G, a):
-    """(dtheta/dt, heat lost per second) of one sleeve receiving the friction power ``p_fric``."""
+def heat_rates(p_fric, p_drag, theta, C, G, a, b):
+    """(dtheta/dt, heat lost per second) of one sleeve + inner ring with the contact friction
+    power ``p_fric`` and its ball bearing's friction power ``p_drag``."""
     loss = G * theta
-    return (a * p_fric - loss) / C, (1.0 - a) * p_fric + loss
+    return (a * p_fric + b * p_drag - loss) / C, (1.0 - a) * p_fric + (1.0 - b) * p_drag + loss
