@@ -468,6 +468,8 @@ def _check_consistency(s: Scene) -> None:
         raise SceneError("solver.t_end / solver.dt must be <= 1e9 steps for the fixed-step method")
     if s.effects.amb == "actuator":
         _check_actuator(s)
+    if s.effects.thermal:
+        _check_thermal(s)
     if s.effects.semi_active_damper:
         sp = s.support
         if not s.effects.housing:
@@ -498,6 +500,20 @@ def _check_bearing_geometry(s: Scene) -> None:
                          f" bore) must be < the inner raceway radius (bearing.pitch_diameter -"
                          f" bearing.ball_diameter) / 2 = {race * 1e3:.4g} mm: the sleeve and the"
                          f" inner ring sit between them")
+
+
+MIN_THERMAL_TIME_CONSTANT = 0.1     # s: a lumped sleeve cools no faster (physics/thermal.py)
+
+
+def _check_thermal(s: Scene) -> None:
+    """The sleeve's cooling time constant m_s c / G is physical and leaves the steps alone."""
+    C = s.sleeve.mass * s.thermal.specific_heat
+    G = s.thermal.conductance
+    if G * MIN_THERMAL_TIME_CONSTANT > C:
+        raise SceneError(f"thermal.conductance = {G:g} W/K is too high for the sleeve's heat capacity"
+                         f" sleeve.mass x thermal.specific_heat = {C:.3g} J/K: the cooling time"
+                         f" constant {C / G:.3g} s must be >= {MIN_THERMAL_TIME_CONSTANT:g} s"
+                         f" (thermal.conductance <= {C / MIN_THERMAL_TIME_CONSTANT:.4g} W/K)")
 
 
 def _check_actuator(s: Scene) -> None:

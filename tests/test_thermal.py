@@ -146,6 +146,15 @@ def test_friction_heat_above_ambient_lowers_mu_by_the_stated_law():
     assert r.friction_coefficient("RB2")[-1] < 0.25 * (1.0 - 1e-3 * 40.0)    # it warmed further
 
 
+def test_a_cooling_time_constant_below_a_tenth_of_a_second_is_refused_in_one_line():
+    with pytest.raises(SceneError, match=r"thermal.conductance = 5000 W/K.*370 J/K.*0.1 s.*<= 3705"
+                       ) as exc:
+        load_scene("paper", {**HEAT, "thermal.conductance": 5000.0})
+    assert "\n" not in str(exc.value)
+    load_scene("paper", {"thermal.conductance": 5000.0})          # irrelevant while off
+    assert time_constant(load_scene("paper", {**HEAT, "thermal.conductance": 3705.0})) >= 0.1
+
+
 @pytest.mark.parametrize("key, value, allowed", [
     ("thermal.specific_heat", 50.0, r"\[100, 2000\] J/\(kg K\)"),
     ("thermal.conductance", -1.0, r"\[0, 10000\] W/K"),
