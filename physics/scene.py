@@ -115,8 +115,8 @@ class Sleeve:
 
 @dataclass(frozen=True)
 class Thermal:
-    """Lumped heating of each sleeve + inner ring by the contact friction and the friction
-    coefficient's temperature law (effects.thermal; docs/physics.md "Friction heat")."""
+    """Lumped heating of each sleeve + inner ring by the contact and bearing friction, and the
+    friction coefficient's temperature law (effects.thermal; docs/physics.md "Friction heat")."""
     specific_heat: float = param(475.0, "J/(kg K)", 100.0, 2000.0,
                                  "specific heat c of the sleeve + inner ring (bearing steel"
                                  " 100Cr6 / AISI 52100: ~475); heat capacity sleeve.mass x c", "A")
