@@ -198,7 +198,7 @@ def test_a_rotor_sliding_to_rest_in_seized_retainers_turns_its_spin_energy_into_
 def test_drop_cli_reports_plots_and_saves_the_sleeve_heating(tmp_path, capsys):
     import json
 
-    from physics.cli import main
+    from agents.cli import main
     out = tmp_path / "drop"
     assert main(["drop", "--t-end", "0.3", "--set", "effects.thermal=true", "--set",
                  "thermal.initial_rise=20", "--set", "thermal.mu_slope=-0.01", "--out", str(out),
