@@ -173,9 +173,10 @@ def test_thermal_constants_out_of_range_are_refused_naming_key_and_range(key, va
 def test_a_rotor_sliding_to_rest_in_seized_retainers_turns_its_spin_energy_into_heat():
     """Seized retainers (seal torque 50 N m, ten times the friction torque), kinematic slip: the
     rotor rests at atan mu up the sleeve wall and slides to a stop, so the friction work is its
-    whole spin energy 1/2 I_p Omega_0^2 (less the sleeves' creep, < 0.2 %). The sleeves warm by
-    ~138 K, the default law lowers mu to 0.26, and the stop comes well after the Coulomb estimate
-    at the ambient mu (rotor weight W shared by the planes: torque r mu W / sqrt(1 + mu^2))."""
+    whole spin energy 1/2 I_p Omega_0^2 (the creeping sleeves' seal drag included; measured to
+    4e-5). The sleeves warm by ~138 K, the default law lowers mu to 0.26, and the stop comes well
+    after the Coulomb estimate at the ambient mu (rotor weight W shared by the planes: torque
+    r mu W / sqrt(1 + mu^2))."""
     scene = load_scene("paper", {**HEAT, "bearing.seal_torque": 50.0, "effects.friction": "kinematic",
                                  "contact.friction": 0.3, "solver.output_rate": 200.0,
                                  "solver.t_end": 60.0})
@@ -185,7 +186,7 @@ def test_a_rotor_sliding_to_rest_in_seized_retainers_turns_its_spin_energy_into_
     e = r.energy()
     assert abs(r.rotor_speed[-1]) < 1e-3 * omega0                        # at rest
     assert e["friction_work"][-1] == pytest.approx(0.5 * rotor.polar_inertia * omega0 ** 2,
-                                                   rel=2e-3)
+                                                   rel=5e-4)
     assert e["heat_stored"][-1] + e["heat_lost"][-1] == pytest.approx(e["friction_work"][-1],
                                                                       rel=1e-9)
     assert 120.0 < r.temperature_rise("RB1").max() < 160.0
