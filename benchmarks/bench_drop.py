@@ -30,20 +30,43 @@ EFFECTS_OFF = [("full model (paper)", {}), *REDUCED,
                ("no gyroscopic coupling", {"effects.gyroscopic": False}),
                ("kinematic slip", {"effects.friction": "kinematic"}),
                ("no friction", {"effects.friction": "none"})]
+# effects beyond the paper, off by default: what switching them on costs
+EFFECTS_ON = [("sleeve heating (thermal)", {"effects.thermal": True})]
 
 
-def ns_per_rhs(result, samples=400, reps=50) -> float:
-    """Median cost of one right-hand-side evaluation over states sampled from a run [ns]."""
+def _rhs_timer(result, samples=400):
+    """A function timing one pass of ``reps`` rhs evaluations over states sampled from a run,
+    returning ns per evaluation."""
     m = result.model
     Y = result.Y[:: max(1, len(result.Y) // samples)].copy()
     U = m.controls(False)
     dy, aux = np.empty(m.n_state), np.empty(N_AUX)
-    times = []
-    for _ in range(5):
+
+    def time_once(reps: int) -> float:
         t0 = time.perf_counter()
         _rhs_loop(Y, m.P, m.I, U, dy, aux, reps)
-        times.append((time.perf_counter() - t0) / (reps * len(Y)) * 1e9)
-    return statistics.median(times)
+        return (time.perf_counter() - t0) / (reps * len(Y)) * 1e9
+    return time_once
+
+
+def ns_per_rhs(result, samples=400, reps=50) -> float:
+    """Median cost of one right-hand-side evaluation over states sampled from a run [ns]."""
+    time_once = _rhs_timer(result, samples)
+    return statistics.median(time_once(reps) for _ in range(5))
+
+
+def rhs_cost_ratio(result, reference, rounds=41, reps=5) -> float:
+    """Median over ``rounds`` interleaved pairs of (ns per rhs of ``result``) / (ns per rhs of
+    ``reference``): short alternating passes, so load from other processes hits both alike."""
+    a, b = _rhs_timer(result), _rhs_timer(reference)
+    ratios = []
+    for i in range(rounds):
+        if i % 2:                       # alternate which goes first
+            tb, ta = b(reps), a(reps)
+        else:
+            ta, tb = a(reps), b(reps)
+        ratios.append(ta / tb)
+    return statistics.median(ratios)
 
 
 def _make_loop():
@@ -71,7 +94,7 @@ def run_case(overrides: dict, t_end: float, repeats: int, source: str = "paper")
     wall = statistics.median(walls)
     return dict(n_state=last.model.n_state, wall_s_per_sim_s=wall / t_end,
                 rhs_evaluations=last.stats.rhs_evaluations, steps=last.stats.steps,
-                rejected=last.stats.rejected_steps, ns_per_rhs=ns_per_rhs(last))
+                rejected=last.stats.rejected_steps, ns_per_rhs=ns_per_rhs(last), result=last)
 
 
 def compile_times() -> dict:
@@ -107,18 +130,31 @@ def main() -> None:
     for mu in (0.25, 0.5):
         for slip in ("paper", "kinematic"):
             row = run_case({"contact.friction": mu, "effects.friction": slip}, args.t_end, args.repeats)
+            del row["result"]
             out["paper"][f"mu={mu} {slip}"] = row
             print(f"  mu = {mu:<5} {slip:9} slip: {row['wall_s_per_sim_s']:.4f} wall s per simulated s, "
                   f"{row['rhs_evaluations']} rhs evaluations, {row['ns_per_rhs']:.0f} ns per rhs")
 
-    print(f"\ncost of each effect (mu = 0.25, median of {args.repeats}):")
+    print(f"\ncost of each effect, off (on for those the paper lacks; mu = 0.25, median of "
+          f"{args.repeats}):")
     print(f"  {'scene':30}{'states':>7}{'wall s/sim s':>14}{'rhs evals':>11}{'ns/rhs':>8}")
     out["effects"] = {}
-    for name, ov in EFFECTS_OFF:
+    results = {}
+    for name, ov in EFFECTS_OFF + EFFECTS_ON:
         row = run_case(ov, args.t_end, args.repeats)
+        results[name] = row.pop("result")
         out["effects"][name] = row
         print(f"  {name:30}{row['n_state']:7d}{row['wall_s_per_sim_s']:14.4f}"
               f"{row['rhs_evaluations']:11d}{row['ns_per_rhs']:8.0f}")
+    # an effect that is off must cost nothing: ns per rhs relative to the full model, measured
+    # as the median of interleaved pairs (robust to other load on the machine)
+    full = results[EFFECTS_OFF[0][0]]
+    out["rhs_cost_vs_full"] = {}
+    print("\nns per rhs relative to the full model (median of 41 interleaved pairs):")
+    for name, _ in EFFECTS_OFF[1:] + EFFECTS_ON:
+        ratio = rhs_cost_ratio(results[name], full)
+        out["rhs_cost_vs_full"][name] = ratio
+        print(f"  {name:30}{ratio:8.3f}")
     if args.json:
         with open(args.json, "w") as f:
             json.dump(out, f, indent=2)

@@ -137,6 +137,10 @@ def _post_fault_tables(m: dict) -> list[str]:
               "ball" + (f" (s0 = 1 at {p0:.0f} MPa for this bearing)" if p0 else ""),
               "friction heat: generated at the rotor-sleeve contact after the fault (net: under the "
               "paper slip law the contact can also return energy)"]
+    if "max_temperature_rise_K" in next(iter(m["planes"].values())):       # effects.thermal
+        lines.append("sleeve heating: " + ", ".join(
+            f"{p} +{v['max_temperature_rise_K']:.1f} K max, mu {v['min_friction_coefficient']:.3f}"
+            f"-{v['max_friction_coefficient']:.3f}" for p, v in m["planes"].items()))
     return lines
 
 

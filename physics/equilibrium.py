@@ -11,7 +11,7 @@ from .ball_bearing import ball_forces
 from .model import (I_PLANES, J_HX, J_SX, N_PLANE_IDX, P_G, P_HALF_PLAY,
                     P_KLIN, P_KS, P_KTOT, P_MH, P_MS, P_NB, P_UB_PHASE, RB_LINEAR, RB_SM, F_RB, F_AMB,
                     AMB_LINEAR, S_PHI, S_VX, S_X, S_W, Model, AMB_ACTUATOR, AMB_AXES, I_AMB_INT,
-                    I_AMB_FILT, I_AMB_COIL, P_AMB_IFF1, I_CS)
+                    I_AMB_FILT, I_AMB_COIL, P_AMB_IFF1, I_CS, I_THERM)
 from .amb import actuator_constants, pid_dynamic_stiffness, pid_steady_states
 from .rotor import steady_unbalance_orbit
 
@@ -55,6 +55,8 @@ def levitated_state(model: Model) -> np.ndarray:
         _actuator_states(model, y, pos, omega)
     if I[I_CS] >= 0:
         y[I[I_CS]] = y[I[I_CS] + 1] = s.support.damping
+    if I[I_THERM] >= 0:                 # sleeve temperatures (effects.thermal)
+        y[I[I_THERM]] = y[I[I_THERM] + 1] = s.thermal.initial_rise
     uy = sleeve_rest_offset(P, I) if I[F_RB] in (RB_SM, RB_LINEAR) else 0.0
     sleeve_mass = P[P_MS] if I[I_PLANES + J_SX] >= 0 else 0.0
     for k in range(2):

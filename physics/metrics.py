@@ -117,6 +117,15 @@ def retainer_loading(result: Result, plane: str, post: np.ndarray) -> dict:
                 max_sleeve_speed_rpm=float(np.abs(ws).max() * RPM) if len(ws) else 0.0)
 
 
+def sleeve_heating(result: Result, plane: str) -> dict:
+    """effects.thermal: the sleeve's largest and final temperature rise above ambient and the
+    friction coefficient's range over the run (mu(theta), physics/thermal.py)."""
+    theta, mu = result.temperature_rise(plane), result.friction_coefficient(plane)
+    return dict(max_temperature_rise_K=float(theta.max()),
+                final_temperature_rise_K=float(theta[-1]),
+                min_friction_coefficient=float(mu.min()), max_friction_coefficient=float(mu.max()))
+
+
 def pre_fault(result: Result) -> np.ndarray:
     """Samples while the AMBs still carry the rotor (every sample when the run ends first)."""
     if result.t_fault is None:
@@ -271,6 +280,8 @@ def compute_metrics(result: Result) -> dict:
                      pre_fault_peak_contact_force_N=float(f_pre.max()) if len(f_pre) else 0.0,
                      final_sleeve_speed_rpm=float(result.sleeve_speed(p)[-1] * RPM))
         entry.update(retainer_loading(result, p, post))
+        if result.has_thermal:
+            entry.update(sleeve_heating(result, p))
         entry.update(whirl(result, p, t_fault))
         out["planes"][p] = entry
     out["backward_whirl"] = any(out["planes"][p]["backward_whirl"] for p in PLANES)

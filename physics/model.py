@@ -18,8 +18,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import amb as amb_mod
-from .ball_bearing import (ball_forces, bearing_constants, cage_ratio, drag_torque_magnitude,
-                           film_thickness)
+from . import thermal
+from .ball_bearing import (ball_forces, ball_forces_with_dry, bearing_constants, cage_ratio,
+                           drag_torque_magnitude, film_thickness)
 from .contact import contact_potential, friction_force, geometry, normal_force, smooth_sign
 from ._jit import njit
 from .rotor import axis_at, tilt_accelerations, unbalance_force
@@ -42,6 +43,10 @@ from .support import housing_force
  # semi-active support damper (spec §6): C_min, C_max, lag time constant
  P_CS_MIN, P_CS_MAX, P_CS_TAU, N_P) = range(57)
 
+# sleeve heating (effects.thermal, physics/thermal.py): heat capacity, loss conductance, contact
+# heat partition, relative mu slope, mu ratio floor and ceiling, bearing heat partition
+P_TH_C, P_TH_G, P_TH_A, P_TH_SLOPE, P_TH_RMIN, P_TH_RMAX, P_TH_B, N_P = range(N_P, N_P + 8)
+
 # ------------------------------------------------------------------- flags and indices I --
 (F_GRAV, F_UNB, F_GYRO, F_AMB, F_RB, F_FILM, F_BFRIC, F_HOUSING, F_SLEEVE_J, F_FRIC, F_AUDIT,
  S_X, S_Y, S_A, S_B, S_VX, S_VY, S_VA, S_VB, S_W, S_PHI, S_EDISS, S_WEXT, I_PLANES) = range(24)
@@ -51,6 +56,10 @@ N_I_CORE = I_PLANES + 2 * N_PLANE_IDX
 # appended blocks (first state index, -1 when absent): actuator PID integrals, derivative-filter
 # states and coil currents (4 axes each: AMB1 x, AMB1 y, AMB2 x, AMB2 y), damper C_s (2 housings)
 I_AMB_INT, I_AMB_FILT, I_AMB_COIL, I_CS, N_I = range(N_I_CORE, N_I_CORE + 5)
+
+# sleeve temperatures of RB1 and RB2, then the heat audit's heat_lost and friction_work
+# (thermal.STATE_NAMES; -1 when effects.thermal is off)
+I_THERM, N_I = N_I, N_I + 1
 AMB_AXES = ("AMB1.x", "AMB1.y", "AMB2.x", "AMB2.y")
 
 AMB_NONE, AMB_LINEAR, AMB_ACTUATOR = 0, 1, 2
@@ -185,6 +194,13 @@ def build_model(scene: Scene) -> Model:
     e_spin = 0.5 * s.rotor.polar_inertia * spin ** 2
     I[S_EDISS] = add("E_dissipated", e_scale, e_spin)
     I[S_WEXT] = add("W_external", e_scale, e_spin)
+    if fx.thermal:
+        I[I_THERM] = len(names)
+        for name in thermal.STATE_NAMES:
+            if name.endswith("temperature"):
+                add(name, thermal.TEMPERATURE_SIZE, thermal.TEMPERATURE_OBS)
+            else:
+                add(name, e_scale, e_spin)
 
     # parameters
     g = s.world.gravity if fx.gravity else 0.0
@@ -223,6 +239,8 @@ def build_model(scene: Scene) -> Model:
         P[P_AMB_IFF1], P[P_AMB_IFF2] = ac.feedforward
     P[P_CS_MIN], P[P_CS_MAX] = s.support.damping_min, s.support.damping_max
     P[P_CS_TAU] = s.support.damper_time_constant
+    if fx.thermal:
+        P[P_TH_C:P_TH_B + 1] = thermal.parameters(s)
     return Model(scene, P, I, tuple(names), np.asarray(scale), np.asarray(obs_scale))
 
 
@@ -349,6 +367,10 @@ def rhs(t, y, P, I, U, dy, aux):
             sx, sy, svx, svy = hx, hy, hvx, hvy
         i_ws = I[base + J_WS]
         ws = y[i_ws] if i_ws >= 0 else 0.0
+        mu = P[P_MU]
+        if I[I_THERM] >= 0:                      # effects.thermal: mu follows the sleeve's heat
+            mu = thermal.friction_coefficient(mu, y[I[I_THERM] + k], P[P_TH_SLOPE],
+                                              P[P_TH_RMIN], P[P_TH_RMAX])
 
         # --- contact, eqs. 14-19 ---
         er, nx, ny = geometry(px - sx, py - sy)
@@ -367,9 +389,9 @@ def rhs(t, y, P, I, U, dy, aux):
         if fric != FRIC_NONE and f_r > 0.0:
             if I[F_SLEEVE_J]:
                 if fric == FRIC_PAPER:
-                    f_mu = friction_force(P[P_MU], f_r, W - ws, P[P_WL])
+                    f_mu = friction_force(mu, f_r, W - ws, P[P_WL])
                 else:
-                    f_mu = friction_force(P[P_MU], f_r, et + W * P[P_RJ] - ws * P[P_RS], P[P_VL])
+                    f_mu = friction_force(mu, f_r, et + W * P[P_RJ] - ws * P[P_RS], P[P_VL])
                 p_fric = f_mu * (et + W * P[P_RJ] - ws * P[P_RS])
                 p_diss += p_fric
             else:
@@ -384,8 +406,8 @@ def rhs(t, y, P, I, U, dy, aux):
                 if I[F_BFRIC]:
                     drag = drag_torque_magnitude(w_roll, f_r, P[P_M0_LOW], P[P_M0_COEF],
                                                  P[P_M1_COEF], P[P_MSEAL]) / P[P_RS]
-                f_mu = sgn * min(P[P_MU] * f_r, drag)
-                ws = w_roll * min(1.0, P[P_MU] * f_r / drag) if drag > 0.0 else w_roll
+                f_mu = sgn * min(mu * f_r, drag)
+                ws = w_roll * min(1.0, mu * f_r / drag) if drag > 0.0 else w_roll
                 p_fric = f_mu * (et + W * P[P_RJ] - ws * P[P_RS])
                 # all the rotor loses: p_fric plus the bearing drag f_mu ws R the sleeve passes on
                 p_diss += f_mu * (et + W * P[P_RJ])
@@ -413,20 +435,21 @@ def rhs(t, y, P, I, U, dy, aux):
             if I[F_FILM]:
                 h, dh_dw = film_thickness(ws, P[P_FILM])
             cage = P[P_CAGE] * y[i_th]
-            qx, qy, V, dV, qsum, qmax = ball_forces(ux, uy, cage, int(P[P_NB]), P[P_HALF_PLAY], h,
-                                                    P[P_KTOT])
+            if I[F_FILM] and i_ws < 0:
+                # massless sleeve: the film follows the algebraic rolling speed, so the audit
+                # keeps the ball potential at zero film (mechanical_energy) and counts the
+                # film's share of the ball forces as a non-potential force (dV: the zero-film
+                # cage derivative, to match); one pass over the balls gives both
+                qx, qy, _, _, qsum, qmax, qx0, qy0, dV = ball_forces_with_dry(
+                    ux, uy, cage, int(P[P_NB]), P[P_HALF_PLAY], h, P[P_KTOT])
+                p_ext += (qx0 - qx) * uvx + (qy0 - qy) * uvy
+            else:
+                qx, qy, _, dV, qsum, qmax = ball_forces(ux, uy, cage, int(P[P_NB]),
+                                                        P[P_HALF_PLAY], h, P[P_KTOT])
             bfx = -qx - P[P_CB] * uvx
             bfy = -qy - P[P_CB] * uvy
             load = math.sqrt(qx * qx + qy * qy)
             p_diss += P[P_CB] * (uvx * uvx + uvy * uvy)
-            if I[F_FILM] and i_ws < 0:
-                # massless sleeve: the film follows the algebraic rolling speed, so the audit
-                # keeps the ball potential at zero film (mechanical_energy) and counts the
-                # film's share of the ball forces as a non-potential force (dV below: the
-                # zero-film cage derivative, to match)
-                qx0, qy0, _, dV, _, _ = ball_forces(ux, uy, cage, int(P[P_NB]), P[P_HALF_PLAY],
-                                                    0.0, P[P_KTOT])
-                p_ext += (qx0 - qx) * uvx + (qy0 - qy) * uvy
             p_ext += dV * P[P_CAGE] * ws          # cage rotation under load (no torque in the model)
             dy[i_th] = ws
         elif I[F_RB] == RB_LINEAR:
@@ -486,6 +509,25 @@ def rhs(t, y, P, I, U, dy, aux):
         aux[o + A_DRAG] = drag_t
         aux[o + A_PFRIC] = p_fric
         aux[o + A_QMAX] = qmax
+
+    i_heat = I[I_THERM]
+    if i_heat >= 0:                              # effects.thermal: sleeve heating, heat audit
+        q_lost = 0.0
+        w_fric = 0.0
+        for k in range(2):
+            o = k * N_AUX_PLANE
+            p = aux[o + A_PFRIC]
+            # bearing friction power M omega_s; a massless sleeve passes its drag on as F_mu R
+            if I[I_PLANES + k * N_PLANE_IDX + J_WS] >= 0:
+                d = aux[o + A_DRAG] * aux[o + A_WS]
+            else:
+                d = aux[o + A_FMU] * P[P_RS] * aux[o + A_WS]
+            dy[i_heat + k], q = thermal.heat_rates(p, d, y[i_heat + k], P[P_TH_C], P[P_TH_G],
+                                                   P[P_TH_A], P[P_TH_B])
+            q_lost += q
+            w_fric += p + d
+        dy[i_heat + 2] = q_lost
+        dy[i_heat + 3] = w_fric
 
     # rotor equations of motion
     dy[I[S_X]] = vx

@@ -117,13 +117,32 @@ def pressure_levels(bearing) -> dict[str, float]:
             f"ISO 76 nominal C0 level {ISO76_C0_PRESSURE * 1e-6:.0f} MPa": ISO76_C0_PRESSURE * 1e-6}
 
 
+def plot_thermal(result: Result, path: Path, title: str = "") -> Path:
+    """effects.thermal: each sleeve's temperature rise and its friction coefficient mu(theta)."""
+    fig, axes = plt.subplots(2, 1, figsize=(9, 5.5), sharex=True, constrained_layout=True)
+    for p in PLANES:
+        axes[0].plot(result.t, result.temperature_rise(p), lw=1.0, label=p)
+        axes[1].plot(result.t, result.friction_coefficient(p), lw=1.0, label=p)
+    axes[0].set_ylabel("sleeve temperature rise [K]")
+    axes[0].set_title(f"Sleeve heating {title}".strip())
+    axes[1].set_ylabel("friction coefficient μ")
+    axes[1].set_xlabel("time [s]")
+    for ax in axes:
+        ax.legend(fontsize=7)
+        ax.grid(alpha=0.3)
+    return save_figure(fig, path)
+
+
 def plot_drop(result: Result, out_dir: Path, title: str = "") -> list[Path]:
     out_dir = Path(out_dir)
-    return [plot_orbits(result, out_dir / "orbits.png", title),
-            plot_forces(result, out_dir / "contact_forces.png", title),
-            plot_speeds(result, out_dir / "speeds.png", title),
-            plot_housing(result, out_dir / "housing.png", title),
-            plot_retainer(result, out_dir / "retainer.png", title)]
+    paths = [plot_orbits(result, out_dir / "orbits.png", title),
+             plot_forces(result, out_dir / "contact_forces.png", title),
+             plot_speeds(result, out_dir / "speeds.png", title),
+             plot_housing(result, out_dir / "housing.png", title),
+             plot_retainer(result, out_dir / "retainer.png", title)]
+    if result.has_thermal:
+        paths.append(plot_thermal(result, out_dir / "thermal.png", title))
+    return paths
 
 
 def save_figure(fig, path: Path) -> Path:

@@ -5,9 +5,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .model import (A_DELTA, A_DRAG, A_FMU, A_FR, A_LOAD, A_PFRIC, A_QMAX, A_WS, I_PLANES, J_HX,
-                    J_SX, N_AUX_PLANE, N_PLANE_IDX, P_Z_AMB1, P_Z_RB1, PLANES, S_EDISS, S_W, S_WEXT, S_X,
-                    Model, energies)
+from . import thermal
+from .model import (A_DELTA, A_DRAG, A_FMU, A_FR, A_LOAD, A_PFRIC, A_QMAX, A_WS, I_PLANES, I_THERM,
+                    J_HX, J_SX, N_AUX_PLANE, N_PLANE_IDX, P_MU, P_TH_C, P_TH_RMAX, P_TH_RMIN,
+                    P_TH_SLOPE, P_Z_AMB1, P_Z_RB1, PLANES, S_EDISS, S_W, S_WEXT, S_X, Model, energies)
 
 AMB_PLANES = ("AMB1", "AMB2")
 
@@ -118,15 +119,44 @@ class Result:
         negative: in a whirl, and slightly while the sleeve rolls at omega_s = Omega."""
         return self._aux(plane, A_PFRIC)
 
+    # -- sleeve heating (effects.thermal) ---------------------------------------------------
+    @property
+    def has_thermal(self) -> bool:
+        return bool(self.model.I[I_THERM] >= 0)
+
+    def temperature_rise(self, plane: str) -> np.ndarray:
+        """Sleeve temperature above ambient theta [K] (zeros without effects.thermal)."""
+        k = self._plane(plane)
+        return self.Y[:, self.model.I[I_THERM] + k] if self.has_thermal else np.zeros(len(self.t))
+
+    def friction_coefficient(self, plane: str) -> np.ndarray:
+        """The rotor-sleeve friction coefficient mu at this plane (mu(theta) with
+        effects.thermal, else the constant contact.friction)."""
+        P = self.model.P
+        if not self.has_thermal:
+            return np.full(len(self.t), P[P_MU])
+        return np.array([thermal.friction_coefficient(P[P_MU], th, P[P_TH_SLOPE], P[P_TH_RMIN],
+                                                      P[P_TH_RMAX])
+                         for th in self.temperature_rise(plane)])
+
     # -- energy audit ---------------------------------------------------------------------
     def energy(self) -> dict[str, np.ndarray]:
         """Mechanical energy, dissipated energy and external work [J] at each sample.
 
-        Balance: E_mech(t) + E_dissipated(t) - W_external(t) = E_mech(0).
+        Balance: E_mech(t) + E_dissipated(t) - W_external(t) = E_mech(0). With effects.thermal
+        also the heat audit (physics/thermal.py): heat_stored (in the two sleeves, above their
+        start) + heat_lost (to the housings and the rotor) = friction_work (the contact
+        friction's share of E_dissipated).
         """
-        E = energies(self.Y, self.model.P, self.model.I)
-        return dict(mechanical=E, dissipated=self.Y[:, self.model.I[S_EDISS]],
-                    external=self.Y[:, self.model.I[S_WEXT]])
+        m = self.model
+        E = energies(self.Y, m.P, m.I)
+        out = dict(mechanical=E, dissipated=self.Y[:, m.I[S_EDISS]], external=self.Y[:, m.I[S_WEXT]])
+        if self.has_thermal:
+            i = m.I[I_THERM]
+            theta = self.Y[:, i] + self.Y[:, i + 1]
+            out.update(heat_stored=m.P[P_TH_C] * (theta - theta[0]), heat_lost=self.Y[:, i + 2],
+                       friction_work=self.Y[:, i + 3])
+        return out
 
     def save_npz(self, path) -> None:
         """Time series with named columns (SI units)."""
@@ -141,4 +171,6 @@ class Result:
                          f"{p}_bearing_load": self.bearing_load(p),
                          f"{p}_friction_power": self.friction_power(p),
                          f"{p}_max_ball_load": self.max_ball_load(p)})
+            if self.has_thermal:
+                cols[f"{p}_temperature_rise"] = self.temperature_rise(p)
         np.savez_compressed(path, states=self.Y, state_names=np.array(self.model.names), **cols)

@@ -115,6 +115,39 @@ class Sleeve:
 
 
 @dataclass(frozen=True)
+class Thermal:
+    """Lumped heating of each sleeve + inner ring by the contact and bearing friction, and the
+    friction coefficient's temperature law (effects.thermal; docs/physics.md "Friction heat")."""
+    specific_heat: float = param(475.0, "J/(kg K)", 100.0, 2000.0,
+                                 "specific heat c of the sleeve + inner ring (bearing steel"
+                                 " 100Cr6 / AISI 52100: ~475); heat capacity sleeve.mass x c", "A")
+    conductance: float = param(0.5, "W/K", 0.0, 1e4,
+                               "heat loss G from a sleeve to the housing per kelvin (ball set,"
+                               " air); 0 = adiabatic; time constant sleeve.mass c / G = 741 s"
+                               " at the defaults", "A")
+    heat_partition: float = param(0.5, "-", 0.0, 1.0,
+                                  "share of the rotor-sleeve friction heat entering the sleeve"
+                                  " (the rest heats the rotor, counted as lost)", "A")
+    drag_heat_partition: float = param(0.5, "-", 0.0, 1.0,
+                                       "share of the retainer bearing's friction heat (drag torque x"
+                                       " sleeve speed) entering the inner ring (the outer ring,"
+                                       " balls and oil take the rest, counted as lost)", "A")
+    mu_slope: float = param(-1e-3, "1/K", -0.02, 0.02,
+                            "relative change kappa of the friction coefficient per kelvin of"
+                            " sleeve temperature rise: mu = contact.friction x clamp(1 + kappa"
+                            " theta, mu_ratio_min, mu_ratio_max); < 0: oxide films (default),"
+                            " > 0: the paper's rise with heat and wear", "A")
+    mu_ratio_min: float = param(0.5, "-", 0.0, 1.0,
+                                "floor of mu / contact.friction under heating", "A")
+    mu_ratio_max: float = param(2.0, "-", 1.0, 10.0,
+                                "ceiling of mu / contact.friction under heating (mu_slope > 0)",
+                                "A")
+    initial_rise: float = param(0.0, "K", 0.0, 1000.0,
+                                "sleeve temperature rise above ambient at t = 0 (e.g. after an"
+                                " earlier drop)", "A")
+
+
+@dataclass(frozen=True)
 class Bearing:
     """Retainer ball bearing 6016 (spec §4)."""
     pitch_diameter: float = param(0.110, "m", 1e-3, 2.0, "pitch diameter d_m")
@@ -184,6 +217,10 @@ class Effects:
                                  doc="sleeve spin inertia; off = massless-sleeve limit (no spin state,"
                                      " the sleeve rolls with the rotor and transmits only the bearing"
                                      " drag)")
+    thermal: bool = param(False, "-",
+                          doc="friction heat warms each sleeve (one temperature state per plane"
+                              " and two heat quadratures); the friction coefficient follows the"
+                              " temperature (thermal.*); beyond the paper", tag="A")
     friction: str = param("paper", "-", doc="rotor-sleeve friction slip definition",
                           choices=("none", "paper", "kinematic"))
     semi_active_damper: bool = param(False, "-",
@@ -193,7 +230,7 @@ class Effects:
 
 GROUPS: dict[str, type] = {
     "rotor": Rotor, "positions": Positions, "unbalance": Unbalance, "world": World, "amb": Amb,
-    "contact": Contact, "sleeve": Sleeve, "bearing": Bearing, "support": Support,
+    "contact": Contact, "sleeve": Sleeve, "thermal": Thermal, "bearing": Bearing, "support": Support,
     "solver": Solver, "effects": Effects,
 }
 
@@ -209,6 +246,7 @@ class Scene:
     amb: Amb = field(default_factory=Amb)
     contact: Contact = field(default_factory=Contact)
     sleeve: Sleeve = field(default_factory=Sleeve)
+    thermal: Thermal = field(default_factory=Thermal)
     bearing: Bearing = field(default_factory=Bearing)
     support: Support = field(default_factory=Support)
     solver: Solver = field(default_factory=Solver)
@@ -463,6 +501,8 @@ def _check_consistency(s: Scene) -> None:
         raise SceneError("solver.t_end / solver.dt must be <= 1e9 steps for the fixed-step method")
     if s.effects.amb == "actuator":
         _check_actuator(s)
+    if s.effects.thermal:
+        _check_thermal(s)
     if s.effects.semi_active_damper:
         sp = s.support
         if not s.effects.housing:
@@ -493,6 +533,20 @@ def _check_bearing_geometry(s: Scene) -> None:
                          f" bore) must be < the inner raceway radius (bearing.pitch_diameter -"
                          f" bearing.ball_diameter) / 2 = {race * 1e3:.4g} mm: the sleeve and the"
                          f" inner ring sit between them")
+
+
+MIN_THERMAL_TIME_CONSTANT = 0.1     # s: a lumped sleeve cools no faster (physics/thermal.py)
+
+
+def _check_thermal(s: Scene) -> None:
+    """The sleeve's cooling time constant m_s c / G is physical and leaves the steps alone."""
+    C = s.sleeve.mass * s.thermal.specific_heat
+    G = s.thermal.conductance
+    if G * MIN_THERMAL_TIME_CONSTANT > C:
+        raise SceneError(f"thermal.conductance = {G:g} W/K is too high for the sleeve's heat capacity"
+                         f" sleeve.mass x thermal.specific_heat = {C:.3g} J/K: the cooling time"
+                         f" constant {C / G:.3g} s must be >= {MIN_THERMAL_TIME_CONSTANT:g} s"
+                         f" (thermal.conductance <= {C / MIN_THERMAL_TIME_CONSTANT:.4g} W/K)")
 
 
 def _check_actuator(s: Scene) -> None:

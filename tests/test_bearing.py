@@ -4,7 +4,7 @@ import math
 import numpy as np
 import pytest
 
-from physics.ball_bearing import (ball_forces, bearing_constants, contact_pressure_coef,
+from physics.ball_bearing import (ball_forces, ball_forces_with_dry, bearing_constants, contact_pressure_coef,
                                   drag_torque_magnitude, film_thickness, hertz_constant,
                                   max_contact_pressure, raceway_radii, reduced_modulus)
 from physics.scene import Scene
@@ -61,6 +61,19 @@ def test_film_is_6um_at_spun_up_sleeve_speed_zero_at_rest_and_smooth():
     assert film_thickness(-500.0, BC.film_coef)[0] == film_thickness(500.0, BC.film_coef)[0]
     dh = (film_thickness(800.0 + 1e-3, BC.film_coef)[0] - film_thickness(800.0 - 1e-3, BC.film_coef)[0]) / 2e-3
     assert film_thickness(800.0, BC.film_coef)[1] == pytest.approx(dh, rel=1e-6)
+
+
+@pytest.mark.parametrize("h", [0.0, 2e-6, 6e-6])
+def test_one_pass_film_and_dry_sums_equal_two_calls_bit_for_bit(h):
+    """The massless-sleeve audit reads the zero-film forces from the same ball pass as the film
+    forces (one loop instead of two): the results must be the separate calls' exactly."""
+    rng = np.random.default_rng(3)
+    for ux, uy, cage in rng.uniform((-2e-5, -2e-5, 0.0), (2e-5, 2e-5, 6.3), size=(50, 3)):
+        both = ball_forces_with_dry(ux, uy, cage, B.balls, HALF, h, BC.K_tot)
+        film = ball_forces(ux, uy, cage, B.balls, HALF, h, BC.K_tot)
+        dry = ball_forces(ux, uy, cage, B.balls, HALF, 0.0, BC.K_tot)
+        assert both[:6] == film
+        assert both[6:] == (dry[0], dry[1], dry[3])
 
 
 def test_film_closes_most_of_the_radial_play():

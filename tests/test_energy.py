@@ -36,7 +36,11 @@ def test_without_friction_and_damping_mechanical_energy_is_conserved():
                                        {"effects.sleeve_inertia": False, "contact.friction": 0.5,
                                         "effects.friction": "kinematic"},
                                        {"effects.sleeve_inertia": False, "effects.ehl_film": False,
-                                        "contact.friction": 0.5, "effects.friction": "kinematic"}])
+                                        "contact.friction": 0.5, "effects.friction": "kinematic"},
+                                       # mu following the sleeve temperature (test_thermal.py
+                                       # checks the heat audit: stored + lost = friction work)
+                                       {"effects.thermal": True, "thermal.mu_slope": 0.02,
+                                        "thermal.initial_rise": 30.0}])
 def test_energy_lost_equals_integrated_dissipated_power(overrides):
     r = simulate(load_scene("paper", overrides), t_end=0.4)
     res, e = energy_residual(r)

@@ -1,0 +1,63 @@
+"""Friction heat in the retainer sleeves and the friction coefficient's temperature law
+(``effects.thermal``; docs/physics.md, "Friction heat and mu(T)").
+
+The paper keeps mu constant and names its change with heat and wear as the model's main
+limitation. Here each retainer plane k's sleeve + inner ring is one lumped body at the
+temperature rise theta_k above ambient, heat capacity C = m_s c (``sleeve.mass`` x
+``thermal.specific_heat``). It takes the share a (``thermal.heat_partition``) of the rotor-sleeve
+friction power P_k (``Result.friction_power``; the rest heats the rotor, whose ~45 kJ/K leave it
+practically cold, so it counts as lost) and the share b (``thermal.drag_heat_partition``) of its
+ball bearing's friction power D_k = M omega_s (the drag torque times the sleeve speed; the outer
+ring, balls and oil take the rest), and loses G theta_k to the housing:
+
+    C dtheta_k/dt = a P_k + b D_k - G theta_k,   mu_k = mu_0 clamp(1 + kappa theta_k, r_min, r_max)
+
+Heat audit (states ``heat_lost`` and ``friction_work``): C (theta_1 + theta_2 - 2 theta_0) +
+Q_lost = W_fric = integral of sum_k (P_k + D_k), with Q_lost = integral of sum_k [(1 - a) P_k +
+(1 - b) D_k + G theta_k]. W_fric is part of the mechanical audit's E_dissipated.
+"""
+from __future__ import annotations
+
+from ._jit import njit
+
+STATE_NAMES = ("RB1.temperature", "RB2.temperature", "heat_lost", "friction_work")
+TEMPERATURE_SIZE = 10.0          # K: tolerance size of a temperature state (atol = rtol x size)
+TEMPERATURE_OBS = 100.0          # K: its observation size
+
+
+def heat_capacity(scene) -> float:
+    """C = m_s c of one sleeve + inner ring [J/K]."""
+    return scene.sleeve.mass * scene.thermal.specific_heat
+
+
+def time_constant(scene) -> float:
+    """C / G [s]: how fast a warm sleeve cools to the housing (inf when adiabatic)."""
+    g = scene.thermal.conductance
+    return heat_capacity(scene) / g if g > 0.0 else float("inf")
+
+
+def parameters(scene) -> tuple[float, ...]:
+    """(C, G, a, kappa, r_min, r_max, b) in the order of the model's P_TH_* entries."""
+    t = scene.thermal
+    return (heat_capacity(scene), t.conductance, t.heat_partition, t.mu_slope, t.mu_ratio_min,
+            t.mu_ratio_max, t.drag_heat_partition)
+
+
+@njit
+def friction_coefficient(mu0, theta, kappa, r_min, r_max):
+    """mu(theta) = mu_0 clamp(1 + kappa theta, r_min, r_max): linear in the temperature rise,
+    bounded (a floor for oxide films, a ceiling for the paper's rise with heat and wear)."""
+    r = 1.0 + kappa * theta
+    if r < r_min:
+        r = r_min
+    elif r > r_max:
+        r = r_max
+    return mu0 * r
+
+
+@njit
+def heat_rates(p_fric, p_drag, theta, C, G, a, b):
+    """(dtheta/dt, heat lost per second) of one sleeve + inner ring with the contact friction
+    power ``p_fric`` and its ball bearing's friction power ``p_drag``."""
+    loss = G * theta
+    return (a * p_fric + b * p_drag - loss) / C, (1.0 - a) * p_fric + (1.0 - b) * p_drag + loss
