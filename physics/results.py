@@ -5,7 +5,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .model import (A_DELTA, A_DRAG, A_FMU, A_FR, A_LOAD, A_PFRIC, A_QMAX, A_WS, I_PLANES, J_HX,
+from .model import (A_STATOR, A_DELTA, A_DRAG, A_FMU, A_FR, A_LOAD, A_PFRIC, A_QMAX, A_WS, I_PLANES, J_HX,
                     J_SX, N_AUX_PLANE, N_PLANE_IDX, P_Z_AMB1, P_Z_RB1, PLANES, S_EDISS, S_W, S_WEXT, S_X,
                     Model, energies)
 
@@ -110,6 +110,11 @@ class Result:
     def max_ball_load(self, plane: str) -> np.ndarray:
         """Load on the most heavily loaded ball [N] (Sopanen-Mikkola bearing; zero otherwise)."""
         return self._aux(plane, A_QMAX)
+
+    def stator_force(self, plane: str) -> np.ndarray:
+        """Rotor-stator normal force F_n at AMB plane ``AMB1``/``AMB2`` [N] (zero without
+        ``effects.stator_contact``)."""
+        return self.aux[:, A_STATOR + self._plane(plane, AMB_PLANES)]
 
     def friction_power(self, plane: str) -> np.ndarray:
         """Power dissipated by the rotor-sleeve contact friction, F_mu times the slip speed

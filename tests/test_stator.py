@@ -1,0 +1,131 @@
+"""Rotor-stator contact at the AMB planes (effects.stator_contact, physics/stator.py)."""
+import hashlib
+import math
+
+import numpy as np
+import pytest
+
+from physics import load_scene, simulate
+from physics.contact import line_deflection
+from physics.metrics import compute_metrics
+from physics.scene import Scene
+from physics.stator import damping_coefficient, damping_ratio, restitution_of_damping, stator_force
+
+from helpers import energy_residual
+
+# sha256 of Result.Y (float64, C order) of simulate(load_scene("paper", {"contact.friction": mu}),
+# t_end=0.3), computed on main at 33d8e96, before stator contact, the contact laws and the validity
+# metrics existed. The new effects are off in the paper preset: the state history must not move
+# by one bit (a different CPU / numba / LLVM build could change the last bits; then re-derive the
+# hashes from main's code the same way before trusting a failure).
+PAPER_STATE_SHA256 = {
+    0.25: "82b866a5443a7822211167604e77ed4edb86fcba2b7dcba696330ba49e0011cd",
+    0.45: "5c500d9c845796448819a139287d7aff6a0102d018cd71750353dd890a641170",
+}
+
+
+@pytest.mark.parametrize("mu", sorted(PAPER_STATE_SHA256))
+def test_paper_drop_is_bit_for_bit_unchanged_with_the_new_effects_off(mu):
+    r = simulate(load_scene("paper", {"contact.friction": mu}), t_end=0.3)
+    assert hashlib.sha256(np.ascontiguousarray(r.Y).tobytes()).hexdigest() == PAPER_STATE_SHA256[mu]
+    assert not r.stator_force("AMB1").any()
+
+
+def test_stator_contact_adds_no_state():
+    on = simulate(load_scene("paper", {"effects.stator_contact": True}), t_end=0.12)
+    off = simulate(load_scene("paper"), t_end=0.12)
+    assert on.model.names == off.model.names
+
+
+@pytest.mark.parametrize("e", [0.2, 0.5, 0.9])
+def test_rigid_stator_rebounds_a_point_mass_with_the_restitution_coefficient(e):
+    """A mass m hitting the immovable stator radially at v0 (no friction, no gravity) leaves with
+    e v0: the damping from damping_coefficient() and the no-pull force law, integrated with RK4."""
+    m, k, gap, v0 = 48.65, 2e9, 600e-6, 0.1
+    c = damping_coefficient(k, m, e)
+
+    def acc(x, v):
+        return stator_force(x, 0.0, v, 0.0, 0.0, gap, k, c, 0.0, 0.045, 1e-3)[0] / m
+
+    x, v, h = gap, v0, 1e-7
+    for _ in range(200_000):
+        k1x, k1v = v, acc(x, v)
+        k2x, k2v = v + 0.5 * h * k1v, acc(x + 0.5 * h * k1x, v + 0.5 * h * k1v)
+        k3x, k3v = v + 0.5 * h * k2v, acc(x + 0.5 * h * k2x, v + 0.5 * h * k2v)
+        k4x, k4v = v + h * k3v, acc(x + h * k3x, v + h * k3v)
+        x += h / 6 * (k1x + 2 * k2x + 2 * k3x + k4x)
+        v += h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v)
+        if x < gap - 1e-6:
+            break
+    assert v < 0.0
+    assert -v / v0 == pytest.approx(e, rel=2e-3)
+    assert restitution_of_damping(damping_ratio(e)) == pytest.approx(e, rel=1e-9)
+
+
+def test_stator_friction_opposes_the_surface_slip_and_brakes_the_spin():
+    """Rotor pressed into the stator along +X, spinning forward: the friction on the rotor points
+    along -t = -Y (against its surface velocity Omega R_a t), its torque is -R_a mu F_n, and the
+    contact dissipates F_mu times the slip speed."""
+    k, gap, mu, R, W = 2e9, 600e-6, 0.3, 0.045, 1000.0
+    fx, fy, torque, f_n, elastic, p = stator_force(gap + 1e-5, 0.0, 0.0, 0.0, W, gap, k, 0.0, mu, R, 1e-3)
+    assert f_n == pytest.approx(k * 1e-5) and elastic == pytest.approx(f_n)
+    assert fx == pytest.approx(-f_n)                    # pushes the rotor back inside
+    assert fy == pytest.approx(-mu * f_n)
+    assert torque == pytest.approx(-R * mu * f_n)
+    assert p == pytest.approx(mu * f_n * W * R)
+    # inside the gap: nothing
+    assert stator_force(gap - 1e-6, 0.0, 1.0, 0.0, W, gap, k, 1e5, mu, R, 1e-3) == (0.0,) * 6
+
+
+def test_default_stator_stiffness_is_the_line_contact_secant():
+    """stator.stiffness (D): secant F / delta(F) at 10 kN of Johnson's internal line contact of a
+    steel rotor (206 GPa, nu 0.3) on a 40 mm stack of 0.96 stacking factor, clearance amb.air_gap."""
+    E, nu = 206e9, 0.3
+    e_star = 1.0 / ((1 - nu ** 2) / E + (1 - nu ** 2) / (0.96 * E))
+    a = math.pi * 0.040 * e_star
+    secant = 1e4 / line_deflection(1e4, a, Scene().amb.air_gap)
+    assert Scene().stator.stiffness == pytest.approx(secant, rel=0.03)
+
+
+@pytest.fixture(scope="module")
+def whirl_drops():
+    """mu = 0.5 (a backward whirl that reaches the stator) without and with a frictionless stator
+    contact and with the default dry stator friction."""
+    base = {"contact.friction": 0.5}
+    return {name: simulate(load_scene("paper", {**base, **ov}), t_end=0.4)
+            for name, ov in (("off", {}),
+                             ("stop", {"effects.stator_contact": True, "stator.friction": 0.0}),
+                             ("dry", {"effects.stator_contact": True}))}
+
+
+def test_the_stator_stops_the_orbit_at_the_air_gap(whirl_drops):
+    gap_um = Scene().amb.air_gap * 1e6
+    off = compute_metrics(whirl_drops["off"])
+    stop = compute_metrics(whirl_drops["stop"])
+    for p in ("AMB1", "AMB2"):
+        assert off["amb_planes"][p]["max_displacement_um"] > 1.3 * gap_um        # 831 µm
+        v = stop["amb_planes"][p]
+        assert gap_um < v["max_displacement_um"] < 1.3 * gap_um                 # 609 µm
+        assert v["stator_contacts"] >= 1 and v["stator_peak_force_N"] > 1e3
+        assert v["stator_contact_time_s"] > 0.0
+        assert off["amb_planes"][p]["stator_contacts"] is None
+    assert any("AMB stator" in w for w in off["warnings"])
+    assert not any("AMB stator" in w for w in stop["warnings"])
+
+
+def test_dry_stator_friction_drives_the_rotor_into_dry_whip(whirl_drops):
+    """With dry friction (mu_st = 0.3) the rotor rolls backward on the stator: the friction torque
+    brakes the spin far below what the retainer contact alone takes (a physics result, see
+    docs/physics.md: the stator contact is then a dry-whip warning, not a stop)."""
+    off, dry = whirl_drops["off"], whirl_drops["dry"]
+    assert dry.rotor_speed[-1] < 0.6 * off.rotor_speed[-1]
+    o = dry.amb_orbit("AMB1")
+    post = dry.t > 0.2
+    ang = np.unwrap(np.arctan2(o[post, 1], o[post, 0]))
+    assert (ang[-1] - ang[0]) < -2 * np.pi * 10          # backward whirl, against the spin
+
+
+@pytest.mark.parametrize("name", ["stop", "dry"])
+def test_energy_audit_closes_with_stator_contact(whirl_drops, name):
+    res, e = energy_residual(whirl_drops[name])
+    assert res.max() < 1e-5 * e["dissipated"][-1]
