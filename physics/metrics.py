@@ -175,6 +175,7 @@ def amb_plane_metrics(result: Result) -> dict:
         out[p] = dict(max_displacement_um=math.sqrt(r2) * 1e6, stator_contact=r2 >= gap * gap)
         out[p].update(stator_contact_events(result, p) if modelled else
                       dict(stator_contacts=None, stator_peak_force_N=None, stator_contact_time_s=None))
+        out[p]["stator_penetration_um"] = max(math.sqrt(r2) - gap, 0.0) * 1e6
     return out
 
 
@@ -226,6 +227,7 @@ def check_metrics(result: Result, m: dict) -> dict:
     out["amb_planes"] = amb_plane_metrics(result)
     out["stator_contact"] = any(v["stator_contact"] for v in out["amb_planes"].values())
     out["stator_contact_modelled"] = bool(result.model.I[F_STATOR])
+    out["stator_penetration_validity_um"] = line_validity(result.model.scene.amb.air_gap) * 1e6
     validity = contact_validity(result)
     for p, v in validity.pop("planes").items():
         m["planes"][p].update(v)
@@ -277,6 +279,13 @@ def warnings_of(m: dict, scene) -> list[str]:
         out.append(f"the rotor reaches the AMB stator (amb.air_gap = {scene.amb.air_gap * 1e6:.0f} µm; "
                    f"max displacement {disp}): the model has no stator contact, the motion "
                    "beyond it is not physical (set effects.stator_contact = true)")
+    deep = {p: v["stator_penetration_um"] for p, v in m["amb_planes"].items()
+            if v["stator_penetration_um"] > m["stator_penetration_validity_um"]}
+    if m["stator_contact_modelled"] and deep:
+        out.append("rotor-stator penetration " + ", ".join(f"{p} {d:.0f} µm" for p, d in deep.items())
+                   + f" passes {m['stator_penetration_validity_um']:.0f} µm (0.40 x amb.air_gap): "
+                   "the stator stack cannot deform that far, the rotor rolls on the stator (dry "
+                   "whip, see stator_peak_force_N); read it as a destroyed stator, not a motion")
     if m["penetration_beyond_validity"]:
         pen = _per_plane(m, m["penetration_beyond_validity"], "max_penetration_um", ".0f")
         out.append(f"rotor-sleeve penetration {pen} passes the contact law's validity bound "

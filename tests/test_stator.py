@@ -119,6 +119,10 @@ def test_dry_stator_friction_drives_the_rotor_into_dry_whip(whirl_drops):
     docs/physics.md: the stator contact is then a dry-whip warning, not a stop)."""
     off, dry = whirl_drops["off"], whirl_drops["dry"]
     assert dry.rotor_speed[-1] < 0.6 * off.rotor_speed[-1]
+    m = compute_metrics(dry)
+    assert m["amb_planes"]["AMB1"]["stator_penetration_um"] > m["stator_penetration_validity_um"]
+    assert any("dry whip" in w for w in m["warnings"])
+    assert not any("dry whip" in w for w in compute_metrics(whirl_drops["stop"])["warnings"])
     o = dry.amb_orbit("AMB1")
     post = dry.t > 0.2
     ang = np.unwrap(np.arctan2(o[post, 1], o[post, 0]))
