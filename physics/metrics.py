@@ -227,7 +227,9 @@ def check_metrics(result: Result, m: dict) -> dict:
     out["amb_planes"] = amb_plane_metrics(result)
     out["stator_contact"] = any(v["stator_contact"] for v in out["amb_planes"].values())
     out["stator_contact_modelled"] = bool(result.model.I[F_STATOR])
-    out["stator_penetration_validity_um"] = line_validity(result.model.scene.amb.air_gap) * 1e6
+    out["stator_penetration_validity_um"] = bound = line_validity(result.model.scene.amb.air_gap) * 1e6
+    out["stator_beyond_validity"] = [p for p, v in out["amb_planes"].items() if
+                                     out["stator_contact_modelled"] and v["stator_penetration_um"] > bound]
     validity = contact_validity(result)
     for p, v in validity.pop("planes").items():
         m["planes"][p].update(v)
@@ -279,10 +281,9 @@ def warnings_of(m: dict, scene) -> list[str]:
         out.append(f"the rotor reaches the AMB stator (amb.air_gap = {scene.amb.air_gap * 1e6:.0f} µm; "
                    f"max displacement {disp}): the model has no stator contact, the motion "
                    "beyond it is not physical (set effects.stator_contact = true)")
-    deep = {p: v["stator_penetration_um"] for p, v in m["amb_planes"].items()
-            if v["stator_penetration_um"] > m["stator_penetration_validity_um"]}
-    if m["stator_contact_modelled"] and deep:
-        out.append("rotor-stator penetration " + ", ".join(f"{p} {d:.0f} µm" for p, d in deep.items())
+    if m["stator_beyond_validity"]:
+        out.append("rotor-stator penetration " + ", ".join(
+            f"{p} {m['amb_planes'][p]['stator_penetration_um']:.0f} µm" for p in m["stator_beyond_validity"])
                    + f" passes {m['stator_penetration_validity_um']:.0f} µm (0.40 x amb.air_gap): "
                    "the stator stack cannot deform that far, the rotor rolls on the stator (dry "
                    "whip, see stator_peak_force_N); read it as a destroyed stator, not a motion")

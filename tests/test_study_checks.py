@@ -79,14 +79,14 @@ def test_sweep_cells_count_the_warnings_rotordrop_drop_prints(tmp_path, capsys):
     assert cell["failed"] == 0 and cell["whirl_probability"] == 0.0
     assert cell["warnings"] == dict(no_fault=0, pre_fault_contact=1, stator_contact=1,
                                     coarse_output=1, missed_peaks=1, aliased_whirl=0,
-                                    penetration=1, film_play=0)
+                                    penetration=1, film_play=0, dry_whip=0)
     run, = r["runs"]
     drop = compute_metrics(simulate(load_scene("paper", run["overrides"])))
     assert run["metrics"]["warnings"] == drop["warnings"] and len(drop["warnings"]) == 5
     assert ("pre_fault_contact 1, stator_contact 1, coarse_output 1, missed_peaks 1, penetration 1 |"
             in text)
     assert "drop checks: 1 drop in contact before the fault, 1 drop reaching the AMB stator" in text
-    assert (out / "sweep.csv").read_text().splitlines()[1].endswith(",0,1,1,1,1,0,1,0")
+    assert (out / "sweep.csv").read_text().splitlines()[1].endswith(",0,1,1,1,1,0,1,0,0")
 
 
 def test_as_drop_and_warning_counts():

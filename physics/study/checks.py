@@ -26,6 +26,8 @@ WARNING_KINDS: dict[str, tuple[Callable[[dict], bool], str]] = {
     "penetration": (lambda m: bool(m.get("penetration_beyond_validity")),
                     "past the contact law's penetration bound"),
     "film_play": (lambda m: bool(m.get("film_exceeds_play")), "with an EHL film above the play"),
+    "dry_whip": (lambda m: bool(m.get("stator_beyond_validity")),
+                 "rolling on the stator past its penetration bound (dry whip)"),
 }
 NO_FAULT = "NoFault"
 
