@@ -146,4 +146,6 @@ class Result:
                          f"{p}_bearing_load": self.bearing_load(p),
                          f"{p}_friction_power": self.friction_power(p),
                          f"{p}_max_ball_load": self.max_ball_load(p)})
+        for p in AMB_PLANES:
+            cols[f"{p}_stator_force"] = self.stator_force(p)
         np.savez_compressed(path, states=self.Y, state_names=np.array(self.model.names), **cols)
