@@ -129,12 +129,27 @@ def contact_period(scene, plane: str, load: float) -> float | None:
     """Period 2π √(m/k) [s] of the rotor's mass share m at a retainer plane (lever rule) on the
     contact stiffness linearised at ``load``, k = e K (F/K)^((e-1)/e) (paper eq. 14): the rotor
     bouncing on an immovable sleeve, the shortest period of an impact (the retainer bearing and
-    the support in series only lengthen it). None without a period (no load with e > 1)."""
+    the support in series only lengthen it). None without a period (no load with e > 1).
+    With ``contact.law = "hertz_line"`` k is the line contact's tangent stiffness
+    a / (ln(4ac/F) − 2), a = π L E* (:func:`physics.contact.line_deflection`), capped at a."""
     c = scene.contact
     m = abs(weight_shares(scene.rotor.mass, scene.positions.rb1, scene.positions.rb2)[
         PLANES.index(plane)])
-    k = c.exponent * c.stiffness * (load / c.stiffness) ** ((c.exponent - 1.0) / c.exponent)
+    if c.law == "hertz_line":
+        b = scene.bearing
+        a = math.pi * c.length * b.youngs_modulus / (2.0 * (1.0 - b.poisson ** 2))
+        lg = math.log(4.0 * a * c.clearance / load) if load > 0.0 else math.inf
+        k = a / (lg - 2.0) if lg > 3.0 else a
+    else:
+        k = c.exponent * c.stiffness * (load / c.stiffness) ** ((c.exponent - 1.0) / c.exponent)
     return 2.0 * math.pi * math.sqrt(m / k) if k > 0.0 and m > 0.0 else None
+
+
+def stator_period(scene) -> float:
+    """Period 2π √(m/k) [s] of the rotor's mass share at an AMB plane on the stator stiffness
+    (``stator.stiffness``): the stator impact, resolved like :func:`contact_period`."""
+    m = abs(weight_shares(scene.rotor.mass, scene.positions.amb1, scene.positions.amb2)[0])
+    return 2.0 * math.pi * math.sqrt(max(m, 1e-3) / scene.stator.stiffness)
 
 
 def min_output_rate(result: Result, planes: dict) -> tuple[float, str]:
@@ -158,6 +173,10 @@ def min_output_rate(result: Result, planes: dict) -> tuple[float, str]:
             if period is not None and SAMPLES_PER_PERIOD / period > best:
                 best = SAMPLES_PER_PERIOD / period
                 source = f"{what} period at {p}, {period * 1e3:.3g} ms"
+    touched = [p for p in AMB_PLANES if (result.stator_force(p) > 0.0).any()]
+    if touched and SAMPLES_PER_PERIOD / stator_period(scene) > best:
+        best = SAMPLES_PER_PERIOD / stator_period(scene)
+        source = f"stator contact period at {touched[0]}, {stator_period(scene) * 1e3:.3g} ms"
     return best, source
 
 

@@ -114,3 +114,21 @@ def test_film_thicker_than_the_internal_play_is_warned(paper_drops):
     assert calm["planes"]["RB1"]["max_film_thickness_um"] < 7.5 and not calm["film_exceeds_play"]
     off = compute_metrics(simulate(load_scene("paper", {"effects.ehl_film": False}), t_end=0.12))
     assert off["planes"]["RB1"]["max_film_thickness_um"] is None and not off["film_exceeds_play"]
+
+
+def test_output_rate_check_follows_the_contact_law_and_the_stator():
+    """The sampling check resolves the stiffer hertz_line contact (its tangent stiffness at the
+    load) and, once the rotor touches it, the stator impact 2π √(m/k_st) = 0.98 ms."""
+    from physics.metrics import contact_period, stator_period
+    paper = load_scene("paper")
+    hertz = paper.with_overrides({"contact.law": "hertz_line"})
+    k = A / (math.log(4 * A * C / 3e3) - 2.0)
+    assert contact_period(hertz, "RB1", 3e3) == pytest.approx(2 * math.pi * math.sqrt(48.65 / k))
+    assert contact_period(hertz, "RB1", 3e3) < 0.5 * contact_period(paper, "RB1", 3e3)
+    assert stator_period(paper) == pytest.approx(2 * math.pi * math.sqrt(48.65 / 2e9))
+    m = compute_metrics(simulate(paper.with_overrides({"contact.friction": 0.5,
+                                                       "effects.stator_contact": True,
+                                                       "stator.friction": 0.0,
+                                                       "solver.output_rate": 5000.0}), t_end=0.3))
+    assert m["min_output_rate_source"].startswith("stator contact period")
+    assert m["output_rate_too_coarse"]
