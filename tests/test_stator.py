@@ -133,3 +133,27 @@ def test_dry_stator_friction_drives_the_rotor_into_dry_whip(whirl_drops):
 def test_energy_audit_closes_with_stator_contact(whirl_drops, name):
     res, e = energy_residual(whirl_drops[name])
     assert res.max() < 1e-5 * e["dissipated"][-1]
+
+
+@pytest.mark.parametrize("key, value, words", [
+    ("stator.stiffness", -1.0, ["stator.stiffness", "[1e+06, 1e+12] N/m"]),
+    ("stator.restitution", 1.5, ["stator.restitution", "[0.05, 1]"]),
+    ("stator.friction", -0.1, ["stator.friction", "[0, 1]"]),
+    ("contact.law", "hertz", ["contact.law", "paper, hertz_line"]),
+    ("effects.stator_contact", "maybe", ["effects.stator_contact", "true or false"]),
+])
+def test_bad_stator_and_law_values_are_one_line_errors(key, value, words):
+    from physics.scene import SceneError
+    with pytest.raises(SceneError) as exc:
+        load_scene("paper", {key: value})
+    msg = str(exc.value)
+    assert "\n" not in msg and all(w in msg for w in words), msg
+
+
+def test_params_lists_the_new_keys_with_unit_range_and_source():
+    from physics.scene import parameter_table
+    rows = {r["key"]: r for r in parameter_table()}
+    assert rows["effects.stator_contact"]["allowed"] == "true|false"
+    assert rows["contact.law"]["allowed"] == "paper|hertz_line"
+    assert rows["stator.stiffness"]["unit"] == "N/m" and rows["stator.stiffness"]["tag"] == "D"
+    assert rows["stator.friction"]["tag"] == "A"
