@@ -123,7 +123,9 @@ def whirl_drops():
     return {name: simulate(load_scene("paper", {**base, **ov}), t_end=0.4)
             for name, ov in (("off", {}),
                              ("stop", {"effects.stator_contact": True, "stator.friction": 0.0}),
-                             ("dry", {"effects.stator_contact": True}))}
+                             ("dry", {"effects.stator_contact": True}),
+                             ("dry_hertz", {"effects.stator_contact": True,
+                                            "contact.law": "hertz_line"}))}
 
 
 def test_the_stator_stops_the_orbit_at_the_air_gap(whirl_drops):
@@ -157,7 +159,7 @@ def test_dry_stator_friction_drives_the_rotor_into_dry_whip(whirl_drops):
     assert (ang[-1] - ang[0]) < -2 * np.pi * 10          # backward whirl, against the spin
 
 
-@pytest.mark.parametrize("name", ["stop", "dry"])
+@pytest.mark.parametrize("name", ["stop", "dry", "dry_hertz"])
 def test_energy_audit_closes_with_stator_contact(whirl_drops, name):
     res, e = energy_residual(whirl_drops[name])
     assert res.max() < 1e-5 * e["dissipated"][-1]
