@@ -99,9 +99,10 @@ def summary_table(m: dict) -> str:
              f"final rotor speed {m['final_rotor_speed_rpm']:.0f} rpm"]
     if m["fault_simulated"]:
         lines += _post_fault_tables(m)
-    lines.append(f"{'AMB plane':10}{'max disp [µm]':>15}{'stator':>8}")
+    lines.append(f"{'AMB plane':10}{'max disp [µm]':>15}{'stator':>8}{'contacts':>10}{'peak F [N]':>12}")
     for p, v in m["amb_planes"].items():
-        lines.append(f"{p:10}{v['max_displacement_um']:15.1f}{'yes' if v['stator_contact'] else 'no':>8}")
+        lines.append(f"{p:10}{v['max_displacement_um']:15.1f}{'yes' if v['stator_contact'] else 'no':>8}"
+                     f"{_fmt(v['stator_contacts'], 'd'):>10}{_fmt(v['stator_peak_force_N'], '.0f'):>12}")
     lines += [f"warning: {w}" for w in m["warnings"]]
     return "\n".join(lines)
 

@@ -8,9 +8,10 @@ import math
 import numpy as np
 
 from .amb import weight_shares
-from .ball_bearing import max_contact_pressure, static_max_ball_load
+from .ball_bearing import film_thickness, max_contact_pressure, static_max_ball_load
+from .contact import line_validity
 from .integrate import P_FR, P_LOAD, P_QMAX
-from .model import F_RB, PLANES, RB_SM
+from .model import F_FILM, F_RB, F_STATOR, P_FILM, PLANES, RB_SM
 from .results import AMB_PLANES, Result
 
 WHIRL_MIN_REVOLUTIONS = 3.0     # net backward orbit revolutions that make a backward whirl
@@ -137,12 +138,27 @@ def contact_period(scene, plane: str, load: float) -> float | None:
     """Period 2π √(m/k) [s] of the rotor's mass share m at a retainer plane (lever rule) on the
     contact stiffness linearised at ``load``, k = e K (F/K)^((e-1)/e) (paper eq. 14): the rotor
     bouncing on an immovable sleeve, the shortest period of an impact (the retainer bearing and
-    the support in series only lengthen it). None without a period (no load with e > 1)."""
+    the support in series only lengthen it). None without a period (no load with e > 1).
+    With ``contact.law = "hertz_line"`` k is the line contact's tangent stiffness
+    a / (ln(4ac/F) − 2), a = π L E* (:func:`physics.contact.line_deflection`), capped at a."""
     c = scene.contact
     m = abs(weight_shares(scene.rotor.mass, scene.positions.rb1, scene.positions.rb2)[
         PLANES.index(plane)])
-    k = c.exponent * c.stiffness * (load / c.stiffness) ** ((c.exponent - 1.0) / c.exponent)
+    if c.law == "hertz_line":
+        b = scene.bearing
+        a = math.pi * c.length * b.youngs_modulus / (2.0 * (1.0 - b.poisson ** 2))
+        lg = math.log(4.0 * a * c.clearance / load) if load > 0.0 else math.inf
+        k = a / (lg - 2.0) if lg > 3.0 else a
+    else:
+        k = c.exponent * c.stiffness * (load / c.stiffness) ** ((c.exponent - 1.0) / c.exponent)
     return 2.0 * math.pi * math.sqrt(m / k) if k > 0.0 and m > 0.0 else None
+
+
+def stator_period(scene) -> float:
+    """Period 2π √(m/k) [s] of the rotor's mass share at an AMB plane on the stator stiffness
+    (``stator.stiffness``): the stator impact, resolved like :func:`contact_period`."""
+    m = abs(weight_shares(scene.rotor.mass, scene.positions.amb1, scene.positions.amb2)[0])
+    return 2.0 * math.pi * math.sqrt(max(m, 1e-3) / scene.stator.stiffness)
 
 
 def min_output_rate(result: Result, planes: dict) -> tuple[float, str]:
@@ -166,19 +182,66 @@ def min_output_rate(result: Result, planes: dict) -> tuple[float, str]:
             if period is not None and SAMPLES_PER_PERIOD / period > best:
                 best = SAMPLES_PER_PERIOD / period
                 source = f"{what} period at {p}, {period * 1e3:.3g} ms"
+    touched = [p for p in AMB_PLANES if (result.stator_force(p) > 0.0).any()]
+    if touched and SAMPLES_PER_PERIOD / stator_period(scene) > best:
+        best = SAMPLES_PER_PERIOD / stator_period(scene)
+        source = f"stator contact period at {touched[0]}, {stator_period(scene) * 1e3:.3g} ms"
     return best, source
 
 
 def amb_plane_metrics(result: Result) -> dict:
     """Largest rotor displacement at each AMB plane over the run and whether it reaches the
-    stator (|r| >= amb.air_gap, the environments' criterion)."""
+    stator (|r| >= amb.air_gap, the environments' criterion). With ``effects.stator_contact`` also
+    the stator contact's events (sampled contact episodes), peak normal force and time in
+    contact over the output samples (None without the effect)."""
     gap = result.model.scene.amb.air_gap
+    modelled = bool(result.model.I[F_STATOR])
     out = {}
     for p in AMB_PLANES:
         o = result.amb_orbit(p)
         r2 = float((o[:, 0] ** 2 + o[:, 1] ** 2).max()) if len(o) else 0.0
         out[p] = dict(max_displacement_um=math.sqrt(r2) * 1e6, stator_contact=r2 >= gap * gap)
+        out[p].update(stator_contact_events(result, p) if modelled else
+                      dict(stator_contacts=None, stator_peak_force_N=None, stator_contact_time_s=None))
+        out[p]["stator_penetration_um"] = max(math.sqrt(r2) - gap, 0.0) * 1e6
     return out
+
+
+def stator_contact_events(result: Result, plane: str) -> dict:
+    """Contact episodes (runs of samples with a stator force), peak force [N] and time in
+    contact [s] (samples in contact times the sample spacing) at AMB plane ``plane``."""
+    f = result.stator_force(plane)
+    touching = f > 0.0
+    starts = int(np.count_nonzero(touching[1:] & ~touching[:-1]) + (1 if len(f) and touching[0] else 0))
+    dt = float(np.diff(result.t).mean()) if len(result.t) > 1 else 0.0
+    return dict(stator_contacts=starts, stator_peak_force_N=float(f.max()) if len(f) else 0.0,
+                stator_contact_time_s=float(np.count_nonzero(touching)) * dt)
+
+
+def contact_validity(result: Result) -> dict:
+    """Per retainer plane: the largest rotor-sleeve penetration over the run [µm] and, with the
+    EHL film, the film at the highest sleeve speed [µm]; with the bounds they are checked
+    against: ``penetration_validity_um`` (:func:`physics.contact.line_validity`, 0.40 c: the
+    steel-on-steel line contact has no elastic approach much beyond it) and the bearing's radial
+    internal play P_d / 2 (a thicker film preloads the balls at the centre, outside the film
+    model's calibration)."""
+    scene = result.model.scene
+    film = bool(result.model.I[F_FILM])
+    planes = {}
+    for p in PLANES:
+        pen = result.penetration(p)
+        ws = np.abs(result.sleeve_speed(p))
+        h = film_thickness(float(ws.max()), result.model.P[P_FILM])[0] if film and len(ws) else None
+        planes[p] = dict(max_penetration_um=max(float(pen.max()), 0.0) * 1e6 if len(pen) else 0.0,
+                         max_film_thickness_um=h * 1e6 if h is not None else None)
+    bound = line_validity(scene.contact.clearance) * 1e6
+    play = scene.bearing.clearance / 2.0 * 1e6
+    return dict(planes=planes, penetration_validity_um=bound, bearing_radial_play_um=play,
+                penetration_beyond_validity=[p for p, v in planes.items()
+                                             if v["max_penetration_um"] > bound],
+                film_exceeds_play=[p for p, v in planes.items()
+                                   if v["max_film_thickness_um"] is not None
+                                   and v["max_film_thickness_um"] > play])
 
 
 def check_metrics(result: Result, m: dict) -> dict:
@@ -191,6 +254,14 @@ def check_metrics(result: Result, m: dict) -> dict:
                                         for p in PLANES))
     out["amb_planes"] = amb_plane_metrics(result)
     out["stator_contact"] = any(v["stator_contact"] for v in out["amb_planes"].values())
+    out["stator_contact_modelled"] = bool(result.model.I[F_STATOR])
+    out["stator_penetration_validity_um"] = bound = line_validity(result.model.scene.amb.air_gap) * 1e6
+    out["stator_beyond_validity"] = [p for p, v in out["amb_planes"].items() if
+                                     out["stator_contact_modelled"] and v["stator_penetration_um"] > bound]
+    validity = contact_validity(result)
+    for p, v in validity.pop("planes").items():
+        m["planes"][p].update(v)
+    out.update(validity)
     rate = result.model.scene.solver.output_rate
     need, source = min_output_rate(result, m["planes"])
     out.update(output_rate_hz=rate, min_output_rate_hz=need, min_output_rate_source=source,
@@ -233,11 +304,29 @@ def warnings_of(m: dict, scene) -> list[str]:
         out.append(f"the rotor touches the retainer bearings before the fault, while levitated "
                    f"(peak contact force {peaks}); the post-fault metrics exclude it (check "
                    "contact.clearance, support.stiffness, unbalance)")
-    if m["stator_contact"]:
+    if m["stator_contact"] and not m["stator_contact_modelled"]:
         disp = ", ".join(f"{p} {v['max_displacement_um']:.0f} µm" for p, v in m["amb_planes"].items())
         out.append(f"the rotor reaches the AMB stator (amb.air_gap = {scene.amb.air_gap * 1e6:.0f} µm; "
                    f"max displacement {disp}): the model has no stator contact, the motion "
-                   "beyond it is not physical")
+                   "beyond it is not physical (set effects.stator_contact = true)")
+    if m["stator_beyond_validity"]:
+        out.append("rotor-stator penetration " + ", ".join(
+            f"{p} {m['amb_planes'][p]['stator_penetration_um']:.0f} µm" for p in m["stator_beyond_validity"])
+                   + f" passes {m['stator_penetration_validity_um']:.0f} µm (0.40 x amb.air_gap): "
+                   "the stator stack cannot deform that far, the rotor rolls on the stator (dry "
+                   "whip, see stator_peak_force_N); read it as a destroyed stator, not a motion")
+    if m["penetration_beyond_validity"]:
+        pen = _per_plane(m, m["penetration_beyond_validity"], "max_penetration_um", ".0f")
+        out.append(f"rotor-sleeve penetration {pen} passes the contact law's validity bound "
+                   f"{m['penetration_validity_um']:.0f} µm (0.40 x contact.clearance, where a steel "
+                   "line contact stops having an elastic approach): the forces beyond it are the "
+                   f"contact.law = {scene.contact.law!r} law's extrapolation, not a deformation")
+    if m["film_exceeds_play"]:
+        film = _per_plane(m, m["film_exceeds_play"], "max_film_thickness_um", ".1f")
+        out.append(f"the EHL film at the highest sleeve speed ({film}) exceeds the retainer "
+                   f"bearing's radial internal play P_d/2 = {m['bearing_radial_play_um']:.1f} µm: "
+                   "the film preloads the balls with the rotor centred, beyond what the film model"
+                   " was made for (check bearing.clearance, bearing.viscosity)")
     if m["output_rate_too_coarse"]:
         out.append(f"solver.output_rate = {m['output_rate_hz']:g} Hz is below "
                    f"{m['min_output_rate_hz']:.0f} Hz ({SAMPLES_PER_PERIOD} samples per "
@@ -254,6 +343,11 @@ def warnings_of(m: dict, scene) -> list[str]:
                        "samples (whirl_sampling_aliased): whirl detection and frequency are unreliable; "
                        "raise solver.output_rate")
     return out
+
+
+def _per_plane(m: dict, planes: list[str], key: str, spec: str) -> str:
+    """"RB1 179 µm, RB2 179 µm": a per-plane µm metric of ``planes`` for a warning."""
+    return ", ".join(f"{p} {m['planes'][p][key]:{spec}} µm" for p in planes)
 
 
 def compute_metrics(result: Result) -> dict:

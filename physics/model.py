@@ -21,10 +21,13 @@ from . import amb as amb_mod
 from . import thermal
 from .ball_bearing import (ball_forces, ball_forces_with_dry, bearing_constants, cage_ratio,
                            drag_torque_magnitude, film_thickness)
-from .contact import contact_potential, friction_force, geometry, normal_force, smooth_sign
+from .contact import (contact_potential, friction_force, geometry, hunt_crossley, hysteresis_factor,
+                      line_elastic_force, line_potential, normal_force, smooth_sign)
 from ._jit import njit
 from .rotor import axis_at, tilt_accelerations, unbalance_force
 from .scene import Scene
+from .stator import damping_coefficient as stator_damping
+from .stator import stator_force, stator_potential
 from .support import housing_force
 
 # ---------------------------------------------------------------------------- parameters P --
@@ -41,7 +44,11 @@ from .support import housing_force
  P_AMB_KMAG, P_AMB_G0, P_AMB_I0, P_AMB_ILIM, P_AMB_RMAX, P_AMB_KP, P_AMB_KI, P_AMB_KD, P_AMB_TD,
  P_AMB_TL, P_AMB_RAMP, P_AMB_IFF1, P_AMB_IFF2,
  # semi-active support damper (spec §6): C_min, C_max, lag time constant
- P_CS_MIN, P_CS_MAX, P_CS_TAU, N_P) = range(57)
+ P_CS_MIN, P_CS_MAX, P_CS_TAU, N_P_BASE) = range(57)
+# rotor-stator contact (physics/stator.py): gap, stiffness, damping, friction, rotor radius,
+# threshold speed; hertz_line law (physics/contact.py): pi L E*, Hunt-Crossley factor chi
+(P_ST_GAP, P_ST_K, P_ST_C, P_ST_MU, P_ST_R, P_ST_VL, P_HL_A, P_HL_CHI,
+ N_P) = range(N_P_BASE, N_P_BASE + 9)
 
 # sleeve heating (effects.thermal, physics/thermal.py): heat capacity, loss conductance, contact
 # heat partition, relative mu slope, mu ratio floor and ceiling, bearing heat partition
@@ -55,8 +62,9 @@ P_TH_C, P_TH_G, P_TH_A, P_TH_SLOPE, P_TH_RMIN, P_TH_RMAX, P_TH_B, N_P = range(N_
 N_I_CORE = I_PLANES + 2 * N_PLANE_IDX
 # appended blocks (first state index, -1 when absent): actuator PID integrals, derivative-filter
 # states and coil currents (4 axes each: AMB1 x, AMB1 y, AMB2 x, AMB2 y), damper C_s (2 housings)
-I_AMB_INT, I_AMB_FILT, I_AMB_COIL, I_CS, N_I = range(N_I_CORE, N_I_CORE + 5)
-
+I_AMB_INT, I_AMB_FILT, I_AMB_COIL, I_CS, N_I_BASE = range(N_I_CORE, N_I_CORE + 5)
+# flags: rotor-stator contact on/off, rotor-sleeve contact law (LAW_*)
+F_STATOR, F_LAW, N_I = range(N_I_BASE, N_I_BASE + 3)
 # sleeve temperatures of RB1 and RB2, then the heat audit's heat_lost and friction_work
 # (thermal.STATE_NAMES; -1 when effects.thermal is off)
 I_THERM, N_I = N_I, N_I + 1
@@ -65,6 +73,7 @@ AMB_AXES = ("AMB1.x", "AMB1.y", "AMB2.x", "AMB2.y")
 AMB_NONE, AMB_LINEAR, AMB_ACTUATOR = 0, 1, 2
 RB_RIGID, RB_LINEAR, RB_SM = 0, 1, 2
 FRIC_NONE, FRIC_PAPER, FRIC_KINEMATIC = 0, 1, 2
+LAW_PAPER, LAW_HERTZ_LINE = 0, 1
 
 # ------------------------------------------------------------------------- controls U --
 # U_AMB_POWER > 0: the AMBs run under their built-in controller (linear law or PID);
@@ -77,9 +86,12 @@ U_AMB_POWER, U_CS1, U_CS2, U_AMB_DIRECT, U_ICMD, U_T_ON, U_REF0, N_U = 0, 1, 2, 
 # ------------------------------------------------------------------- diagnostics aux --
 # per plane k at aux[k*N_AUX_PLANE + j]
 (A_FR, A_FMU, A_DELTA, A_LOAD, A_WS, A_DRAG, A_PFRIC, A_QMAX, N_AUX_PLANE) = range(9)
-N_AUX = 2 * N_AUX_PLANE
+# then the stator's normal force at AMB plane k at aux[A_STATOR + k] (zero without stator contact)
+A_STATOR = 2 * N_AUX_PLANE
+N_AUX = A_STATOR + 2
 
 PLANES = ("RB1", "RB2")
+STANDARD_GRAVITY = 9.80665  # m/s^2: sets the hertz_line reference impact speed sqrt(2 g c)
 VELOCITY = 0.1      # m/s: size of translational velocities (a free fall through the gap: 0.077 m/s)
 
 
@@ -141,6 +153,8 @@ def build_model(scene: Scene) -> Model:
     I[F_SLEEVE_J] = fx.sleeve_inertia
     I[F_FRIC] = {"none": FRIC_NONE, "paper": FRIC_PAPER, "kinematic": FRIC_KINEMATIC}[fx.friction]
     I[F_AUDIT] = 1
+    I[F_STATOR] = fx.stator_contact
+    I[F_LAW] = {"paper": LAW_PAPER, "hertz_line": LAW_HERTZ_LINE}[s.contact.law]
 
     # rotor states (positions, then velocities). Observation sizes are physical: the clearance,
     # VELOCITY, and for tilt rates VELOCITY over the lever arm to the farther retainer plane
@@ -241,7 +255,21 @@ def build_model(scene: Scene) -> Model:
     P[P_CS_TAU] = s.support.damper_time_constant
     if fx.thermal:
         P[P_TH_C:P_TH_B + 1] = thermal.parameters(s)
+    _pack_contact_extensions(s, P)
     return Model(scene, P, I, tuple(names), np.asarray(scale), np.asarray(obs_scale))
+
+
+def _pack_contact_extensions(s: Scene, P: np.ndarray) -> None:
+    """Parameters of the stator contact and the hertz_line law (docs/physics.md)."""
+    st = s.stator
+    share = abs(amb_mod.weight_shares(s.rotor.mass, s.positions.amb1, s.positions.amb2)[0])
+    P[P_ST_GAP], P[P_ST_K], P[P_ST_MU], P[P_ST_R] = s.amb.air_gap, st.stiffness, st.friction, st.rotor_radius
+    P[P_ST_C] = stator_damping(st.stiffness, max(share, 1e-3), st.restitution)
+    P[P_ST_VL] = s.contact.threshold_rpm * math.pi / 30.0 * st.rotor_radius
+    b, c = s.bearing, s.contact
+    e_star = b.youngs_modulus / (2.0 * (1.0 - b.poisson ** 2))     # steel journal in a steel sleeve
+    P[P_HL_A] = math.pi * c.length * e_star
+    P[P_HL_CHI] = hysteresis_factor(c.restitution, math.sqrt(2.0 * STANDARD_GRAVITY * c.clearance))
 
 
 # ------------------------------------------------------------------------------- kernels --
@@ -382,7 +410,11 @@ def rhs(t, y, P, I, U, dy, aux):
         p_fric = 0.0                             # power dissipated by the contact friction
         if delta > 0.0:
             ddelta = nx * rel_vx + ny * rel_vy
-            f_r, f_el = normal_force(delta, ddelta, P[P_KC], P[P_EC], P[P_CMAX], P[P_DC])
+            if I[F_LAW] == LAW_PAPER:
+                f_r, f_el = normal_force(delta, ddelta, P[P_KC], P[P_EC], P[P_CMAX], P[P_DC])
+            else:
+                f_el = line_elastic_force(delta, P[P_HL_A], P[P_CLR])
+                f_r = hunt_crossley(f_el, ddelta, P[P_HL_CHI])
             p_diss += (f_r - f_el) * ddelta
         et = tx * rel_vx + ty * rel_vy           # whirl velocity along t
         fric = I[F_FRIC]
@@ -528,6 +560,23 @@ def rhs(t, y, P, I, U, dy, aux):
             w_fric += p + d
         dy[i_heat + 2] = q_lost
         dy[i_heat + 3] = w_fric
+    if I[F_STATOR]:                              # rotor-stator contact at the AMB planes
+        for k in range(2):
+            z = P[P_Z_AMB1 + k]
+            px, py, pvx, pvy = axis_motion(y, I, z)
+            sfx, sfy, torque, f_n, _, p_st = stator_force(px, py, pvx, pvy, W, P[P_ST_GAP],
+                                                          P[P_ST_K], P[P_ST_C], P[P_ST_MU],
+                                                          P[P_ST_R], P[P_ST_VL])
+            Fx += sfx
+            Fy += sfy
+            Ma += z * sfx
+            Mb += z * sfy
+            T += torque
+            p_diss += p_st
+            aux[A_STATOR + k] = f_n
+    else:
+        aux[A_STATOR] = 0.0
+        aux[A_STATOR + 1] = 0.0
 
     # rotor equations of motion
     dy[I[S_X]] = vx
@@ -613,7 +662,13 @@ def mechanical_energy(y, P, I):
         if i_ws >= 0:
             E += 0.5 * P[P_JS] * ws * ws
         er, _, _ = geometry(px - sx, py - sy)
-        E += contact_potential(er - P[P_CLR], P[P_KC], P[P_EC])
+        if I[F_LAW] == LAW_PAPER:
+            E += contact_potential(er - P[P_CLR], P[P_KC], P[P_EC])
+        else:
+            E += line_potential(er - P[P_CLR], P[P_HL_A], P[P_CLR])
+        if I[F_STATOR]:
+            ax, ay, _, _ = axis_motion(y, I, P[P_Z_AMB1 + k])
+            E += stator_potential(ax, ay, P[P_ST_GAP], P[P_ST_K])
         ux, uy = sx - hx, sy - hy
         if I[F_RB] == RB_SM:        # zero film without sleeve inertia (see rhs)
             h = film_thickness(ws, P[P_FILM])[0] if I[F_FILM] and i_ws >= 0 else 0.0

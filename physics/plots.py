@@ -12,8 +12,8 @@ import numpy as np  # noqa: E402
 from .ball_bearing import max_contact_pressure  # noqa: E402
 from .metrics import (ISO76_C0_PRESSURE, RPM, friction_heat, rating_pressure,  # noqa: E402
                       retainer_loading)
-from .model import F_RB, PLANES, RB_SM  # noqa: E402
-from .results import Result  # noqa: E402
+from .model import F_RB, F_STATOR, PLANES, RB_SM  # noqa: E402
+from .results import AMB_PLANES, Result  # noqa: E402
 
 
 def orbit_panel(ax, result: Result, plane: str, lw: float = 0.5, circle_lw: float = 1.0,
@@ -37,6 +37,37 @@ def plot_orbits(result: Result, path: Path, title: str = "") -> Path:
         ax.set_ylabel("Y [µm]")
         ax.set_title(f"{p} {title}".strip())
         ax.legend(loc="upper right", fontsize=8)
+    return save_figure(fig, path)
+
+
+def plot_amb_planes(result: Result, path: Path, title: str = "") -> Path:
+    """Rotor orbit at AMB1 and AMB2 over the run with the stator's air-gap circle (amb.air_gap),
+    the samples in stator contact marked (stator force > 0 with ``effects.stator_contact``, else
+    every sample at or beyond the gap) and, with the effect, the stator contact force."""
+    modelled = bool(result.model.I[F_STATOR])
+    fig = plt.figure(figsize=(10, 8.5 if modelled else 5), constrained_layout=True)
+    grid = fig.add_gridspec(2 if modelled else 1, 2, height_ratios=(2, 1) if modelled else None)
+    gap_um = result.model.scene.amb.air_gap * 1e6
+    a = np.linspace(0, 2 * np.pi, 361)
+    for i, p in enumerate(AMB_PLANES):
+        ax = fig.add_subplot(grid[0, i])
+        o = result.amb_orbit(p) * 1e6
+        ax.plot(o[:, 0], o[:, 1], lw=0.5)
+        ax.plot(gap_um * np.cos(a), gap_um * np.sin(a), "k--", lw=1.0, label="air gap (stator)")
+        touch = (result.stator_force(p) > 0.0) if modelled else (np.hypot(o[:, 0], o[:, 1]) >= gap_um)
+        ax.plot(o[touch, 0], o[touch, 1], "r.", ms=2, label="stator contact")
+        ax.set_aspect("equal")
+        ax.set_xlabel("X [µm]")
+        ax.set_ylabel("Y [µm]")
+        ax.set_title(f"{p} {title}".strip())
+        ax.legend(loc="upper right", fontsize=8)
+    if modelled:
+        ax = fig.add_subplot(grid[1, :])
+        for p in AMB_PLANES:
+            ax.plot(result.t, result.stator_force(p), lw=0.6, label=p)
+        ax.set_xlabel("time [s]")
+        ax.set_ylabel("stator contact force [N]")
+        ax.legend(fontsize=8)
     return save_figure(fig, path)
 
 
@@ -139,7 +170,8 @@ def plot_drop(result: Result, out_dir: Path, title: str = "") -> list[Path]:
              plot_forces(result, out_dir / "contact_forces.png", title),
              plot_speeds(result, out_dir / "speeds.png", title),
              plot_housing(result, out_dir / "housing.png", title),
-             plot_retainer(result, out_dir / "retainer.png", title)]
+             plot_retainer(result, out_dir / "retainer.png", title),
+             plot_amb_planes(result, out_dir / "amb_planes.png", title)]
     if result.has_thermal:
         paths.append(plot_thermal(result, out_dir / "thermal.png", title))
     return paths

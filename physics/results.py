@@ -6,8 +6,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import thermal
-from .model import (A_DELTA, A_DRAG, A_FMU, A_FR, A_LOAD, A_PFRIC, A_QMAX, A_WS, I_PLANES, I_THERM,
-                    J_HX, J_SX, N_AUX_PLANE, N_PLANE_IDX, P_MU, P_TH_C, P_TH_RMAX, P_TH_RMIN,
+from .model import (A_DELTA, A_DRAG, A_FMU, A_FR, A_LOAD, A_PFRIC, A_QMAX, A_STATOR, A_WS, I_PLANES,
+                    I_THERM, J_HX, J_SX, N_AUX_PLANE, N_PLANE_IDX, P_MU, P_TH_C, P_TH_RMAX, P_TH_RMIN,
                     P_TH_SLOPE, P_Z_AMB1, P_Z_RB1, PLANES, S_EDISS, S_W, S_WEXT, S_X, Model, energies)
 
 AMB_PLANES = ("AMB1", "AMB2")
@@ -112,6 +112,11 @@ class Result:
         """Load on the most heavily loaded ball [N] (Sopanen-Mikkola bearing; zero otherwise)."""
         return self._aux(plane, A_QMAX)
 
+    def stator_force(self, plane: str) -> np.ndarray:
+        """Rotor-stator normal force F_n at AMB plane ``AMB1``/``AMB2`` [N] (zero without
+        ``effects.stator_contact``)."""
+        return self.aux[:, A_STATOR + self._plane(plane, AMB_PLANES)]
+
     def friction_power(self, plane: str) -> np.ndarray:
         """Power dissipated by the rotor-sleeve contact friction, F_mu times the slip speed
         r Omega + v_t - R omega_s [W] (the heat generated at the retainer's inner surface). Under
@@ -173,4 +178,6 @@ class Result:
                          f"{p}_max_ball_load": self.max_ball_load(p)})
             if self.has_thermal:
                 cols[f"{p}_temperature_rise"] = self.temperature_rise(p)
+        for p in AMB_PLANES:
+            cols[f"{p}_stator_force"] = self.stator_force(p)
         np.savez_compressed(path, states=self.Y, state_names=np.array(self.model.names), **cols)

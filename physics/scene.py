@@ -106,6 +106,30 @@ class Contact:
     friction: float = param(0.25, "-", 0.0, 1.0, "rotor-sleeve friction coefficient mu")
     threshold_rpm: float = param(10.0, "rpm", 1e-3, 1e4,
                                  "friction threshold speed omega_l (kinematic slip: omega_l*r)")
+    law: str = param("paper", "-", doc="rotor-sleeve normal force law: paper (K delta^e with the STEP"
+                     " damping, eq. 14) or hertz_line (Johnson's internal line contact of steel on"
+                     " steel over contact.length, Hunt-Crossley damping; docs/physics.md)",
+                     tag="A", choices=("paper", "hertz_line"))
+    length: float = param(0.022, "m", 1e-4, 1.0, "hertz_line: axial contact length L of journal and"
+                          " sleeve (the 6016's width)", "A")
+    restitution: float = param(0.9, "-", 0.05, 1.0, "hertz_line: coefficient of restitution e of a"
+                               " normal impact at the free-fall speed through the clearance"
+                               " (sets the Hunt-Crossley damping)", "A")
+
+
+@dataclass(frozen=True)
+class Stator:
+    """Rotor-stator contact at the AMB planes (effects.stator_contact; docs/physics.md)."""
+    stiffness: float = param(2.0e9, "N/m", 1e6, 1e12,
+                             "contact stiffness k of the laminated pole stack: secant of Johnson's"
+                             " internal line contact (steel rotor on a 40 mm stack, 0.96 stacking"
+                             " factor, air gap clearance) at 10 kN", "D")
+    restitution: float = param(0.5, "-", 0.05, 1.0,
+                               "coefficient of restitution e of a normal impact of the rotor's mass"
+                               " share at the AMB plane (sets the contact damping)", "A")
+    friction: float = param(0.3, "-", 0.0, 1.0, "dry rotor-stator friction coefficient mu_st", "A")
+    rotor_radius: float = param(0.045, "m", 1e-3, 1.0,
+                                "rotor radius R_a at the AMB planes (friction torque lever)", "A")
 
 
 @dataclass(frozen=True)
@@ -223,6 +247,9 @@ class Effects:
                               " temperature (thermal.*); beyond the paper", tag="A")
     friction: str = param("paper", "-", doc="rotor-sleeve friction slip definition",
                           choices=("none", "paper", "kinematic"))
+    stator_contact: bool = param(False, "-",
+                                 doc="rotor-stator contact at the AMB planes once the rotor reaches"
+                                     " amb.air_gap (stator.* parameters; no state)", tag="A")
     semi_active_damper: bool = param(False, "-",
                                      doc="support damping C_s is a controlled state lagging its command"
                                          " (needs housing; adds one state per housing)")
@@ -230,7 +257,8 @@ class Effects:
 
 GROUPS: dict[str, type] = {
     "rotor": Rotor, "positions": Positions, "unbalance": Unbalance, "world": World, "amb": Amb,
-    "contact": Contact, "sleeve": Sleeve, "thermal": Thermal, "bearing": Bearing, "support": Support,
+    "contact": Contact, "stator": Stator, "sleeve": Sleeve, "thermal": Thermal, "bearing": Bearing,
+    "support": Support,
     "solver": Solver, "effects": Effects,
 }
 
@@ -245,6 +273,7 @@ class Scene:
     world: World = field(default_factory=World)
     amb: Amb = field(default_factory=Amb)
     contact: Contact = field(default_factory=Contact)
+    stator: Stator = field(default_factory=Stator)
     sleeve: Sleeve = field(default_factory=Sleeve)
     thermal: Thermal = field(default_factory=Thermal)
     bearing: Bearing = field(default_factory=Bearing)

@@ -12,6 +12,7 @@ from physics import load_scene
 from agents.cli import main as cli_main
 from physics.study.ensemble import JITTER_S, logistic_fit, onset, perturbations, probability_curve
 from physics.study.paper import DAMPING
+from physics.study.checks import WARNING_KINDS
 from physics.study.parametric import PLANE_KPIS
 from physics.sweep import Run, reproduce_command, run_sweep
 
@@ -227,7 +228,7 @@ def test_parametric_sweep_reports_failed_drops(tmp_path):
     assert len(r["runs"]) == 2 and not any(run["ok"] for run in r["runs"])
     assert all("--set solver.max_steps=100" in run["command"] for run in r["runs"])
     assert (out / "sweep.csv").read_text().splitlines()[1] == ("0.2,2,2" + "," * (1 + 3 * len(PLANE_KPIS))
-                                                           + ",0" * 6)      # no warnings: no metrics
+                                                           + ",0" * len(WARNING_KINDS))  # no metrics
     assert (out / "sweep.png").is_file()
 
 

@@ -66,7 +66,7 @@ def test_a_run_that_ends_before_the_fault_is_a_failed_drop_not_a_calm_one(tmp_pa
     from physics.study.checks import WARNING_KINDS
     head, row = (out / "sweep.csv").read_text().splitlines()
     assert head.endswith(",".join(f"warnings_{k}" for k in WARNING_KINDS))
-    assert row.endswith(",2,0,0,0,0,0")
+    assert row.endswith(",2" + ",0" * (len(WARNING_KINDS) - 1))
 
 
 def test_sweep_cells_count_the_warnings_rotordrop_drop_prints(tmp_path, capsys):
@@ -78,13 +78,15 @@ def test_sweep_cells_count_the_warnings_rotordrop_drop_prints(tmp_path, capsys):
     cell, = r["cells"]
     assert cell["failed"] == 0 and cell["whirl_probability"] == 0.0
     assert cell["warnings"] == dict(no_fault=0, pre_fault_contact=1, stator_contact=1,
-                                    coarse_output=1, missed_peaks=1, aliased_whirl=0)
+                                    coarse_output=1, missed_peaks=1, aliased_whirl=0,
+                                    penetration=1, film_play=0, dry_whip=0)
     run, = r["runs"]
     drop = compute_metrics(simulate(load_scene("paper", run["overrides"])))
-    assert run["metrics"]["warnings"] == drop["warnings"] and len(drop["warnings"]) == 4
-    assert "pre_fault_contact 1, stator_contact 1, coarse_output 1, missed_peaks 1 |" in text
+    assert run["metrics"]["warnings"] == drop["warnings"] and len(drop["warnings"]) == 5
+    assert ("pre_fault_contact 1, stator_contact 1, coarse_output 1, missed_peaks 1, penetration 1 |"
+            in text)
     assert "drop checks: 1 drop in contact before the fault, 1 drop reaching the AMB stator" in text
-    assert (out / "sweep.csv").read_text().splitlines()[1].endswith(",0,1,1,1,1,0")
+    assert (out / "sweep.csv").read_text().splitlines()[1].endswith(",0,1,1,1,1,0,1,0,0")
 
 
 def test_as_drop_and_warning_counts():

@@ -17,11 +17,17 @@ from ..sweep import Outcome
 WARNING_KINDS: dict[str, tuple[Callable[[dict], bool], str]] = {
     "no_fault": (lambda m: not m["fault_simulated"], "without a fault (counted as failed)"),
     "pre_fault_contact": (lambda m: m["contact_before_fault"], "in contact before the fault"),
-    "stator_contact": (lambda m: m["stator_contact"], "reaching the AMB stator"),
+    "stator_contact": (lambda m: m["stator_contact"] and not m.get("stator_contact_modelled"),
+                       "reaching the AMB stator"),
     "coarse_output": (lambda m: m["output_rate_too_coarse"], "with too coarse an output rate"),
     "missed_peaks": (lambda m: bool(m["sampled_peaks_missed"]), "whose samples miss impact peaks"),
     "aliased_whirl": (lambda m: any(p["whirl_sampling_aliased"] for p in m["planes"].values()),
                       "with an aliased whirl"),
+    "penetration": (lambda m: bool(m.get("penetration_beyond_validity")),
+                    "past the contact law's penetration bound"),
+    "film_play": (lambda m: bool(m.get("film_exceeds_play")), "with an EHL film above the play"),
+    "dry_whip": (lambda m: bool(m.get("stator_beyond_validity")),
+                 "rolling on the stator past its penetration bound (dry whip)"),
 }
 NO_FAULT = "NoFault"
 

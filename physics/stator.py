@@ -1,0 +1,84 @@
+"""Rotor-stator contact at the AMB planes (``effects.stator_contact``, docs/physics.md).
+
+Once the rotor axis at an AMB plane reaches the magnetic air gap ``amb.air_gap`` it touches the
+stator's laminated pole stack: the same circle-in-circle geometry as the rotor-sleeve contact
+(spec §3), with the stator fixed to ground. Normal law: a linear spring-dashpot (Kelvin-Voigt)
+whose force never pulls,
+
+    F_n = max(k δ + c δ̇, 0),  δ = |p| − g_0,
+
+k the stack's contact stiffness (``stator.stiffness``), c set by :func:`damping_coefficient` so
+that a normal impact of the rotor's mass share at the plane on the immovable stator rebounds with
+the restitution coefficient ``stator.restitution``. Dry friction μ_st F_n opposes the slip of the
+rotor surface over the stator, v = ė·t + Ω R_a (R_a = ``stator.rotor_radius``), regularised like
+the rotor-sleeve friction (eq. 19, threshold ω_l R_a); its torque −R_a F_μ acts on the rotor spin.
+"""
+from __future__ import annotations
+
+import math
+
+from ._jit import njit
+from .contact import geometry, smooth_sign
+
+
+def restitution_of_damping(zeta: float) -> float:
+    """Restitution e of a point mass hitting a rigid wall through a linear spring-dashpot of
+    damping ratio ζ < 1 whose force cannot pull: the mass leaves when k δ + c δ̇ = 0, i.e. at
+    ω_d t = π − 2 asin ζ, with e = exp(−ζ (π − 2 asin ζ) / √(1 − ζ²)) (from the free damped
+    response x = v_0/ω_d e^(−ζ ω_n t) sin ω_d t; without the no-pull clamp it would be
+    exp(−ζ π / √(1 − ζ²)))."""
+    if zeta <= 0.0:
+        return 1.0
+    return math.exp(-zeta * (math.pi - 2.0 * math.asin(zeta)) / math.sqrt(1.0 - zeta * zeta))
+
+
+def damping_ratio(e: float) -> float:
+    """The damping ratio ζ in [0, 1) with :func:`restitution_of_damping` (ζ) = e (bisection; e is
+    strictly decreasing in ζ from 1 at ζ = 0 to 0 as ζ → 1)."""
+    if e >= 1.0:
+        return 0.0
+    lo, hi = 0.0, 1.0 - 1e-12
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if restitution_of_damping(mid) > e:
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+def damping_coefficient(stiffness: float, mass: float, e: float) -> float:
+    """Dashpot c = 2 ζ √(k m) [N s/m] giving restitution ``e`` for ``mass`` on ``stiffness``."""
+    return 2.0 * damping_ratio(e) * math.sqrt(stiffness * mass)
+
+
+@njit
+def stator_force(px, py, pvx, pvy, W, gap, k, c, mu, radius, v_l):
+    """Contact of the rotor axis at (px, py), moving at (pvx, pvy) and spinning at W, with the
+    fixed stator bore of radial gap ``gap`` centred at the origin.
+
+    Returns (fx, fy, torque, f_n, elastic, p_diss): the force (fx, fy) and spin torque on the rotor,
+    the normal force F_n >= 0, its elastic part k δ and the power the contact dissipates (dashpot
+    and friction, >= 0 for the friction). All zero while the rotor is inside the gap.
+    """
+    r, nx, ny = geometry(px, py)
+    delta = r - gap
+    if delta <= 0.0:
+        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    tx, ty = -ny, nx
+    ddelta = nx * pvx + ny * pvy
+    elastic = k * delta
+    f_n = elastic + c * ddelta
+    if f_n <= 0.0:
+        f_n = 0.0
+    slip = tx * pvx + ty * pvy + W * radius     # rotor surface velocity over the stator, along t
+    f_mu = mu * f_n * smooth_sign(slip, v_l)
+    return (-f_n * nx - f_mu * tx, -f_n * ny - f_mu * ty, -radius * f_mu, f_n, elastic,
+            (f_n - elastic) * ddelta + f_mu * slip)
+
+
+@njit
+def stator_potential(px, py, gap, k):
+    """Elastic energy ½ k δ² stored in the stator contact (energy audit)."""
+    delta = math.sqrt(px * px + py * py) - gap
+    return 0.5 * k * delta * delta if delta > 0.0 else 0.0
