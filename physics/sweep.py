@@ -1,21 +1,16 @@
-"""Many drops at once: a process pool with a progress bar that never drops a failed run.
+"""Many drops at once, with a progress bar that never drops a failed run.
 
 A :class:`Run` is a preset (or TOML path) plus dotted overrides, exactly what ``rotordrop drop
 --scene ... --set ...`` takes, so every point of a sweep can be re-run by hand
-(:func:`reproduce_command`). :func:`run_sweep` simulates the runs on all cores and returns one
-:class:`Outcome` per run, in order; a run that raises (bad scene, integration failure, anything
-else) comes back with ``ok = False`` and the error text instead of being skipped.
-
-Each worker loads the numba kernels once (:func:`physics.simulate.warm_up` in the pool
-initializer); every scene shares the same compiled kernel.
+(:func:`reproduce_command`). :func:`run_sweep` simulates the runs on all cores (threads of this
+process, :func:`physics.batch.run_chunk`) and returns one :class:`Outcome` per run, in order; a
+run that raises (bad scene, integration failure, anything else) comes back with ``ok = False``
+and the error text instead of being skipped.
 """
 from __future__ import annotations
 
-import multiprocessing
-import os
 import shlex
 import traceback
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from numbers import Integral
 from typing import Any, Callable, Iterable, Sequence
@@ -67,6 +62,12 @@ class Outcome:
         d.update(ok=self.ok, error=self.error, metrics=self.metrics, extra=self.extra)
         return d
 
+    @classmethod
+    def from_dict(cls, d: dict) -> "Outcome":
+        """The outcome :meth:`to_dict` wrote (e.g. read back from JSON)."""
+        run = Run.of(d["scene"], d["overrides"], **d["labels"])
+        return cls(run, d["ok"], d["metrics"], d["extra"], d["error"])
+
 
 def reproduce_command(run: Run) -> str:
     """The ``rotordrop drop`` command line that re-runs ``run`` exactly."""
@@ -101,8 +102,14 @@ def simulate_run(run: Run, evaluate: Evaluate | None = None) -> Outcome:
     try:
         return outcome_of(run, simulate(run.to_scene()), evaluate)
     except Exception as exc:                                   # reported, never dropped
-        detail = "" if _expected(exc) else "\n" + traceback.format_exc(limit=3)
-        return Outcome(run, False, error=f"{type(exc).__name__}: {exc}{detail}")
+        return failed_outcome(run, exc)
+
+
+def failed_outcome(run: Run, exc: Exception) -> Outcome:
+    """The failed :class:`Outcome` of ``run`` stopped by ``exc``: the message of an expected
+    error (bad scene, integration failure), a short traceback with anything else."""
+    detail = "" if _expected(exc) else "\n" + traceback.format_exc(limit=3)
+    return Outcome(run, False, error=f"{type(exc).__name__}: {exc}{detail}")
 
 
 def _expected(exc: Exception) -> bool:
@@ -111,72 +118,40 @@ def _expected(exc: Exception) -> bool:
     return isinstance(exc, (SceneError, IntegrationError))
 
 
-def _init_worker(scene: str) -> None:
-    """Pool initializer: load the compiled kernels once per worker process."""
-    from .model import build_model
-    from .scene import load_scene
-    from .simulate import warm_up
-    os.environ.setdefault("MPLBACKEND", "Agg")
-    warm_up(build_model(load_scene(scene)))
-
-
-def _call(args):
-    run, evaluate = args
-    return simulate_run(run, evaluate)
-
-
-def default_jobs() -> int:
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except AttributeError:                                     # not on Linux
-        return max(1, os.cpu_count() or 1)
-
-
 def plan_jobs(jobs: int | None, runs: int) -> tuple[int, str]:
-    """Worker processes for ``runs`` drops: ``jobs`` (>= 1; None: all cores) capped at the CPU
+    """Threads for ``runs`` drops: ``jobs`` (>= 1; None: all available cores) capped at the CPU
     count and at the number of drops, and a note saying so when ``jobs`` was capped ("" else)."""
+    from .batch import available_cores
     if jobs is not None and (isinstance(jobs, bool) or not isinstance(jobs, Integral) or jobs < 1):
         from .cli import UsageError
         raise UsageError(f"--jobs must be an integer >= 1, got {jobs!r}")
-    cpus = default_jobs()
+    cpus = available_cores()
     used = max(1, min(cpus if jobs is None else jobs, cpus, runs))
     if jobs is None or used == jobs:
         return used, ""
-    return used, (f"--jobs {jobs} capped at {used} worker process(es) "
+    return used, (f"--jobs {jobs} capped at {used} thread(s) "
                   f"({cpus} CPU(s), {runs} drop(s) to run)")
 
 
 def run_sweep(runs: Sequence[Run] | Iterable[Run], evaluate: Evaluate | None = None,
               jobs: int | None = None, desc: str = "sweep", progress: bool = True) -> list[Outcome]:
-    """Simulate ``runs`` on ``jobs`` processes (default: all cores; at most one per CPU and per
-    run, :func:`plan_jobs`); outcomes in input order.
+    """Simulate ``runs`` in this process on ``jobs`` threads (default: all available cores; at
+    most one per CPU and per run, :func:`plan_jobs`) with :func:`physics.batch.run_chunk`;
+    outcomes in input order.
 
-    ``evaluate(result) -> dict`` (a module-level function, so it can be pickled) computes extra
-    numbers from the full result inside the worker; only the small dicts travel back.
+    ``evaluate(result) -> dict`` (a module-level function) computes extra numbers from the full
+    result as each drop finishes; only the small dicts are kept.
     """
+    from .batch import run_chunk
     runs = list(runs)
     jobs = plan_jobs(jobs, len(runs))[0]
     bar = _bar(progress, len(runs), desc)
-    out: list[Outcome] = []
     try:
-        if jobs == 1 or len(runs) <= 1:
-            if runs:
-                _init_worker(runs[0].scene)
-            for run in runs:
-                out.append(simulate_run(run, evaluate))
-                _tick(bar, out[-1])
-        else:
-            ctx = multiprocessing.get_context("fork" if os.name == "posix" else "spawn")
-            with ProcessPoolExecutor(jobs, mp_context=ctx, initializer=_init_worker,
-                                     initargs=(runs[0].scene,)) as pool:
-                chunk = max(1, min(8, len(runs) // (4 * jobs)))
-                for outcome in pool.map(_call, ((r, evaluate) for r in runs), chunksize=chunk):
-                    out.append(outcome)
-                    _tick(bar, outcome)
+        return run_chunk(runs, evaluate, threads=jobs,
+                         on_outcome=None if bar is None else (lambda i, o: _tick(bar, o)))
     finally:
         if bar is not None:
             bar.close()
-    return out
 
 
 def _bar(enabled: bool, total: int, desc: str):
