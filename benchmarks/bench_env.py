@@ -108,7 +108,7 @@ def passive_split(kwargs: dict, episodes: int):
         b = u._b
         y, U = b.y.copy(), b.U.copy()
         sv = u.scene.solver
-        work = np.empty((8, y.size))
+        work = np.empty((9, y.size))
         t0 = CLOCK()
         status = _physics_loop(y, b.M[K.M_T], u.dt, n_steps, b.P, b.I, U, sv.rtol, b.atol,
                                b.M[K.M_H], sv.max_step, sv.min_step, work)
