@@ -50,15 +50,16 @@ def run_chunk(runs: Sequence[Run], evaluate: Evaluate | None = None, threads: in
         return []
     n = max(1, min(threads or available_cores(), len(runs)))
     compile_s = _warm_up(runs[0])
+    bases = _base_scenes(runs)
     out: list[Outcome | None] = [None] * len(runs)
     if n == 1:
         for i, run in enumerate(runs):
-            out[i] = simulate_drop(run, evaluate, compile_s if i == 0 else 0.0)
+            out[i] = simulate_drop(run, evaluate, compile_s if i == 0 else 0.0, bases)
             if on_outcome is not None:
                 on_outcome(i, out[i])
         return out
     with ThreadPoolExecutor(n, thread_name_prefix="drop") as pool:
-        pending = {pool.submit(simulate_drop, run, evaluate, compile_s if i == 0 else 0.0): i
+        pending = {pool.submit(simulate_drop, run, evaluate, compile_s if i == 0 else 0.0, bases): i
                    for i, run in enumerate(runs)}
         while pending:
             done, _ = wait(pending, return_when=FIRST_COMPLETED)
@@ -70,14 +71,32 @@ def run_chunk(runs: Sequence[Run], evaluate: Evaluate | None = None, threads: in
     return out
 
 
-def simulate_drop(run: Run, evaluate: Evaluate | None = None, compile_s: float = 0.0) -> Outcome:
-    """One drop of a chunk whose kernels are loaded (``compile_s``: its share of the warm-up)."""
+def simulate_drop(run: Run, evaluate: Evaluate | None = None, compile_s: float = 0.0,
+                  bases: dict | None = None) -> Outcome:
+    """One drop of a chunk whose kernels are loaded (``compile_s``: its share of the warm-up;
+    ``bases``: the chunk's scenes without overrides by source, :func:`_base_scenes`)."""
     from .model import build_model
     from .simulate import run_model
     try:
-        return outcome_of(run, run_model(build_model(run.to_scene()), compile_s), evaluate)
+        base = (bases or {}).get(run.scene)
+        scene = base.with_overrides(run.settings) if base is not None else run.to_scene()
+        return outcome_of(run, run_model(build_model(scene), compile_s), evaluate)
     except Exception as exc:                                   # reported, never dropped
         return failed_outcome(run, exc)
+
+
+def _base_scenes(runs: Sequence[Run]) -> dict:
+    """Each scene source of ``runs`` loaded once (``load_scene(source, overrides)`` is
+    ``load_scene(source).with_overrides(overrides)``; parsing the TOML per drop cost more than
+    the metrics). A source that fails to load is left out: its drops report the error."""
+    from .scene import load_scene
+    bases = {}
+    for source in {run.scene for run in runs}:
+        try:
+            bases[source] = load_scene(source)
+        except Exception:                                      # the drops report it
+            pass
+    return bases
 
 
 def _warm_up(run: Run) -> float:

@@ -152,3 +152,23 @@ def integrate_segment(y, t0, t1, P, I, U, rtol, atol, h, h_max, h_min, fixed, ma
             if h < h_min:
                 return STEP_COLLAPSE, t, h, out_pos, n_rhs, n_steps, n_rej
     return OK, t, h, out_pos, n_rhs, n_steps, n_rej
+
+
+@njit
+def sample_diagnostics(T, Y, i0, i1, P, I, U, AUX, work):
+    """``AUX[k]``: the right-hand side's per-plane diagnostics at output sample ``k`` (time
+    ``T[k]``, state ``Y[k]``) for k in [i0, i1), with controls ``U``. ``Y`` and ``AUX`` may be
+    column-major (the drop driver's layout, which the metrics read by column); the rhs sees
+    contiguous copies (``work``: the integrator's (9, n) scratch), so the values are those of
+    :func:`physics.model.diagnostics`."""
+    n = Y.shape[1]
+    y = work[7]
+    dy = work[8]
+    aux = np.empty(N_AUX)
+    for k in range(i0, i1):
+        for i in range(n):
+            y[i] = Y[k, i]
+        rhs(T[k], y, P, I, U, dy, aux)
+        for j in range(N_AUX):
+            AUX[k, j] = aux[j]
+

@@ -8,7 +8,8 @@ from concurrent.futures import TimeoutError as FutureTimeout
 import numpy as np
 
 from .equilibrium import levitated_state
-from .integrate import N_PEAK, NOT_FINITE, OK, STEP_COLLAPSE, TOO_MANY_STEPS, integrate_segment
+from .integrate import (N_PEAK, NOT_FINITE, OK, STEP_COLLAPSE, TOO_MANY_STEPS, integrate_segment,
+                        sample_diagnostics)
 from .model import N_AUX, AMB_NONE, F_AMB, Model, build_model, diagnostics
 from .results import Result, RunStats
 from .scene import Scene, SceneError, param_meta
@@ -113,13 +114,16 @@ def warm_up(model: Model, progress: bool = False) -> float:
     progress bar); returns the seconds it took."""
     t0 = time.perf_counter()
     y = levitated_state(model)
-    Integrator(model).advance(y, 0.0, 1e-9, model.controls(True))
+    integ = Integrator(model)
+    integ.advance(y, 0.0, 1e-9, model.controls(True))        # the environments' fault state
+    t_out = np.array([0.0, 1e-9, 2e-9])                      # the drop driver's calls
+    Y = np.zeros((3, model.n_state), order="F")
     peaks = np.zeros(2 * N_PEAK)
-    Integrator(model).advance(y, 1e-9, 2e-9, model.controls(False), peaks=peaks)
-    if progress:
-        Integrator(model).advance(y, 2e-9, 3e-9, model.controls(True), clock=np.zeros(1))
-        Integrator(model).advance(y, 3e-9, 4e-9, model.controls(False), peaks=peaks,
-                                  clock=np.zeros(1))
+    clock = np.zeros(1) if progress else None
+    integ.advance(y, 0.0, 1e-9, model.controls(True), t_out, Y, 1, None, clock)
+    integ.advance(y, 1e-9, 2e-9, model.controls(False), t_out, Y, 2, peaks, clock)
+    sample_diagnostics(t_out, Y, 0, 3, model.P, model.I, model.controls(False),
+                       np.empty((3, N_AUX), order="F"), integ.work)
     diagnostics(np.zeros(1), y[None, :].copy(), model.P, model.I, model.controls(True),
                 np.empty((1, N_AUX)))
     return time.perf_counter() - t0
@@ -193,27 +197,36 @@ def run_model(model: Model, compile_s: float = 0.0, progress: bool = False) -> R
     t_end = model.scene.solver.t_end
     t_out = output_times(model)
     n_out = len(t_out)
-    Y = np.empty((n_out, model.n_state))
+    Y = np.empty((n_out, model.n_state), order="F")     # column-major: the metrics read columns
     y = levitated_state(model)
     Y[0] = y
     integ = Integrator(model)
     bar = _progress(progress, t_end, model.scene.name)
     peaks = np.zeros(2 * N_PEAK)
-    wall0 = time.perf_counter()
+    wall0, cpu0 = time.perf_counter(), time.thread_time()
     run_segments(integ, y, t_end, t_out, Y, bar, peaks)
     integ.stats.wall_time_s = time.perf_counter() - wall0
+    if bar is None:                 # else the kernel ran in another thread
+        integ.stats.cpu_time_s = time.thread_time() - cpu0
     integ.stats.compile_time_s = compile_s
     if bar is not None:
         bar.close()
-    aux = np.empty((n_out, N_AUX))
-    for a, b, powered in segments(model, t_end):
-        sel = np.flatnonzero((t_out >= a) & ((t_out <= b) if powered else True))
-        chunk = np.empty((len(sel), N_AUX))
-        diagnostics(t_out[sel], Y[sel], model.P, model.I, model.controls(powered), chunk)
-        aux[sel] = chunk
+    aux = sampled_diagnostics(model, t_out, Y, integ.work)
     t_fault = next((a for a, _, powered in segments(model, t_end) if not powered), None)
     return Result(model, t_out, Y, aux, integ.stats, t_fault,
                   step_peaks=peaks.reshape(2, N_PEAK) if t_fault is not None else None)
+
+
+def sampled_diagnostics(model: Model, t_out: np.ndarray, Y: np.ndarray,
+                        work: np.ndarray) -> np.ndarray:
+    """The per-plane diagnostics (N_AUX columns, column-major) at the output samples, each with
+    the controls of its segment (a sample at the fault time: the unpowered one's)."""
+    aux = np.empty((len(t_out), N_AUX), order="F")
+    for a, b, powered in segments(model, t_out[-1]):
+        i0 = int(np.searchsorted(t_out, a, "left"))
+        i1 = int(np.searchsorted(t_out, b, "right")) if powered else len(t_out)
+        sample_diagnostics(t_out, Y, i0, i1, model.P, model.I, model.controls(powered), aux, work)
+    return aux
 
 
 def output_times(model: Model) -> np.ndarray:
