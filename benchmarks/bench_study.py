@@ -28,7 +28,7 @@ import tempfile
 import time
 
 from physics import load_scene, simulate
-from physics.batch import available_cores
+from physics.sweep import available_cores
 from physics.simulate import warm_up
 from physics.model import build_model
 from physics.study.paper import Plan, StudyInput, plan_runs

@@ -193,7 +193,7 @@ def simulate(scene: Scene, t_end: float | None = None, progress: bool = False) -
 def run_model(model: Model, compile_s: float = 0.0, progress: bool = False) -> Result:
     """The drop of a built ``model`` whose kernels are loaded (:func:`warm_up`; ``compile_s``:
     the seconds that took, reported apart from the integration's ``wall_time_s``). The single
-    drop and the batches of :mod:`physics.batch` both run this, so their numbers are identical."""
+    drop and the batches of :func:`physics.sweep.run_chunk` both run this, so their numbers are identical."""
     t_end = model.scene.solver.t_end
     t_out = output_times(model)
     n_out = len(t_out)

@@ -1,10 +1,10 @@
-"""Drops in batches (physics.batch): the numbers of a batch are the single drop's, bit for bit."""
+"""Drops in batches (physics.sweep.run_chunk): the numbers of a batch are the single drop's, bit for bit."""
 import json
 
 import pytest
 
 from physics import load_scene, simulate
-from physics.batch import run_chunk
+from physics.sweep import run_chunk
 from physics.metrics import compute_metrics
 from physics.study.observables import drop_observables
 from physics.sweep import Outcome, Run
