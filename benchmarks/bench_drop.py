@@ -4,7 +4,9 @@
 
 Every figure is the median of ``--repeats`` runs after a JIT warm-up, on one core (numba kernels
 are single-threaded). Also times a cold compile (empty numba cache, in a subprocess) and a warm
-start (kernels loaded from the on-disk cache).
+start (kernels loaded from the on-disk cache), and the floor ratio of the paper drop: its
+integration time over the accepted steps' rhs evaluations times the cost of one rhs, each drop
+followed by its rhs timing (interleaved, so a machine's load moves both).
 """
 from __future__ import annotations
 
@@ -32,18 +34,36 @@ EFFECTS_OFF = [("full model (paper)", {}), *REDUCED,
                ("no friction", {"effects.friction": "none"})]
 
 
-def ns_per_rhs(result, samples=400, reps=50) -> float:
+def ns_per_rhs(result, samples=400, reps=50, clock=time.perf_counter) -> float:
     """Median cost of one right-hand-side evaluation over states sampled from a run [ns]."""
     m = result.model
-    Y = result.Y[:: max(1, len(result.Y) // samples)].copy()
+    Y = np.ascontiguousarray(result.Y[:: max(1, len(result.Y) // samples)])
     U = m.controls(False)
     dy, aux = np.empty(m.n_state), np.empty(N_AUX)
     times = []
     for _ in range(5):
-        t0 = time.perf_counter()
+        t0 = clock()
         _rhs_loop(Y, m.P, m.I, U, dy, aux, reps)
-        times.append((time.perf_counter() - t0) / (reps * len(Y)) * 1e9)
+        times.append((clock() - t0) / (reps * len(Y)) * 1e9)
     return statistics.median(times)
+
+
+def floor_ratio(scene, t_end: float, repeats: int) -> dict:
+    """A drop's integration time over its floor, the accepted steps' rhs evaluations (every rhs
+    evaluation but the 6 of each rejected step) times the cost of one rhs, timed right after
+    each drop (interleaved); medians of ``repeats``. By the wall clock (the drop's
+    ``wall_time_s``) and by the thread's CPU time (``cpu_time_s``: robust to a loaded machine)."""
+    wall, cpu = [], []
+    for _ in range(repeats):
+        r = simulate(scene, t_end=t_end)
+        st = r.stats
+        accepted_rhs = st.rhs_evaluations - 6 * st.rejected_steps
+        wall.append(st.wall_time_s / (accepted_rhs * ns_per_rhs(r) * 1e-9))
+        cpu.append(st.cpu_time_s / (accepted_rhs * ns_per_rhs(r, clock=time.thread_time) * 1e-9))
+    return dict(floor_ratio_wall=statistics.median(wall), floor_ratio_cpu=statistics.median(cpu),
+                wall_s_per_sim_s=st.wall_time_s / t_end, rhs_evaluations=st.rhs_evaluations,
+                rejected=st.rejected_steps, accepted_rhs=accepted_rhs,
+                compile_time_s=st.compile_time_s)
 
 
 def _make_loop():
@@ -101,6 +121,16 @@ def main() -> None:
         out["compile"] = compile_times()
         print(f"compile from empty cache {out['compile']['cold_compile_s']:.1f} s, "
               f"warm start {out['compile']['warm_cache_load_s']:.2f} s (process import + cache load)")
+
+    print(f"\nfloor ratio (integration time / (accepted steps' rhs evaluations x ns per rhs), "
+          f"each drop followed by its rhs timing; median of {args.repeats}):")
+    out["floor"] = {}
+    for mu in (0.25, 0.5):
+        row = floor_ratio(load_scene("paper", {"contact.friction": mu}), args.t_end, args.repeats)
+        out["floor"][f"mu={mu}"] = row
+        print(f"  mu = {mu:<5} {row['floor_ratio_wall']:.3f} (wall), {row['floor_ratio_cpu']:.3f} "
+              f"(CPU time); {row['wall_s_per_sim_s']:.4f} wall s per simulated s, "
+              f"{row['rhs_evaluations']} rhs evaluations, {row['rejected']} rejected steps")
 
     print(f"\npaper scene, default tolerance, median of {args.repeats} runs of {args.t_end:g} s:")
     out["paper"] = {}
