@@ -162,20 +162,18 @@ def integrate_segment(y, t0, t1, P, I, U, rtol, atol, h, h_max, h_min, fixed, ma
 
 
 @njit
-def sample_diagnostics(T, Y, i0, i1, P, I, U, AUX, work):
+def sample_diagnostics(T, Y, i0, i1, P, I, U, AUX, Y_cols):
     """``AUX[k]``: the right-hand side's per-plane diagnostics at output sample ``k`` (time
-    ``T[k]``, state ``Y[k]``) for k in [i0, i1), with controls ``U``. ``Y`` and ``AUX`` may be
-    column-major (the drop driver's layout, which the metrics read by column); the rhs sees
-    contiguous copies (``work``: the integrator's (9, n) scratch), so the values are those of
-    :func:`physics.model.diagnostics`."""
+    ``T[k]``, state ``Y[k]``, the integrator's row-major output) for k in [i0, i1), with
+    controls ``U``; and ``Y_cols[k] = Y[k]``: ``Y_cols`` and ``AUX`` are column-major, the layout
+    the metrics read (whole time series of single states), written here, after the integration,
+    where the rows are read anyway. The values are those of :func:`physics.model.diagnostics`."""
     n = Y.shape[1]
-    y = work[7]
-    dy = work[8]
+    dy = np.empty(n)
     aux = np.empty(N_AUX)
     for k in range(i0, i1):
-        for i in range(n):
-            y[i] = Y[k, i]
-        rhs(T[k], y, P, I, U, dy, aux)
+        rhs(T[k], Y[k], P, I, U, dy, aux)
         for j in range(N_AUX):
             AUX[k, j] = aux[j]
-
+        for i in range(n):
+            Y_cols[k, i] = Y[k, i]

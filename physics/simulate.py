@@ -43,7 +43,7 @@ class Integrator:
         self.work = np.empty((9, model.n_state))
         self.stats = RunStats()
         self._no_out = np.empty(0)
-        self._no_Y = np.empty((0, model.n_state), order="F")     # the drop driver's layout
+        self._no_Y = np.empty((0, model.n_state))
 
     def advance(self, y, t0, t1, U, t_out=None, Y_out=None, pos=0, peaks=None,
                 clock=None) -> int:
@@ -117,13 +117,12 @@ def warm_up(model: Model) -> float:
     y = levitated_state(model)
     integ = Integrator(model)
     t_out = np.array([0.0, 1e-9, 2e-9])
-    Y = np.zeros((3, model.n_state), order="F")
+    Y = np.zeros((3, model.n_state))
     peaks = np.zeros(2 * N_PEAK)
     clock = np.zeros(1)
     integ.advance(y, 0.0, 1e-9, model.controls(True), t_out, Y, 1, None, clock)
     integ.advance(y, 1e-9, 2e-9, model.controls(False), t_out, Y, 2, peaks, clock)
-    sample_diagnostics(t_out, Y, 0, 3, model.P, model.I, model.controls(False),
-                       np.empty((3, N_AUX), order="F"), integ.work)
+    sampled_diagnostics(model, t_out, Y)
     diagnostics(np.zeros(1), y[None, :].copy(), model.P, model.I, model.controls(True),
                 np.empty((1, N_AUX)))
     return time.perf_counter() - t0
@@ -197,7 +196,7 @@ def run_model(model: Model, compile_s: float = 0.0, progress: bool = False) -> R
     t_end = model.scene.solver.t_end
     t_out = output_times(model)
     n_out = len(t_out)
-    Y = np.empty((n_out, model.n_state), order="F")     # column-major: the metrics read columns
+    Y = np.empty((n_out, model.n_state))
     y = levitated_state(model)
     Y[0] = y
     integ = Integrator(model)
@@ -211,22 +210,25 @@ def run_model(model: Model, compile_s: float = 0.0, progress: bool = False) -> R
     integ.stats.compile_time_s = compile_s
     if bar is not None:
         bar.close()
-    aux = sampled_diagnostics(model, t_out, Y, integ.work)
+    Y, aux = sampled_diagnostics(model, t_out, Y)
     t_fault = next((a for a, _, powered in segments(model, t_end) if not powered), None)
     return Result(model, t_out, Y, aux, integ.stats, t_fault,
                   step_peaks=peaks.reshape(2, N_PEAK) if t_fault is not None else None)
 
 
-def sampled_diagnostics(model: Model, t_out: np.ndarray, Y: np.ndarray,
-                        work: np.ndarray) -> np.ndarray:
-    """The per-plane diagnostics (N_AUX columns, column-major) at the output samples, each with
+def sampled_diagnostics(model: Model, t_out: np.ndarray,
+                        Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The output samples ``Y`` and their per-plane diagnostics (N_AUX columns), both
+    column-major (the metrics read time series of single states), each sample's diagnostics with
     the controls of its segment (a sample at the fault time: the unpowered one's)."""
+    Y_cols = np.empty(Y.shape, order="F")
     aux = np.empty((len(t_out), N_AUX), order="F")
     for a, b, powered in segments(model, t_out[-1]):
         i0 = int(np.searchsorted(t_out, a, "left"))
         i1 = int(np.searchsorted(t_out, b, "right")) if powered else len(t_out)
-        sample_diagnostics(t_out, Y, i0, i1, model.P, model.I, model.controls(powered), aux, work)
-    return aux
+        sample_diagnostics(t_out, Y, i0, i1, model.P, model.I, model.controls(powered), aux,
+                           Y_cols)
+    return Y_cols, aux
 
 
 def output_times(model: Model) -> np.ndarray:
