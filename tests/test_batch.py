@@ -51,3 +51,19 @@ def test_bad_thread_counts_are_refused_and_an_empty_chunk_is_empty():
     for bad in (0, -1, 1.5, True):
         with pytest.raises(ValueError, match="threads must be an integer >= 1"):
             run_chunk(RUNS[:1], threads=bad)
+
+
+def test_a_progress_bar_changes_no_number_and_the_warm_up_compiles_everything_a_drop_runs():
+    """The bar follows a clock the kernel writes (same steps with and without it); after
+    warm_up the drop compiles nothing, so its wall_time_s holds no compilation."""
+    from physics.integrate import integrate_segment, sample_diagnostics
+    from physics.model import build_model
+    from physics.simulate import warm_up
+    scene = load_scene("paper", {"solver.t_end": 0.15, "contact.friction": 0.5})
+    warm_up(build_model(scene))
+    kernels = (integrate_segment, sample_diagnostics)
+    compiled = [len(k.signatures) for k in kernels]
+    plain = compute_metrics(simulate(scene))
+    with_bar = compute_metrics(simulate(scene, progress=True))
+    assert [len(k.signatures) for k in kernels] == compiled
+    assert _numbers(plain) == _numbers(with_bar) and plain["rhs_evaluations"] > 1000
