@@ -16,6 +16,7 @@ from .model import A_FR, A_LOAD, A_QMAX, N_AUX, N_AUX_PLANE, rhs
 (P_FR, P_LOAD, P_QMAX, N_PEAK) = range(4)
 
 OK, STEP_COLLAPSE, TOO_MANY_STEPS, NOT_FINITE = 0, 1, 2, 3
+SAMPLE_BLOCK = 64       # output samples per block of sample_diagnostics' column-major copies
 
 # Butcher tableau (Dormand & Prince 1980) and dense-output polynomial (Hairer et al.)
 _C = np.array([0.0, 1 / 5, 3 / 10, 4 / 5, 8 / 9, 1.0, 1.0])
@@ -167,13 +168,18 @@ def sample_diagnostics(T, Y, i0, i1, P, I, U, AUX, Y_cols):
     ``T[k]``, state ``Y[k]``, the integrator's row-major output) for k in [i0, i1), with
     controls ``U``; and ``Y_cols[k] = Y[k]``: ``Y_cols`` and ``AUX`` are column-major, the layout
     the metrics read (whole time series of single states), written here, after the integration,
-    where the rows are read anyway. The values are those of :func:`physics.model.diagnostics`."""
+    in blocks of ``SAMPLE_BLOCK`` samples (a column-major write per sample touches a cache line
+    per column). The values are those of :func:`physics.model.diagnostics`."""
     n = Y.shape[1]
     dy = np.empty(n)
-    aux = np.empty(N_AUX)
-    for k in range(i0, i1):
-        rhs(T[k], Y[k], P, I, U, dy, aux)
+    block = np.empty((SAMPLE_BLOCK, N_AUX))
+    for k0 in range(i0, i1, SAMPLE_BLOCK):
+        m = min(SAMPLE_BLOCK, i1 - k0)
+        for k in range(m):
+            rhs(T[k0 + k], Y[k0 + k], P, I, U, dy, block[k])
         for j in range(N_AUX):
-            AUX[k, j] = aux[j]
+            for k in range(m):
+                AUX[k0 + k, j] = block[k, j]
         for i in range(n):
-            Y_cols[k, i] = Y[k, i]
+            for k in range(m):
+                Y_cols[k0 + k, i] = Y[k0 + k, i]
