@@ -10,7 +10,7 @@ import numpy as np
 from .equilibrium import levitated_state
 from .integrate import (N_PEAK, NOT_FINITE, OK, STEP_COLLAPSE, TOO_MANY_STEPS, integrate_segment,
                         sample_diagnostics)
-from .model import N_AUX, AMB_NONE, F_AMB, Model, build_model, diagnostics
+from .model import N_AUX, AMB_NONE, F_AMB, Model, build_model
 from .results import Result, RunStats
 from .scene import Scene, SceneError, param_meta
 
@@ -123,8 +123,6 @@ def warm_up(model: Model) -> float:
     integ.advance(y, 0.0, 1e-9, model.controls(True), t_out, Y, 1, None, clock)
     integ.advance(y, 1e-9, 2e-9, model.controls(False), t_out, Y, 2, peaks, clock)
     sampled_diagnostics(model, t_out, Y)
-    diagnostics(np.zeros(1), y[None, :].copy(), model.P, model.I, model.controls(True),
-                np.empty((1, N_AUX)))
     return time.perf_counter() - t0
 
 
