@@ -86,29 +86,38 @@ def integrate_segment(y, t0, t1, P, I, U, rtol, atol, h, h_max, h_min, fixed, ma
             h = t1 - t
         # stages 2..7 (the 7th is evaluated at the new point: first-same-as-last)
         for s in range(1, 7):
-            # j outer, i inner (contiguous, vectorised); per i the sum runs in the same j order
-            for i in range(n):
-                acc[i] = 0.0
-            for j in range(s):
-                a = _A[s, j]
+            # j outer, i inner (contiguous, vectorised), the first and last terms fused into the
+            # passes around them; per i: 0.0 + a_s0 k_0 + ... + a_s,s-1 k_s-1, in this order
+            if s == 1:
                 for i in range(n):
-                    acc[i] += a * K[j, i]
-            for i in range(n):
-                ytry[i] = y[i] + h * acc[i]
+                    ytry[i] = y[i] + h * (0.0 + _A[1, 0] * K[0, i])
+            else:
+                a = _A[s, 0]
+                for i in range(n):
+                    acc[i] = 0.0 + a * K[0, i]
+                for j in range(1, s - 1):
+                    a = _A[s, j]
+                    for i in range(n):
+                        acc[i] += a * K[j, i]
+                a = _A[s, s - 1]
+                for i in range(n):
+                    ytry[i] = y[i] + h * (acc[i] + a * K[s - 1, i])
             rhs(t + _C[s] * h, ytry, P, I, U, K[s], aux)
         n_rhs += 6
         n_steps += 1
         err = 0.0
         finite = True
+        a = _E[0]
         for i in range(n):
-            acc[i] = 0.0
-        for j in range(7):
+            acc[i] = 0.0 + a * K[0, i]
+        for j in range(1, 6):
             a = _E[j]
             for i in range(n):
                 acc[i] += a * K[j, i]
+        a = _E[6]
         for i in range(n):
             sc = atol[i] + rtol * max(abs(y[i]), abs(ytry[i]))
-            r = h * acc[i] / sc
+            r = h * (acc[i] + a * K[6, i]) / sc
             err += r * r
             if not math.isfinite(ytry[i]):
                 finite = False
