@@ -115,10 +115,11 @@ def integrate_segment(y, t0, t1, P, I, U, rtol, atol, h, h_max, h_min, fixed, ma
             for i in range(n):
                 acc[i] += a * K[j, i]
         a = _E[6]
-        for i in range(n):
+        for i in range(n):                  # scaled errors (vectorised), then summed in order
             sc = atol[i] + rtol * max(abs(y[i]), abs(ytry[i]))
-            r = h * (acc[i] + a * K[6, i]) / sc
-            err += r * r
+            acc[i] = h * (acc[i] + a * K[6, i]) / sc
+        for i in range(n):
+            err += acc[i] * acc[i]
             if not math.isfinite(ytry[i]):
                 finite = False
         err = math.sqrt(err / n)
