@@ -4,7 +4,9 @@
 
 Every figure is the median of ``--repeats`` runs after a JIT warm-up, on one core (numba kernels
 are single-threaded). Also times a cold compile (empty numba cache, in a subprocess) and a warm
-start (kernels loaded from the on-disk cache).
+start (kernels loaded from the on-disk cache), and the floor ratio of the paper drop: its
+integration time over the accepted steps' rhs evaluations times the cost of one rhs, each drop
+followed by its rhs timing (interleaved, so a machine's load moves both).
 """
 from __future__ import annotations
 
@@ -34,24 +36,24 @@ EFFECTS_OFF = [("full model (paper)", {}), *REDUCED,
 EFFECTS_ON = [("sleeve heating (thermal)", {"effects.thermal": True})]
 
 
-def _rhs_timer(result, samples=400):
+def _rhs_timer(result, samples=400, clock=time.perf_counter):
     """A function timing one pass of ``reps`` rhs evaluations over states sampled from a run,
-    returning ns per evaluation."""
+    returning ns per evaluation (by ``clock``: the wall clock, or ``time.thread_time``)."""
     m = result.model
-    Y = result.Y[:: max(1, len(result.Y) // samples)].copy()
+    Y = np.ascontiguousarray(result.Y[:: max(1, len(result.Y) // samples)])
     U = m.controls(False)
     dy, aux = np.empty(m.n_state), np.empty(N_AUX)
 
     def time_once(reps: int) -> float:
-        t0 = time.perf_counter()
+        t0 = clock()
         _rhs_loop(Y, m.P, m.I, U, dy, aux, reps)
-        return (time.perf_counter() - t0) / (reps * len(Y)) * 1e9
+        return (clock() - t0) / (reps * len(Y)) * 1e9
     return time_once
 
 
-def ns_per_rhs(result, samples=400, reps=50) -> float:
+def ns_per_rhs(result, samples=400, reps=50, clock=time.perf_counter) -> float:
     """Median cost of one right-hand-side evaluation over states sampled from a run [ns]."""
-    time_once = _rhs_timer(result, samples)
+    time_once = _rhs_timer(result, samples, clock)
     return statistics.median(time_once(reps) for _ in range(5))
 
 
@@ -67,6 +69,24 @@ def rhs_cost_ratio(result, reference, rounds=41, reps=5) -> float:
             ta, tb = a(reps), b(reps)
         ratios.append(ta / tb)
     return statistics.median(ratios)
+
+
+def floor_ratio(scene, t_end: float, repeats: int) -> dict:
+    """A drop's integration time over its floor, the accepted steps' rhs evaluations (every rhs
+    evaluation but the 6 of each rejected step) times the cost of one rhs, timed right after
+    each drop (interleaved); medians of ``repeats``. By the wall clock (the drop's
+    ``wall_time_s``) and by the thread's CPU time (``cpu_time_s``: robust to a loaded machine)."""
+    wall, cpu = [], []
+    for _ in range(repeats):
+        r = simulate(scene, t_end=t_end)
+        st = r.stats
+        accepted_rhs = st.rhs_evaluations - 6 * st.rejected_steps
+        wall.append(st.wall_time_s / (accepted_rhs * ns_per_rhs(r) * 1e-9))
+        cpu.append(st.cpu_time_s / (accepted_rhs * ns_per_rhs(r, clock=time.thread_time) * 1e-9))
+    return dict(floor_ratio_wall=statistics.median(wall), floor_ratio_cpu=statistics.median(cpu),
+                wall_s_per_sim_s=st.wall_time_s / t_end, rhs_evaluations=st.rhs_evaluations,
+                rejected=st.rejected_steps, accepted_rhs=accepted_rhs,
+                compile_time_s=st.compile_time_s)
 
 
 def _make_loop():
@@ -124,6 +144,16 @@ def main() -> None:
         out["compile"] = compile_times()
         print(f"compile from empty cache {out['compile']['cold_compile_s']:.1f} s, "
               f"warm start {out['compile']['warm_cache_load_s']:.2f} s (process import + cache load)")
+
+    print(f"\nfloor ratio (integration time / (accepted steps' rhs evaluations x ns per rhs), "
+          f"each drop followed by its rhs timing; median of {args.repeats}):")
+    out["floor"] = {}
+    for mu in (0.25, 0.5):
+        row = floor_ratio(load_scene("paper", {"contact.friction": mu}), args.t_end, args.repeats)
+        out["floor"][f"mu={mu}"] = row
+        print(f"  mu = {mu:<5} {row['floor_ratio_wall']:.3f} (wall), {row['floor_ratio_cpu']:.3f} "
+              f"(CPU time); {row['wall_s_per_sim_s']:.4f} wall s per simulated s, "
+              f"{row['rhs_evaluations']} rhs evaluations, {row['rejected']} rejected steps")
 
     print(f"\npaper scene, default tolerance, median of {args.repeats} runs of {args.t_end:g} s:")
     out["paper"] = {}

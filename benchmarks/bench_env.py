@@ -16,7 +16,8 @@ a machine shared with other jobs) or by the wall clock (``--clock wall``).
   1 ms step, in one compiled loop), the step kernel (physics + sub-sampled monitors, reward,
   observation), the Python ``step`` and Gymnasium's wrappers;
 * batched: ``BatchedRotorDropVecEnv`` with N envs of the damping env, with 1 numba thread (the
-  per-core figure) and with all threads.
+  per-core figure) and with all threads; and with its default threads (chosen as it runs) over
+  one thread, N = 1 and N = ``--n-envs``, by the wall clock, runs interleaved.
 """
 from __future__ import annotations
 
@@ -108,7 +109,7 @@ def passive_split(kwargs: dict, episodes: int):
         b = u._b
         y, U = b.y.copy(), b.U.copy()
         sv = u.scene.solver
-        work = np.empty((8, y.size))
+        work = np.empty((9, y.size))
         t0 = CLOCK()
         status = _physics_loop(y, b.M[K.M_T], u.dt, n_steps, b.P, b.I, U, sv.rtol, b.atol,
                                b.M[K.M_H], sv.max_step, sv.min_step, work)
@@ -134,7 +135,11 @@ def _physics_loop(y, t, dt, n, P, I, U, rtol, atol, h, h_max, h_min, work):
     return 0
 
 
-def batched_rate(env_id: str, kwargs: dict, n_envs: int, steps: int, threads: int, seed: int = 0):
+def batched_rate(env_id: str, kwargs: dict, n_envs: int, steps: int, threads: int | None,
+                 seed: int = 0, clock=None):
+    """Env steps per second of a batch (``threads`` None: the batch's own choice), timed by
+    ``clock`` (default: the --clock of the run)."""
+    clock = clock or CLOCK
     venv = rotordrop_env.BatchedRotorDropVecEnv(env_id, n_envs, seed=seed, n_threads=threads,
                                                 **kwargs)
     rng = np.random.default_rng(seed)
@@ -143,11 +148,23 @@ def batched_rate(env_id: str, kwargs: dict, n_envs: int, steps: int, threads: in
 
     def run():
         venv.reset()
-        t0 = CLOCK()
+        t0 = clock()
         for k in range(steps):
             venv.step(acts[k % len(acts)])
-        return steps * n_envs / (CLOCK() - t0)
+        return steps * n_envs / (clock() - t0)
     return run
+
+
+def default_vs_one_thread(env_id: str, kwargs: dict, n_envs: int, steps: int, repeats: int):
+    """Wall-clock steps/s of the batch with its default threads over the same batch on one
+    thread, runs interleaved: (median ratio, default rate, one-thread rate)."""
+    wall = time.perf_counter
+    auto = batched_rate(env_id, kwargs, n_envs, steps, None, clock=wall)
+    one = batched_rate(env_id, kwargs, n_envs, steps, 1, clock=wall)
+    auto(), one()                                      # warm-up
+    pairs = [(auto(), one()) for _ in range(repeats)]
+    return (statistics.median(a / o for a, o in pairs), statistics.median(a for a, _ in pairs),
+            statistics.median(o for _, o in pairs))
 
 
 def main(argv=None) -> int:
@@ -205,6 +222,13 @@ def main(argv=None) -> int:
         print(f"  {threads} thread(s): {per_core:10.0f} env steps/s per core "
               f"({per_core / single:.2f}x the single env)"
               + ("" if args.clock == "cpu" else f", {rate:.0f} env steps/s in all"))
+    print(f"batched VecEnv with default threads (chosen as it runs) over one thread, wall clock, "
+          f"runs interleaved (median of {R}):")
+    for n_b in sorted({1, n}):
+        ratio, auto, one = default_vs_one_thread("RotorDrop-Damping-v0", kwargs, n_b,
+                                                 max(steps, 4800 // n_b), R)
+        res[f"batched N={n_b} default/one thread (wall)"] = ratio
+        print(f"  N = {n_b:3d}: {ratio:.2f}x ({auto:.0f} vs {one:.0f} env steps/s)")
     if args.json:
         with open(args.json, "w") as fh:
             json.dump(res, fh, indent=2)

@@ -428,7 +428,7 @@ def register(subparsers) -> None:
     add_scene_args(p)
     p.add_argument("--out", default="out/accuracy", help="output directory")
     p.add_argument("--quick", action="store_true", help="2 drops of 0.3 s, fewer settings")
-    p.add_argument("--jobs", type=at_least(1), default=None, help="worker processes (default: all cores)")
+    p.add_argument("--jobs", type=at_least(1), default=None, help="threads (default: all cores)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_accuracy)
 

@@ -19,6 +19,7 @@ class RunStats:
     steps: int = 0
     rejected_steps: int = 0
     wall_time_s: float = 0.0       # integration only, JIT compilation excluded
+    cpu_time_s: float = 0.0        # its CPU time (robust to a loaded machine; 0 with a progress bar)
     compile_time_s: float = 0.0    # JIT compilation or cache load before the run
 
 
@@ -33,6 +34,7 @@ class Result:
     # after the fault, per plane (RB1, RB2): the contact force, bearing load and largest ball load
     # at every accepted integrator step (physics.integrate.P_*), whatever the output rate
     step_peaks: np.ndarray | None = None
+    _axes: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     # -- rotor ----------------------------------------------------------------------------
     def state(self, name: str) -> np.ndarray:
@@ -53,9 +55,15 @@ class Result:
             raise ValueError(f"plane must be one of {planes}, got {plane!r}") from None
 
     def _axis(self, z: float, offset: int = 0) -> np.ndarray:
-        """Rotor axis (x + z a, y + z b) at axial station z; offset 4: its velocity."""
-        i = self.model.I[S_X] + offset
-        return np.stack([self.Y[:, i] + z * self.Y[:, i + 2], self.Y[:, i + 1] + z * self.Y[:, i + 3]], 1)
+        """Rotor axis (x + z a, y + z b) at axial station z; offset 4: its velocity. Computed
+        once per station (the metrics ask several times), read-only."""
+        key = (z, offset)
+        if key not in self._axes:
+            i = self.model.I[S_X] + offset
+            a = np.stack([self.Y[:, i] + z * self.Y[:, i + 2], self.Y[:, i + 1] + z * self.Y[:, i + 3]], 1)
+            a.flags.writeable = False
+            self._axes[key] = a
+        return self._axes[key]
 
     def orbit(self, plane: str) -> np.ndarray:
         """Rotor axis position (x, y) at a retainer plane, relative to the nominal centre [m]."""

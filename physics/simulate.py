@@ -2,16 +2,19 @@
 from __future__ import annotations
 
 import time
+from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import TimeoutError as FutureTimeout
 
 import numpy as np
 
 from .equilibrium import levitated_state
-from .integrate import N_PEAK, NOT_FINITE, OK, STEP_COLLAPSE, TOO_MANY_STEPS, integrate_segment
-from .model import N_AUX, AMB_NONE, F_AMB, Model, build_model, diagnostics
+from .integrate import (N_PEAK, NOT_FINITE, OK, STEP_COLLAPSE, TOO_MANY_STEPS, integrate_segment,
+                        sample_diagnostics)
+from .model import N_AUX, AMB_NONE, F_AMB, Model, build_model
 from .results import Result, RunStats
 from .scene import Scene, SceneError, param_meta
 
-CHUNK_S = 0.01      # the run is advanced in chunks of this length (progress bar granularity)
+BAR_POLL_S = 0.1    # a progress bar reads the time the kernel has reached this often [s]
 MAX_OUTPUT_BYTES = 2 * 1024 ** 3    # states + diagnostics kept in memory; the metrics, the time
                                     # series file and the figures need about as much again
 
@@ -37,20 +40,25 @@ class Integrator:
         self.h_max = sv.dt if self.fixed else sv.max_step
         self.h_min = sv.min_step
         self.max_steps = sv.max_steps
-        self.work = np.empty((8, model.n_state))
+        self.work = np.empty((9, model.n_state))
         self.stats = RunStats()
         self._no_out = np.empty(0)
         self._no_Y = np.empty((0, model.n_state))
 
-    def advance(self, y, t0, t1, U, t_out=None, Y_out=None, pos=0, peaks=None) -> int:
-        """Integrate t0 -> t1 (``peaks``: optional (2 N_PEAK,) step-resolved maxima to update)."""
+    def advance(self, y, t0, t1, U, t_out=None, Y_out=None, pos=0, peaks=None,
+                clock=None) -> int:
+        """Integrate t0 -> t1 (``peaks``: optional (2 N_PEAK,) step-resolved maxima to update;
+        ``clock``: optional (1,) array that follows the time reached, for a progress bar)."""
         if t_out is None:
             t_out, Y_out = self._no_out, self._no_Y
         budget = self.max_steps - self.stats.steps
         args = (y, t0, t1, self.model.P, self.model.I, U, self.rtol, self.atol, self.h,
                 self.h_max, self.h_min, self.fixed, budget, t_out, Y_out, pos, self.work)
-        status, t, h, pos, n_rhs, n_steps, n_rej = (
-            integrate_segment(*args) if peaks is None else integrate_segment(*args, peaks))
+        if clock is not None:
+            args += (peaks, clock)
+        elif peaks is not None:
+            args += (peaks,)
+        status, t, h, pos, n_rhs, n_steps, n_rej = integrate_segment(*args)
         st = self.stats
         st.rhs_evaluations += n_rhs
         st.steps += n_steps
@@ -102,12 +110,19 @@ def _moves(sv, *moves: tuple[str, str, bool]) -> list[str]:
 
 
 def warm_up(model: Model) -> float:
-    """Compile (or load from numba's disk cache) the kernels; returns the seconds it took."""
+    """Compile (or load from numba's disk cache) the kernels a drop runs; returns the seconds
+    it took. Exactly the drop driver's calls (:func:`run_segments`: every segment with a clock,
+    the unpowered one with step peaks), so the first drop's ``wall_time_s`` compiles nothing."""
     t0 = time.perf_counter()
     y = levitated_state(model)
-    Integrator(model).advance(y, 0.0, 1e-9, model.controls(True))
-    diagnostics(np.zeros(1), y[None, :].copy(), model.P, model.I, model.controls(True),
-                np.empty((1, N_AUX)))
+    integ = Integrator(model)
+    t_out = np.array([0.0, 1e-9, 2e-9])
+    Y = np.zeros((3, model.n_state))
+    peaks = np.zeros(2 * N_PEAK)
+    clock = np.zeros(1)
+    integ.advance(y, 0.0, 1e-9, model.controls(True), t_out, Y, 1, None, clock)
+    integ.advance(y, 1e-9, 2e-9, model.controls(False), t_out, Y, 2, peaks, clock)
+    sampled_diagnostics(model, t_out, Y)
     return time.perf_counter() - t0
 
 
@@ -125,22 +140,42 @@ def segments(model: Model, t_end: float) -> list[tuple[float, float, bool]]:
 
 def run_segments(integ: Integrator, y: np.ndarray, t_end: float, t_out=None, Y=None,
                  bar=None, peaks=None) -> None:
-    """Advance ``y`` from t = 0 to ``t_end`` through the AMB-powered/unpowered segments in
-    chunks of ``CHUNK_S`` (so a progress bar moves), filling ``Y`` at ``t_out[1:]`` if given,
-    and the step-resolved maxima after the fault into ``peaks`` if given.
-    The drop driver and the environments' fault state both use it, so they are bit-identical."""
+    """Advance ``y`` from t = 0 to ``t_end`` through the AMB-powered/unpowered segments, one
+    kernel call per segment, filling ``Y`` at ``t_out[1:]`` if given, and the step-resolved
+    maxima after the fault into ``peaks`` if given. A progress ``bar`` follows the time reached
+    from this thread while the kernel runs in another one, so the steps (and the numbers) are
+    the same with and without it. The drop driver and the environments' fault state both use
+    it, so they are bit-identical."""
     model = integ.model
     pos = 1
     for a, b, powered in segments(model, t_end):
+        if b <= a:
+            continue
         U = model.controls(powered)
         seg_peaks = None if powered else peaks
-        edges = np.append(np.arange(a, b, CHUNK_S), b)
-        for c0, c1 in zip(edges[:-1], edges[1:]):
-            if c1 - c0 <= 0.0:
+        if bar is None:             # the clock anyway: one compiled variant with and without bar
+            pos = integ.advance(y, a, b, U, t_out, Y, pos, seg_peaks, np.zeros(1))
+        else:
+            pos = _with_bar(bar, a, lambda clock: integ.advance(y, a, b, U, t_out, Y, pos,
+                                                               seg_peaks, clock))
+
+
+def _with_bar(bar, t0: float, advance):
+    """Run ``advance(clock)`` in a worker thread (the kernel releases the GIL) while ``bar``
+    follows ``clock[0]``, the time the kernel has reached; returns what ``advance`` returns."""
+    clock = np.array([t0])
+    with ThreadPoolExecutor(1, thread_name_prefix="drop") as pool:
+        job = pool.submit(advance, clock)
+        shown = t0
+        while True:
+            try:
+                result = job.result(timeout=BAR_POLL_S)
+            except FutureTimeout:
+                bar.update(clock[0] - shown)
+                shown = clock[0]
                 continue
-            pos = integ.advance(y, c0, c1, U, t_out, Y, pos, seg_peaks)
-            if bar is not None:
-                bar.update(c1 - c0)
+            bar.update(clock[0] - shown)
+            return result
 
 
 def simulate(scene: Scene, t_end: float | None = None, progress: bool = False) -> Result:
@@ -148,31 +183,50 @@ def simulate(scene: Scene, t_end: float | None = None, progress: bool = False) -
     if t_end is not None:
         scene = scene.with_overrides({"solver.t_end": t_end})
     model = build_model(scene)
-    t_end = scene.solver.t_end
-    t_out = output_times(model)
     compile_s = warm_up(model)
+    return run_model(model, compile_s, progress)
+
+
+def run_model(model: Model, compile_s: float = 0.0, progress: bool = False) -> Result:
+    """The drop of a built ``model`` whose kernels are loaded (:func:`warm_up`; ``compile_s``:
+    the seconds that took, reported apart from the integration's ``wall_time_s``). The single
+    drop and the batches of :func:`physics.sweep.run_chunk` both run this, so their numbers are identical."""
+    t_end = model.scene.solver.t_end
+    t_out = output_times(model)
     n_out = len(t_out)
     Y = np.empty((n_out, model.n_state))
     y = levitated_state(model)
     Y[0] = y
     integ = Integrator(model)
-    bar = _progress(progress, t_end, scene.name)
+    bar = _progress(progress, t_end, model.scene.name)
     peaks = np.zeros(2 * N_PEAK)
-    wall0 = time.perf_counter()
+    wall0, cpu0 = time.perf_counter(), time.thread_time()
     run_segments(integ, y, t_end, t_out, Y, bar, peaks)
     integ.stats.wall_time_s = time.perf_counter() - wall0
+    if bar is None:                 # else the kernel ran in another thread
+        integ.stats.cpu_time_s = time.thread_time() - cpu0
     integ.stats.compile_time_s = compile_s
     if bar is not None:
         bar.close()
-    aux = np.empty((n_out, N_AUX))
-    for a, b, powered in segments(model, t_end):
-        sel = np.flatnonzero((t_out >= a) & ((t_out <= b) if powered else True))
-        chunk = np.empty((len(sel), N_AUX))
-        diagnostics(t_out[sel], Y[sel], model.P, model.I, model.controls(powered), chunk)
-        aux[sel] = chunk
+    Y, aux = sampled_diagnostics(model, t_out, Y)
     t_fault = next((a for a, _, powered in segments(model, t_end) if not powered), None)
     return Result(model, t_out, Y, aux, integ.stats, t_fault,
                   step_peaks=peaks.reshape(2, N_PEAK) if t_fault is not None else None)
+
+
+def sampled_diagnostics(model: Model, t_out: np.ndarray,
+                        Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The output samples ``Y`` and their per-plane diagnostics (N_AUX columns), both
+    column-major (the metrics read time series of single states), each sample's diagnostics with
+    the controls of its segment (a sample at the fault time: the unpowered one's)."""
+    Y_cols = np.empty(Y.shape, order="F")
+    aux = np.empty((len(t_out), N_AUX), order="F")
+    for a, b, powered in segments(model, t_out[-1]):
+        i0 = int(np.searchsorted(t_out, a, "left"))
+        i1 = int(np.searchsorted(t_out, b, "right")) if powered else len(t_out)
+        sample_diagnostics(t_out, Y, i0, i1, model.P, model.I, model.controls(powered), aux,
+                           Y_cols)
+    return Y_cols, aux
 
 
 def output_times(model: Model) -> np.ndarray:

@@ -22,7 +22,7 @@ class Buffers:
     def __init__(self, n_state: int, n_obs: int, n_act: int, n_sub: int, n_envs: int | None = None):
         lead = () if n_envs is None else (n_envs,)
         shapes = dict(act=(n_act,), y=(n_state,), P=(N_P,), I=(N_I,), U=(N_U,), atol=(n_state,),
-                      work=(8, n_state), t_sub=(n_sub,), Y_sub=(n_sub, n_state), aux=(N_AUX,),
+                      work=(9, n_state), t_sub=(n_sub,), Y_sub=(n_sub, n_state), aux=(N_AUX,),
                       cur=(4,), C=(N_C,), M=(N_M,), scale=(n_obs,), obs=(n_obs,), out=(N_O,))
         for name in FIELDS:
             dtype = np.int64 if name == "I" else np.float64

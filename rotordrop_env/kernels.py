@@ -285,6 +285,15 @@ def step_one(a, y, P, I, U, atol, work, t_sub, Y_sub, aux, cur, C, M, scale, obs
     observe(t1, y, P, I, U, C, M, aux, cur, scale, obs)
 
 
+@njit
+def step_rows(A, Y, P, I, U, ATOL, WORK, TSUB, YSUB, AUX, CUR, C, M, SCALE, OBS, OUT):
+    """:func:`step_one` for N environments (rows), one after the other on the calling thread
+    (no parallel launch: the batch's choice when threads do not pay)."""
+    for e in range(Y.shape[0]):
+        step_one(A[e], Y[e], P[e], I[e], U[e], ATOL[e], WORK[e], TSUB[e], YSUB[e], AUX[e], CUR[e],
+                 C[e], M[e], SCALE[e], OBS[e], OUT[e])
+
+
 @njit_parallel
 def step_batch(A, Y, P, I, U, ATOL, WORK, TSUB, YSUB, AUX, CUR, C, M, SCALE, OBS, OUT):
     """:func:`step_one` for N environments (rows), in parallel over environments."""

@@ -7,8 +7,12 @@ reset at once, its last observation stored in ``infos[i]["terminal_observation"]
 
 Each of the N environments is an ordinary ``gym.make(env_id, **env_kwargs)`` environment whose
 arrays are rows of one stack; resets (scenario sampling from each env's own ``np_random``) run
-per environment in Python, steps run all rows in :func:`rotordrop_env.kernels.step_batch`,
-parallel over environments with numba's threads (``numba.set_num_threads`` limits them).
+per environment in Python, steps run all rows in one numba call: on one thread
+(:func:`rotordrop_env.kernels.step_rows`) or parallel over environments
+(:func:`rotordrop_env.kernels.step_batch`). By default the batch picks between the two as it
+runs (:class:`ThreadChoice`): one thread for a few environments, where waking other threads
+costs more than it saves, and on a loaded machine; threads where they pay. Every choice gives
+the same numbers (each environment is one row, stepped by the same code).
 All actions are checked before any environment advances; with a ``render_mode`` each environment
 records its steps as a single one does; a pickled or deep-copied batch re-attaches its
 environments to its own stack.
@@ -21,6 +25,8 @@ thread on a loaded 2-core machine; with passive waiting it is never slower than 
 from __future__ import annotations
 
 import os
+import statistics
+import time
 from typing import Any, Sequence
 
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")       # before numba starts its OpenMP pool
@@ -35,14 +41,58 @@ from .buffers import Buffers
 from .env import RotorDropEnv, peak_kpis, real_action, step_infos
 
 
+ENVS_PER_THREAD = 4      # fewer environments per thread than this never pay the parallel launch
+TRIAL_STEPS = 8          # batch steps timed per candidate when the batch (re)chooses its threads
+RECHOOSE_EVERY = 2000    # batch steps between two choices (the machine's load changes)
+
+
+class ThreadChoice:
+    """The thread count of the batched step, chosen by timing: ``TRIAL_STEPS`` steps on one
+    thread, as many on ``most`` threads, then the faster (median wall time per step) for the
+    next ``RECHOOSE_EVERY`` steps, and again. With ``most`` = 1 it is always one thread."""
+
+    def __init__(self, most: int):
+        self.most = max(1, int(most))
+        self.trials: dict[int, list[float]] = {1: [], self.most: []}
+        self.chosen = 1
+        self.left = 0                                   # steps before the next choice
+
+    def next(self) -> int:
+        """Threads for the coming step."""
+        if self.most == 1 or self.left > 0:
+            return self.chosen
+        return 1 if len(self.trials[1]) < TRIAL_STEPS else self.most
+
+    def record(self, threads: int, seconds: float) -> None:
+        """The wall time of a step on ``threads`` threads."""
+        if self.most == 1:
+            return
+        if self.left > 0:
+            self.left -= 1
+            return
+        self.trials[threads].append(seconds)
+        if len(self.trials[self.most]) >= TRIAL_STEPS:
+            self.chosen = min(self.trials, key=lambda n: statistics.median(self.trials[n]))
+            self.trials = {1: [], self.most: []}
+            self.left = RECHOOSE_EVERY
+
+
+def auto_threads(n_envs: int) -> int:
+    """The most threads worth trying for ``n_envs`` environments: the cores this process may
+    use and numba's threads, at most one per ``ENVS_PER_THREAD`` environments."""
+    from physics.sweep import available_cores
+    return max(1, min(available_cores(), numba.config.NUMBA_NUM_THREADS,
+                      n_envs // ENVS_PER_THREAD))
+
+
 class BatchedRotorDropVecEnv(VecEnv):
     """``n_envs`` copies of ``env_id`` (with ``env_kwargs``) stepped together.
 
     ``seed``: environment i is seeded ``seed + i`` at the first reset (as SB3's
     ``make_vec_env``); later resets continue each environment's own random stream.
-    ``n_threads``: numba threads for the batched step (default: numba's setting, i.e. all
-    cores); on a machine shared with other work use the number of free cores, since a thread
-    that loses its core stalls the whole batch at the end of every step.
+    ``n_threads``: numba threads for the batched step; default None: chosen as the batch runs
+    (:class:`ThreadChoice` between one thread and :func:`auto_threads`), so the batch is never
+    slower than on one thread; a number fixes it.
     """
 
     def __init__(self, env_id: str, n_envs: int, seed: int | None = None,
@@ -68,6 +118,7 @@ class BatchedRotorDropVecEnv(VecEnv):
             raise ValueError(f"n_threads = {n_threads!r} must be in [1, "
                              f"{numba.config.NUMBA_NUM_THREADS}] (numba's NUMBA_NUM_THREADS)")
         self.n_threads = None if n_threads is None else int(n_threads)
+        self.threads = ThreadChoice(auto_threads(int(n_envs)) if n_threads is None else 1)
         self.actions: np.ndarray | None = None
         super().__init__(int(n_envs), first.observation_space, first.action_space)
         if seed is not None:
@@ -103,9 +154,7 @@ class BatchedRotorDropVecEnv(VecEnv):
         e, err = K.first_bad_action(act, self.stack.C)
         if e >= 0:                                # before any env advances; single env's message
             self.envs[e]._action_error(err, a[e])
-        if self.n_threads is not None:
-            numba.set_num_threads(self.n_threads)
-        K.step_batch(*self._args)
+        self._step_kernel()
         out = self.stack.out
         failed = np.flatnonzero(out[:, K.O_STATUS])
         if failed.size:                           # the single env's clear IntegrationError
@@ -127,6 +176,26 @@ class BatchedRotorDropVecEnv(VecEnv):
             new_obs, self.reset_infos[e] = self.envs[e].reset()
             obs[e] = new_obs
         return obs, rewards, dones, infos
+
+    def _step_kernel(self) -> None:
+        """All rows one control step on the fixed or the chosen number of threads (the chosen
+        one at most numba's current setting, e.g. a training run's ``--threads``)."""
+        if self.n_threads is not None:
+            n = self.n_threads
+        else:
+            n = min(self.threads.next(), numba.get_num_threads())
+        t0 = time.perf_counter()
+        if n == 1:
+            K.step_rows(*self._args)
+        else:
+            previous = numba.get_num_threads()
+            numba.set_num_threads(n)
+            try:
+                K.step_batch(*self._args)
+            finally:
+                numba.set_num_threads(previous)
+        if self.n_threads is None:
+            self.threads.record(n, time.perf_counter() - t0)
 
     def __setstate__(self, state: dict) -> None:
         """A copy (pickle, deepcopy) steps on its own stack: its environments' arrays are

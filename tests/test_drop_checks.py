@@ -177,7 +177,9 @@ def test_params_shows_the_values_the_drop_default_scene_runs_with(capsys):
 def test_step_resolved_peaks_do_not_depend_on_the_output_rate_and_expose_missed_peaks():
     """The integrator's own maxima at every accepted step are the same at any output rate (the
     output is dense output, it does not steer the steps), bound the sampled peaks from above
-    and, at 500 Hz, show that the samples miss the impact (3.1 kN stepped vs ~1.7 kN sampled)."""
+    (up to the top of a peak that falls between two step ends, which a sample there can catch:
+    0.02 % here) and, at 500 Hz, show that the samples miss the impact (3.1 kN stepped vs
+    ~1.7 kN sampled)."""
     fine = compute_metrics(simulate(load_scene("paper"), t_end=0.15))
     coarse = compute_metrics(simulate(load_scene("paper", {"solver.output_rate": 500}), t_end=0.15))
     assert coarse["step_resolved_peaks"] == fine["step_resolved_peaks"]
@@ -185,7 +187,7 @@ def test_step_resolved_peaks_do_not_depend_on_the_output_rate_and_expose_missed_
     for p, peaks in fine["step_resolved_peaks"].items():
         for key, stepped in peaks.items():
             sampled = fine["planes"][p][key]
-            assert sampled <= stepped * (1 + 1e-12) and sampled > (1 - PEAK_TOLERANCE) * stepped
+            assert sampled <= stepped * (1 + 1e-3) and sampled > (1 - PEAK_TOLERANCE) * stepped
     missed = {(d["plane"], d["key"]) for d in coarse["sampled_peaks_missed"]}
     assert ("RB1", "peak_contact_force_N") in missed and ("RB1", "peak_bearing_load_N") in missed
     assert any("miss impact peaks" in w for w in coarse["warnings"])

@@ -14,13 +14,13 @@ from physics.stator import damping_coefficient, damping_ratio, restitution_of_da
 from helpers import energy_residual
 
 # sha256 of Result.Y (float64, C order) of simulate(load_scene("paper", {"contact.friction": mu}),
-# t_end=0.3), computed on main at 33d8e96, before stator contact, the contact laws and the validity
-# metrics existed. The new effects are off in the paper preset: the state history must not move
+# t_end=0.3), computed on the `ensembles` branch at bd3cbbd (its PI step control, beta 0.06),
+# before stator contact, the contact laws, the validity metrics and the thermal model existed. The new effects are off in the paper preset: the state history must not move
 # by one bit (a different CPU / numba / LLVM build could change the last bits; then re-derive the
 # hashes from main's code the same way before trusting a failure).
 PAPER_STATE_SHA256 = {
-    0.25: "82b866a5443a7822211167604e77ed4edb86fcba2b7dcba696330ba49e0011cd",
-    0.45: "5c500d9c845796448819a139287d7aff6a0102d018cd71750353dd890a641170",
+    0.25: "c8f4312d5b60c638eb301af92127795577658325cbee9037938f4cad22d604b7",
+    0.45: "1cd2f7c55088f5d6bc72a5bd65d8dbb1502cd42e03f720eceba2f1ffb968928a",
 }
 
 

@@ -79,7 +79,7 @@ def test_sweep_keeps_order_reports_failures_and_runs_are_reproducible(tmp_path):
     assert [o.ok for o in out] == [True, False, False, True]
     assert "SceneError" in out[1].error and "contact.friction" in out[1].error
     assert "IntegrationError" in out[2].error and "solver.max_steps" in out[2].error
-    # a worker process gives exactly what one process gives
+    # two threads give exactly what one thread gives
     serial = run_sweep(runs[:1], jobs=1, progress=False)[0]
     assert serial.metrics["planes"] == out[0].metrics["planes"]
     # and the printed command reproduces the run

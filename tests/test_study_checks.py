@@ -144,7 +144,7 @@ def test_jobs_are_capped_at_the_cpus_and_the_drops():
 def test_the_sweep_records_and_prints_the_jobs_it_used(tmp_path, capsys):
     r, _, text = _sweep(tmp_path, capsys, "--vary", "contact.friction=0.3", "--members", "1",
                         "--set", "solver.t_end=0.12", "--jobs", "100")
-    assert r["jobs"] == 1 and "note: --jobs 100 capped at 1 worker process(es)" in text
+    assert r["jobs"] == 1 and "note: --jobs 100 capped at 1 thread(s)" in text
 
 
 # ---------------------------------------------------------------------- 6. TOML base chains --

@@ -20,7 +20,7 @@ def register(subparsers) -> None:
     q.add_argument("--quick", action="store_true",
                    help="coarse grid and small ensembles (same outputs, minutes -> seconds)")
     q.add_argument("--jobs", type=at_least(1), default=None,
-                   help="worker processes (default: all cores; at most one per CPU and per drop)")
+                   help="threads (default: all cores; at most one per CPU and per drop)")
     q.add_argument("--quiet", action="store_true", help="no progress bar")
     q.set_defaults(func=cmd_study_paper)
 
@@ -35,7 +35,7 @@ def register(subparsers) -> None:
     q.add_argument("--seed", type=at_least(0), default=0, help="seed of the ensemble perturbations")
     q.add_argument("--out", default="out/sweep", help="output directory")
     q.add_argument("--jobs", type=at_least(1), default=None,
-                   help="worker processes (default: all cores; at most one per CPU and per drop)")
+                   help="threads (default: all cores; at most one per CPU and per drop)")
     q.add_argument("--no-plots", action="store_true", help="no sweep.png")
     q.add_argument("--quiet", action="store_true", help="no progress bar")
     q.set_defaults(func=cmd_study_sweep)
