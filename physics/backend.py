@@ -1,0 +1,343 @@
+"""Where batches of drops run: in this process (``local``) or on a Ray cluster (``ray``).
+
+A batch (a study, a sweep) is cut into chunks of :class:`physics.sweep.Run` s; each chunk is
+simulated by :func:`physics.batch.run_chunk` in one process, the only function a backend calls:
+
+* ``local`` runs the chunks one after the other in this process (``run_chunk`` spreads a chunk
+  over ``--jobs`` threads);
+* ``ray`` sends one Ray task per chunk (``num_cpus=1``, one thread) to the cluster at
+  ``--address`` (default: a Ray started on this machine for the run), collects the chunks as
+  they finish (``ray.wait``) and retries a chunk whose worker died (``max_retries``).
+
+A task carries only picklable values: the chunk's runs (scene name, overrides, labels), the
+``evaluate`` function by reference and the thread count; only the per-drop metrics come back.
+Every finished drop goes to a :class:`physics.store.DropStore` at once, so a killed worker
+(Ray re-runs its chunk) or a killed driver (``--resume``) loses nothing. Ray is imported only
+here and only for ``--backend ray``: the package works without the ``cluster`` extra.
+"""
+from __future__ import annotations
+
+import ipaddress
+import math
+import os
+import socket
+import statistics
+import time
+from dataclasses import dataclass, field
+from typing import Any, Callable, Iterator, Sequence
+
+from .cli import UsageError
+from .sweep import Evaluate, Outcome, Run
+
+BACKENDS = ("local", "ray")
+INSTALL = 'python3 -m pip install -e ".[cluster]"'
+CONNECT_TIMEOUT_S = 3.0          # an address that does not answer within this fails at once
+TASK_CPUS = 1                    # CPUs (and threads) of one Ray task
+TASKS_PER_CPU = 4                # chunks per cluster CPU: load balance vs per-task overhead
+MAX_RETRIES = 3                  # re-runs of a chunk whose worker or node died
+
+
+class BackendError(UsageError):
+    """The backend cannot be used or a task failed beyond its retries (one line, exit 2)."""
+
+
+@dataclass(frozen=True)
+class Backend:
+    """``local`` or ``ray`` (with the cluster ``address``; None: ``RAY_ADDRESS`` or a Ray
+    started on this machine for the run)."""
+    name: str = "local"
+    address: str | None = None
+
+    def __post_init__(self):
+        if self.name not in BACKENDS:
+            raise UsageError(f"--backend must be one of {', '.join(BACKENDS)}, got {self.name!r}")
+        if self.address is not None and self.name != "ray":
+            raise UsageError(f"--address {self.address} needs --backend ray")
+
+    @classmethod
+    def from_args(cls, args) -> "Backend":
+        return cls(getattr(args, "backend", "local"), getattr(args, "address", None))
+
+    def session(self) -> "Session":
+        return RaySession(self.address) if self.name == "ray" else Session()
+
+
+def add_backend_args(p, resume: bool = True) -> None:
+    """``--backend``, ``--address`` (and ``--resume``) for a command that runs batches."""
+    p.add_argument("--backend", choices=BACKENDS, default="local",
+                   help="where the drops run: local (this process, --jobs threads) or ray "
+                        "(a Ray cluster: one task per chunk of drops; needs the cluster extra)")
+    p.add_argument("--address", default=None, metavar="HOST:PORT",
+                   help="Ray cluster to connect to (with --backend ray; default: RAY_ADDRESS, or "
+                        "a Ray started on this machine for the run)")
+    if resume:
+        p.add_argument("--resume", action="store_true",
+                       help="keep the drops already finished in --out (an interrupted run of the "
+                            "same command) and run only the missing ones")
+
+
+# ------------------------------------------------------------------------------ sessions --
+class Session:
+    """Runs tasks in this process, one after the other (the ``local`` backend)."""
+    name = "local"
+
+    def __enter__(self) -> "Session":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        pass
+
+    def cpus(self) -> int:
+        from .batch import available_cores
+        return available_cores()
+
+    def imap(self, fn: Callable, tasks: Sequence[tuple], num_cpus: int = TASK_CPUS
+             ) -> Iterator[tuple[int, Any]]:
+        """``(i, fn(*tasks[i]))`` for every task, as each finishes."""
+        for i, args in enumerate(tasks):
+            yield i, fn(*args)
+
+    def describe(self) -> dict:
+        return dict(backend=self.name)
+
+
+class RaySession(Session):
+    """One Ray task per call of ``fn``; results as they finish (``ray.wait``)."""
+    name = "ray"
+
+    def __init__(self, address: str | None):
+        self.address = address or os.environ.get("RAY_ADDRESS") or None
+        self.started = False
+        self.sent: list[int] = []                      # pickled bytes of each task's arguments
+
+    def __enter__(self) -> "RaySession":
+        try:
+            import ray
+        except ImportError:
+            raise BackendError(f"--backend ray needs Ray, which is not installed: {INSTALL}") from None
+        kwargs: dict[str, Any] = dict(logging_level="ERROR", configure_logging=True)
+        if self.address in (None, "local"):
+            kwargs.update(include_dashboard=False)
+        elif self.address != "auto":
+            host = probe(self.address)
+            if not self.address.startswith("ray://") and _is_loopback(host):
+                kwargs["_node_ip_address"] = host         # a node of this machine: its address
+        try:
+            ray.init(address=self.address, **kwargs)
+        except Exception as exc:                          # ConnectionError, AuthenticationError...
+            where = f"the Ray cluster at {self.address}" if self.address else "a local Ray"
+            raise BackendError(f"--backend ray: cannot connect to {where}: {first_line(exc)}"
+                               + _token_hint(exc)) from None
+        self.started = True
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self.started:
+            import ray
+            ray.shutdown()
+
+    def cpus(self) -> int:
+        import ray
+        return max(1, int(ray.cluster_resources().get("CPU", 1)))
+
+    def imap(self, fn: Callable, tasks: Sequence[tuple], num_cpus: int = TASK_CPUS
+             ) -> Iterator[tuple[int, Any]]:
+        import ray
+        from ray import cloudpickle
+        remote = ray.remote(num_cpus=num_cpus, max_retries=MAX_RETRIES)(fn)
+        pending = {}
+        for i, args in enumerate(tasks):
+            self.sent.append(len(cloudpickle.dumps(args)))
+            pending[remote.remote(*args)] = i
+        while pending:
+            done, _ = ray.wait(list(pending), num_returns=1)
+            for ref in done:
+                i = pending.pop(ref)
+                try:
+                    result = ray.get(ref)
+                except ray.exceptions.RayError as exc:
+                    for other in pending:
+                        ray.cancel(other, force=True)
+                    raise BackendError(f"--backend ray: task {i} failed after {MAX_RETRIES} "
+                                       f"retries: {first_line(exc)}") from None
+                yield i, result
+
+    def describe(self) -> dict:
+        import ray
+        nodes = [n for n in ray.nodes() if n.get("Alive")]
+        return dict(backend=self.name, address=self.address, nodes=len(nodes), cpus=self.cpus(),
+                    tasks=len(self.sent),
+                    bytes_per_task=dict(median=statistics.median(self.sent), max=max(self.sent))
+                    if self.sent else None)
+
+
+def probe(address: str, timeout: float = CONNECT_TIMEOUT_S) -> str:
+    """The host of ``address`` (``HOST:PORT`` or ``ray://HOST:PORT``) once something answers
+    there; a one-line BackendError when nothing does within ``timeout`` (``ray.init`` itself
+    would retry for minutes)."""
+    hostport = address.removeprefix("ray://")
+    host, _, port = hostport.rpartition(":")
+    if not host or not port.isdigit():
+        raise BackendError(f"--address must be HOST:PORT or ray://HOST:PORT, got {address!r}")
+    try:
+        with socket.create_connection((host.strip("[]"), int(port)), timeout=timeout):
+            pass
+    except OSError as exc:
+        reason = "no answer" if isinstance(exc, TimeoutError) else (exc.strerror or str(exc))
+        raise BackendError(f"--address {address}: no Ray cluster reachable there ({reason} "
+                           f"within {timeout:g} s)") from None
+    return host.strip("[]")
+
+
+def _is_loopback(host: str) -> bool:
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return host == "localhost"
+
+
+def _token_hint(exc: Exception) -> str:
+    text = str(exc).lower()
+    if "auth" in text or "token" in text:
+        return " (a cluster started with RAY_AUTH_MODE=token needs RAY_AUTH_MODE=token and its " \
+               "token in RAY_AUTH_TOKEN here too)"
+    return ""
+
+
+def first_line(exc: BaseException) -> str:
+    lines = [l.strip() for l in str(exc).splitlines() if l.strip()]
+    return f"{type(exc).__name__}: {lines[0] if lines else ''}"
+
+
+# ------------------------------------------------------------------------------- batches --
+@dataclass
+class Dispatch:
+    """How a batch ran: backend, chunks, drops resumed from disk, bytes sent per task."""
+    backend: dict = field(default_factory=dict)
+    drops: int = 0
+    resumed: int = 0
+    chunks: int = 0
+    wall_time_s: float = 0.0
+
+    def note(self) -> str:
+        """One line for the command's output ("" for a plain local run)."""
+        parts = []
+        if self.resumed:
+            parts.append(f"{self.resumed} of {self.drops} drops resumed from disk")
+        b = self.backend
+        if b.get("backend") == "ray":
+            sent = b.get("bytes_per_task")
+            parts.append(f"ray: {b['tasks']} task(s) on {b['nodes']} node(s), {b['cpus']} CPU(s)"
+                         + (f", {sent['median'] / 1e3:.1f} kB sent per task (median)" if sent else ""))
+        return "note: " + "; ".join(parts) if parts else ""
+
+
+def chunk_task(runs: list[Run], evaluate: Evaluate | None, threads: int) -> list[dict]:
+    """The body of one Ray task: a chunk of drops in one process, as JSON-ready records."""
+    return [record(o) for o in _run_chunk(runs, evaluate, threads)]
+
+
+def record(o: Outcome) -> dict:
+    """What is kept of a drop (its run is known from the plan): ok, metrics, extra, error."""
+    return dict(ok=o.ok, metrics=o.metrics, extra=o.extra, error=o.error)
+
+
+def plan_threads(backend: Backend, jobs: int | None, runs: int) -> tuple[int | None, str]:
+    """Threads of the local backend (:func:`physics.sweep.plan_jobs`) and its note; on Ray every
+    task takes one CPU and the cluster's CPUs set the parallelism, so ``--jobs`` is refused."""
+    if backend.name == "local":
+        from .sweep import plan_jobs
+        return plan_jobs(jobs, runs)
+    if jobs is not None:
+        raise UsageError("--jobs sets the threads of --backend local; with --backend ray every "
+                         "task takes one CPU and the cluster's CPUs set the parallelism")
+    return None, ""
+
+
+def run_drops(runs: Sequence[Run], evaluate: Evaluate | None = None, backend: Backend = Backend(),
+              jobs: int | None = None, out=None, resume: bool = False, desc: str = "drops",
+              progress: bool = True) -> tuple[list[Outcome], Dispatch]:
+    """Simulate ``runs`` on ``backend``; outcomes in input order and how they ran.
+
+    With ``out`` every drop is written to ``out/drops`` as it finishes
+    (:class:`physics.store.DropStore`); with ``resume`` the drops already there are kept and
+    only the missing ones run. Each outcome is read back from its JSON record, so both backends
+    (and a resumed run) return identical numbers.
+    """
+    from .store import DropStore
+    runs = list(runs)
+    store = (DropStore.open(out, runs, evaluate, desc, resume) if out is not None
+             else DropStore.memory(runs))
+    todo = store.missing()
+    info = Dispatch(drops=len(runs), resumed=len(runs) - len(todo))
+    t0 = time.perf_counter()
+    bar = None
+    try:
+        if todo:
+            with backend.session() as session:
+                store.begin()
+                bar = _bar(progress, len(runs), info.resumed, desc)
+                if session.name == "local":
+                    info.chunks = 1
+                    _run_local(runs, todo, evaluate, jobs, store, bar)
+                else:
+                    info.chunks = _run_remote(session, runs, todo, evaluate, store, bar)
+                info.backend = session.describe()
+        else:
+            info.backend = dict(backend=backend.name)
+    finally:
+        if bar is not None:
+            bar.close()
+        store.close()
+    info.wall_time_s = time.perf_counter() - t0
+    return [Outcome(run, **rec) for run, rec in zip(runs, store.records())], info
+
+
+def _run_local(runs, todo: list[int], evaluate, jobs, store, bar) -> None:
+    def done(i: int, outcome: Outcome) -> None:
+        store.add(todo[i], record(outcome))
+        _tick(bar, 1, outcome.ok)
+    _run_chunk([runs[i] for i in todo], evaluate, jobs, done)
+
+
+def _run_remote(session: Session, runs, todo: list[int], evaluate, store, bar) -> int:
+    size = max(1, math.ceil(len(todo) / (TASKS_PER_CPU * session.cpus())))
+    chunks = [todo[k:k + size] for k in range(0, len(todo), size)]
+    tasks = [([runs[i] for i in c], evaluate, TASK_CPUS) for c in chunks]
+    for k, records in session.imap(chunk_task, tasks):
+        for i, rec in zip(chunks[k], records):
+            store.add(i, rec)
+            _tick(bar, 1, rec["ok"])
+        store.sync()
+    return len(chunks)
+
+
+def _run_chunk(runs: list[Run], evaluate, threads, on_outcome=None) -> list[Outcome]:
+    """:func:`physics.batch.run_chunk` (the unit of work of every backend)."""
+    try:
+        from .batch import run_chunk
+    except ImportError:          # before physics.batch: today's in-process path, same shape
+        from .sweep import run_sweep
+        out = run_sweep(runs, evaluate, jobs=threads, progress=False)
+        for i, o in enumerate(out):
+            if on_outcome is not None:
+                on_outcome(i, o)
+        return out
+    return run_chunk(runs, evaluate, threads=threads, on_outcome=on_outcome)
+
+
+def _bar(enabled: bool, total: int, initial: int, desc: str):
+    if not enabled:
+        return None
+    from tqdm.auto import tqdm
+    return tqdm(total=total, initial=initial, desc=desc, unit="run")
+
+
+def _tick(bar, n: int, ok: bool) -> None:
+    if bar is None:
+        return
+    bar.update(n)
+    if not ok:
+        bar.failed = getattr(bar, "failed", 0) + 1
+        bar.set_postfix_str(f"{bar.failed} failed (reported, not dropped)", refresh=False)
+
