@@ -5,9 +5,10 @@ simulated by :func:`physics.batch.run_chunk` in one process, the only function a
 
 * ``local`` runs the chunks one after the other in this process (``run_chunk`` spreads a chunk
   over ``--jobs`` threads);
-* ``ray`` sends one Ray task per chunk (``num_cpus=1``, one thread) to the cluster at
-  ``--address`` (default: a Ray started on this machine for the run), collects the chunks as
-  they finish (``ray.wait``) and retries a chunk whose worker died (``max_retries``).
+* ``ray`` sends one Ray task per chunk (``num_cpus=1``, one thread; spread over the nodes) to
+  the cluster at ``--address`` (default: a Ray started on this machine for the run), collects
+  the chunks as they finish (``ray.wait``) and re-runs a chunk whose worker or node died
+  (``max_retries``).
 
 A task carries only picklable values: the chunk's runs (scene name, overrides, labels), the
 ``evaluate`` function by reference and the thread count; only the per-drop metrics come back.
@@ -109,6 +110,7 @@ class RaySession(Session):
         self.address = address or os.environ.get("RAY_ADDRESS") or None
         self.started = False
         self.sent: list[int] = []                      # pickled bytes of each task's arguments
+        self.nodes: dict[str, int] = {}                # tasks finished per node address
 
     def __enter__(self) -> "RaySession":
         try:
@@ -144,31 +146,39 @@ class RaySession(Session):
              ) -> Iterator[tuple[int, Any]]:
         import ray
         from ray import cloudpickle
-        remote = ray.remote(num_cpus=num_cpus, max_retries=MAX_RETRIES)(fn)
+        remote = ray.remote(num_cpus=num_cpus, max_retries=MAX_RETRIES,
+                            scheduling_strategy="SPREAD")(on_node)
         pending = {}
         for i, args in enumerate(tasks):
             self.sent.append(len(cloudpickle.dumps(args)))
-            pending[remote.remote(*args)] = i
+            pending[remote.remote(fn, *args)] = i
         while pending:
             done, _ = ray.wait(list(pending), num_returns=1)
             for ref in done:
                 i = pending.pop(ref)
                 try:
-                    result = ray.get(ref)
+                    node, result = ray.get(ref)
                 except ray.exceptions.RayError as exc:
                     for other in pending:
                         ray.cancel(other, force=True)
                     raise BackendError(f"--backend ray: task {i} failed after {MAX_RETRIES} "
                                        f"retries: {first_line(exc)}") from None
+                self.nodes[node] = self.nodes.get(node, 0) + 1
                 yield i, result
 
     def describe(self) -> dict:
         import ray
         nodes = [n for n in ray.nodes() if n.get("Alive")]
         return dict(backend=self.name, address=self.address, nodes=len(nodes), cpus=self.cpus(),
-                    tasks=len(self.sent),
+                    tasks=len(self.sent), tasks_per_node=dict(sorted(self.nodes.items())),
                     bytes_per_task=dict(median=statistics.median(self.sent), max=max(self.sent))
                     if self.sent else None)
+
+
+def on_node(fn: Callable, *args) -> tuple[str, Any]:
+    """A Ray task: ``fn(*args)`` and the address of the node that ran it."""
+    import ray
+    return ray.util.get_node_ip_address(), fn(*args)
 
 
 def probe(address: str, timeout: float = CONNECT_TIMEOUT_S) -> str:
@@ -316,12 +326,13 @@ def _run_chunk(runs: list[Run], evaluate, threads, on_outcome=None) -> list[Outc
     """:func:`physics.batch.run_chunk` (the unit of work of every backend)."""
     try:
         from .batch import run_chunk
-    except ImportError:          # before physics.batch: today's in-process path, same shape
-        from .sweep import run_sweep
-        out = run_sweep(runs, evaluate, jobs=threads, progress=False)
-        for i, o in enumerate(out):
+    except ImportError:          # before physics.batch: the single-drop path, same shape
+        from .sweep import simulate_run
+        out = []
+        for i, run in enumerate(runs):
+            out.append(simulate_run(run, evaluate))
             if on_outcome is not None:
-                on_outcome(i, o)
+                on_outcome(i, out[-1])
         return out
     return run_chunk(runs, evaluate, threads=threads, on_outcome=on_outcome)
 

@@ -1,0 +1,155 @@
+"""A two-node Ray cluster on this machine (issue 14): head on 127.0.0.2, worker on 127.0.0.3, token
+authentication on. A sweep runs across both nodes, the worker is killed mid-sweep, and the sweep
+completes with the same cells and per-drop metrics as the local backend.
+
+Marked ``cluster`` (needs the cluster extra; ``pytest -m cluster``). All traffic stays on
+loopback addresses (Ray rewrites 127.0.0.1 into the machine's network address, so the nodes
+get other loopback addresses). Every Ray process the test starts is ended by its process id.
+"""
+import json
+import os
+import secrets
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import pytest
+
+from physics.cli import main as cli_main
+
+pytestmark = pytest.mark.cluster
+
+HEAD, WORKER = "127.0.0.2", "127.0.0.3"
+ROOT = Path(__file__).resolve().parents[1]
+# the issue's done-when command
+SWEEP = ["study", "sweep", "--vary", "contact.friction=0.3:0.5:0.1",
+         "--vary", "support.damping=2790,27900", "--quiet", "--no-plots"]
+TIMEOUT_S = 600
+
+
+def free_port(host: str) -> int:
+    with socket.socket() as s:
+        s.bind((host, 0))
+        return s.getsockname()[1]
+
+
+def ray_processes(tag: str):
+    """Processes of the cluster whose command line holds ``tag`` (its temporary directory)."""
+    import psutil
+    for p in psutil.process_iter(["cmdline"]):
+        try:
+            if any(tag in part for part in p.info["cmdline"] or ()):
+                yield p
+        except psutil.Error:
+            pass
+
+
+def end(procs) -> None:
+    import psutil
+    procs = list(procs)
+    for p in procs:
+        try:
+            p.send_signal(signal.SIGKILL)
+        except psutil.Error:
+            pass
+    psutil.wait_procs(procs, timeout=10)
+
+
+@pytest.fixture
+def cluster():
+    """(address, env of a driver holding the token, temporary directory of the cluster)."""
+    pytest.importorskip("psutil")
+    import ray  # noqa: F401  (the cluster extra must be installed: fail here if it is not)
+    tmp = tempfile.mkdtemp(prefix="rd-ray-", dir="/tmp")     # short: Unix socket paths
+    env = dict(os.environ, RAY_AUTH_MODE="token", RAY_AUTH_TOKEN=secrets.token_hex(16),
+               RAY_USAGE_STATS_ENABLED="0", MPLBACKEND="Agg",
+               PYTHONPATH=os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]))
+    env.pop("RAY_ADDRESS", None)
+    port = free_port(HEAD)
+    ray_bin = [sys.executable, "-m", "ray.scripts.scripts"]
+    common = ["--num-cpus", "1", "--disable-usage-stats", "--min-worker-port", "0",
+              "--max-worker-port", "0"]
+    try:
+        subprocess.run(ray_bin + ["start", "--head", "--node-ip-address", HEAD, "--port", str(port),
+                                  "--include-dashboard", "false", "--temp-dir", tmp,
+                                  "--ray-client-server-port", str(free_port(HEAD))] + common,
+                       env=env, check=True, capture_output=True, timeout=120)
+        subprocess.run(ray_bin + ["start", "--address", f"{HEAD}:{port}", "--node-ip-address", WORKER]
+                       + common, env=env, check=True, capture_output=True, timeout=120)
+        yield f"{HEAD}:{port}", env, tmp
+    finally:
+        end(ray_processes(tmp))
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def without_timing(metrics: dict) -> dict:
+    return {k: v for k, v in metrics.items() if k not in ("wall_time_s", "compile_time_s")}
+
+
+def test_a_sweep_across_two_nodes_survives_a_killed_worker(cluster, tmp_path):
+    address, env, tmp = cluster
+    # token authentication is on: a driver without the token is refused, in one line
+    no_token = {k: v for k, v in env.items() if k not in ("RAY_AUTH_TOKEN", "RAY_AUTH_MODE")}
+    bad = subprocess.run([sys.executable, "-m", "physics.cli"] + SWEEP + [
+        "--backend", "ray", "--address", address, "--out", str(tmp_path / "refused")],
+        env=no_token, capture_output=True, text=True, timeout=120, cwd=ROOT)
+    assert bad.returncode != 0 and not (tmp_path / "refused" / "sweep.json").exists()
+
+    out = tmp_path / "ray"
+    driver = subprocess.Popen([sys.executable, "-c", "import sys; from physics.cli import main; "
+                               "sys.exit(main(sys.argv[1:]))"] + SWEEP + [
+        "--backend", "ray", "--address", address, "--out", str(out)],
+        env=env, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    done = out / "drops" / "done.jsonl"
+    deadline = time.monotonic() + TIMEOUT_S
+    killed = []
+    while driver.poll() is None and time.monotonic() < deadline:
+        if done.exists() and done.read_text().count("\n") >= 16:        # a third of the 48 drops
+            killed = [p for p in ray_processes(tmp)
+                      if any(WORKER in part for part in p.cmdline())]
+            end(killed)
+            break
+        time.sleep(0.2)
+    try:
+        stdout, stderr = driver.communicate(timeout=max(1.0, deadline - time.monotonic()))
+    finally:
+        driver.kill()
+    assert killed, "the worker node was not killed mid-sweep"
+    assert driver.returncode == 0, stderr[-2000:]
+
+    ray_report = json.loads((out / "sweep.json").read_text())
+    per_node = ray_report["backend"]["tasks_per_node"]
+    assert per_node.get(WORKER, 0) >= 1 and per_node.get(HEAD, 0) >= 1, per_node
+    assert sum(per_node.values()) >= ray_report["backend"]["tasks"]
+    assert "ray:" in stdout
+
+    assert cli_main(SWEEP + ["--backend", "local", "--out", str(tmp_path / "local")]) == 0
+    local_report = json.loads((tmp_path / "local" / "sweep.json").read_text())
+    assert len(ray_report["runs"]) == 48
+    assert ray_report["cells"] == local_report["cells"]
+    assert [without_timing(r["metrics"]) for r in ray_report["runs"]] == \
+        [without_timing(r["metrics"]) for r in local_report["runs"]]
+    assert [r["overrides"] for r in ray_report["runs"]] == [r["overrides"] for r in local_report["runs"]]
+
+
+def test_one_node_ray_gives_the_local_numbers_of_the_paper_study_drops(tmp_path):
+    """A Ray started for the run (no --address) and the local backend: identical outcomes,
+    including the study's extra observables."""
+    pytest.importorskip("ray")
+    from physics.backend import Backend, run_drops
+    from physics.study.observables import drop_observables
+    from physics.sweep import Run
+    runs = [Run.of("paper", {"solver.t_end": 0.2, "contact.friction": mu}, friction=mu)
+            for mu in (0.2, 0.3, 0.45, 3.0)]                               # the last one fails
+    local, _ = run_drops(runs, drop_observables, Backend("local"), progress=False)
+    remote, info = run_drops(runs, drop_observables, Backend("ray"), out=tmp_path, progress=False)
+    assert info.backend["tasks"] >= 1 and info.backend["bytes_per_task"]["max"] < 10_000
+    assert [o.ok for o in remote] == [True, True, True, False]
+    assert remote[3].error == local[3].error and "contact.friction" in remote[3].error
+    for a, b in zip(local, remote):
+        assert without_timing(a.metrics) == without_timing(b.metrics) and a.extra == b.extra
