@@ -20,7 +20,7 @@ from pathlib import Path
 
 import pytest
 
-from physics.cli import main as cli_main
+from agents.cli import main as cli_main
 
 pytestmark = pytest.mark.cluster
 
@@ -95,13 +95,13 @@ def test_a_sweep_across_two_nodes_survives_a_killed_worker(cluster, tmp_path):
     address, env, tmp = cluster
     # token authentication is on: a driver without the token is refused, in one line
     no_token = {k: v for k, v in env.items() if k not in ("RAY_AUTH_TOKEN", "RAY_AUTH_MODE")}
-    bad = subprocess.run([sys.executable, "-m", "physics.cli"] + SWEEP + [
+    bad = subprocess.run([sys.executable, "-m", "agents.cli"] + SWEEP + [
         "--backend", "ray", "--address", address, "--out", str(tmp_path / "refused")],
         env=no_token, capture_output=True, text=True, timeout=120, cwd=ROOT)
     assert bad.returncode != 0 and not (tmp_path / "refused" / "sweep.json").exists()
 
     out = tmp_path / "ray"
-    driver = subprocess.Popen([sys.executable, "-c", "import sys; from physics.cli import main; "
+    driver = subprocess.Popen([sys.executable, "-c", "import sys; from agents.cli import main; "
                                "sys.exit(main(sys.argv[1:]))"] + SWEEP + [
         "--backend", "ray", "--address", address, "--out", str(out)],
         env=env, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
