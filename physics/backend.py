@@ -131,6 +131,7 @@ class RaySession(Session):
             raise BackendError(f"--backend ray: cannot connect to {where}: {first_line(exc)}"
                                + _token_hint(exc)) from None
         self.started = True
+        self.at_start = dict(nodes=sum(1 for n in ray.nodes() if n.get("Alive")), cpus=self.cpus())
         return self
 
     def __exit__(self, *exc) -> None:
@@ -167,10 +168,10 @@ class RaySession(Session):
                 yield i, result
 
     def describe(self) -> dict:
-        import ray
-        nodes = [n for n in ray.nodes() if n.get("Alive")]
-        return dict(backend=self.name, address=self.address, nodes=len(nodes), cpus=self.cpus(),
-                    tasks=len(self.sent), tasks_per_node=dict(sorted(self.nodes.items())),
+        """Backend, address, nodes and CPUs at the start, tasks (per node that finished them)
+        and the pickled bytes of a task's arguments."""
+        return dict(backend=self.name, address=self.address, **self.at_start, tasks=len(self.sent),
+                    tasks_per_node=dict(sorted(self.nodes.items())),
                     bytes_per_task=dict(median=statistics.median(self.sent), max=max(self.sent))
                     if self.sent else None)
 
