@@ -14,6 +14,7 @@ from pathlib import Path
 
 from physics import accuracy, study
 from physics import cli as physics_cli
+from physics.backend import add_backend_args
 from physics.cli import at_least
 
 from . import research
@@ -71,16 +72,29 @@ def _number(text: str):
 
 
 def cmd_train(args) -> int:
+    from physics.backend import Backend
     from .hyperparams import ConfigError
     from .train import command_line, train
     try:
-        res = train(args.env, args.algo, args.out, timesteps=args.timesteps, n_envs=args.n_envs,
-                    config=args.config, seed=args.seed, resume=args.resume, threads=args.threads,
-                    progress=not args.quiet, verbose=args.verbose, command=command_line(),
-                    overwrite=args.overwrite)
+        backend = Backend.from_args(args)
+        common = dict(timesteps=args.timesteps, n_envs=args.n_envs, config=args.config,
+                      verbose=args.verbose, command=command_line(), overwrite=args.overwrite)
+        if args.seeds is None and backend.name == "local":
+            print(train(args.env, args.algo, args.out, seed=args.seed, resume=args.resume,
+                        threads=args.threads, progress=not args.quiet, **common).summary())
+            return 0
+        from .seeds import parse_seeds, seed_dir, train_seeds
+        if args.resume is not None:
+            raise ValueError("--resume continues one run on --backend local; leave out --seeds "
+                             "and --backend ray")
+        seeds = [args.seed] if args.seeds is None else parse_seeds(args.seeds)
+        outs = [args.out] if args.seeds is None else [seed_dir(args.out, s) for s in seeds]
+        results = train_seeds(seeds, args.env, args.algo, outs, backend, threads=args.threads,
+                              progress=not args.quiet, **common)
     except (ConfigError, *ERRORS) as exc:
         return _fail("train", exc)
-    print(res.summary())
+    for seed, res in zip(seeds, results):
+        print(f"seed {seed}: {res.summary()}")
     return 0
 
 
@@ -151,6 +165,10 @@ def register(sub) -> None:
                    help="YAML with hyperparameters keyed by env id (rl-zoo3 style), applied over "
                         "the shipped agents/configs/<algo>.yaml")
     p.add_argument("--seed", type=_SEED, default=0)
+    p.add_argument("--seeds", default=None, metavar="S1,S2,...",
+                   help="train one run per seed into --out/seed_<s>, side by side (on --backend "
+                        "ray one task each, holding --threads CPUs)")
+    add_backend_args(p, resume=False)
     p.add_argument("--resume", default=None, metavar="DIR|CHECKPOINT.zip",
                    help="continue from a checkpoint (or the newest one in a run directory)")
     p.add_argument("--threads", type=int, default=1,

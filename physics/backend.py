@@ -117,6 +117,15 @@ class RaySession(Session):
             import ray
         except ImportError:
             raise BackendError(f"--backend ray needs Ray, which is not installed: {INSTALL}") from None
+        if ray.is_initialized():                           # inside a Ray program: use its Ray
+            self.address = self.address or "the running Ray"
+        else:
+            self._connect(ray)
+            self.started = True
+        self.at_start = dict(nodes=sum(1 for n in ray.nodes() if n.get("Alive")), cpus=self.cpus())
+        return self
+
+    def _connect(self, ray) -> None:
         kwargs: dict[str, Any] = dict(logging_level="ERROR", configure_logging=True)
         if self.address in (None, "local"):
             kwargs.update(include_dashboard=False)
@@ -130,12 +139,9 @@ class RaySession(Session):
             where = f"the Ray cluster at {self.address}" if self.address else "a local Ray"
             raise BackendError(f"--backend ray: cannot connect to {where}: {first_line(exc)}"
                                + _token_hint(exc)) from None
-        self.started = True
-        self.at_start = dict(nodes=sum(1 for n in ray.nodes() if n.get("Alive")), cpus=self.cpus())
-        return self
 
     def __exit__(self, *exc) -> None:
-        if self.started:
+        if self.started:                                  # only a Ray this session started
             import ray
             ray.shutdown()
 
@@ -162,8 +168,11 @@ class RaySession(Session):
                 except ray.exceptions.RayError as exc:
                     for other in pending:
                         ray.cancel(other, force=True)
-                    raise BackendError(f"--backend ray: task {i} failed after {MAX_RETRIES} "
-                                       f"retries: {first_line(exc)}") from None
+                    cause = getattr(exc, "cause", None)
+                    if isinstance(exc, ray.exceptions.RayTaskError) and isinstance(cause, Exception):
+                        raise cause from None             # the task's own error, as if local
+                    raise BackendError(f"--backend ray: task {i} failed (retried up to "
+                                       f"{MAX_RETRIES} times): {first_line(exc)}") from None
                 self.nodes[node] = self.nodes.get(node, 0) + 1
                 yield i, result
 

@@ -146,3 +146,21 @@ def test_a_killed_driver_loses_no_finished_drop(tmp_path):
     a, b = (json.loads((d / "sweep.json").read_text()) for d in (killed, tmp_path / "whole"))
     assert a["cells"] == b["cells"]
     assert [without_timing(r["metrics"]) for r in a["runs"]] == [without_timing(r["metrics"]) for r in b["runs"]]
+
+
+def test_train_seeds_are_checked_before_anything_runs(tmp_path, capsys):
+    from agents.seeds import parse_seeds
+    assert parse_seeds("0,1, 2") == [0, 1, 2]
+    for bad in ("", "a,b", "0,0", "-1"):
+        with pytest.raises(ValueError, match="--seeds expects distinct integers >= 0"):
+            parse_seeds(bad)
+    base = ["train", "--env", "RotorDrop-Damping-v0", "--algo", "ppo", "--out", str(tmp_path / "t")]
+    for extra, message in ((["--seeds", "1,1"], "--seeds expects"),
+                           (["--seeds", "0,1", "--resume", str(tmp_path)], "--resume continues one run"),
+                           (["--seeds", "0,1", "--backend", "ray", "--address", "127.0.0.9:6999"],
+                            "no Ray cluster reachable"),
+                           (["--seeds", "0,1", "--config", str(tmp_path / "none.yaml")], "does not exist")):
+        assert cli_main(base + extra) == 2
+        err = capsys.readouterr().err
+        assert message in err and err.count("\n") == 1, err
+    assert not (tmp_path / "t").exists()

@@ -157,3 +157,27 @@ def test_one_node_ray_gives_the_local_numbers_of_the_paper_study_drops(tmp_path)
     assert remote[3].error == local[3].error and "contact.friction" in remote[3].error
     for a, b in zip(local, remote):
         assert without_timing(a.metrics) == without_timing(b.metrics) and a.extra == b.extra
+
+
+TINY = ("RotorDrop-Damping-v0:\n  n_steps: 64\n  batch_size: 64\n  n_epochs: 1\n  eval_freq: 0\n"
+        "  checkpoint_freq: 0\n  env_kwargs:\n    episode_time: 0.02\n")
+
+
+def test_seeds_trained_as_ray_tasks_equal_the_local_ones(tmp_path):
+    """`train --seeds 0,1 --backend ray`: one task per seed, the same networks as local."""
+    pytest.importorskip("ray")
+    import torch
+    from stable_baselines3 import PPO
+    (tmp_path / "tiny.yaml").write_text(TINY)
+    args = ["train", "--env", "RotorDrop-Damping-v0", "--algo", "ppo", "--timesteps", "128",
+            "--n-envs", "1", "--config", str(tmp_path / "tiny.yaml"), "--seeds", "0,1", "--quiet"]
+    assert cli_main(args + ["--out", str(tmp_path / "local")]) == 0
+    assert cli_main(args + ["--out", str(tmp_path / "ray"), "--backend", "ray"]) == 0
+
+    def weights(where, seed):
+        return PPO.load(tmp_path / where / f"seed_{seed}" / "model.zip").policy.state_dict()
+    for seed in (0, 1):
+        a, b = weights("local", seed), weights("ray", seed)
+        assert all(torch.equal(a[k], b[k]) for k in a)
+    a, b = weights("local", 0), weights("local", 1)
+    assert not all(torch.equal(a[k], b[k]) for k in a)               # the seeds differ
