@@ -141,11 +141,12 @@ def cmd_ride_through(args) -> int:
 
 
 def cmd_tune(args) -> int:
+    from physics.backend import Backend
     from .tune import tune
     try:
         r = tune(args.policy, args.env, args.gain, args.out, iterations=args.iterations,
                  population=args.population, elite=args.elite, seed=args.seed,
-                 progress=not args.quiet, plots=not args.no_plots)
+                 progress=not args.quiet, plots=not args.no_plots, backend=Backend.from_args(args))
     except ERRORS as exc:
         return _fail("tune", exc)
     print(f"{r['controller']} on {r['env_id']}: validation score {r['start_validation_score']:.2f} "
@@ -231,6 +232,7 @@ def register(sub) -> None:
     p.add_argument("--population", type=int, default=24, help="candidates per generation")
     p.add_argument("--elite", type=int, default=6, help="best candidates the next generation is fitted to")
     p.add_argument("--seed", type=_SEED, default=0)
+    add_backend_args(p, resume=False)
     _output_args(p, "out/tune")
     p.set_defaults(func=cmd_tune)
 

@@ -181,3 +181,17 @@ def test_seeds_trained_as_ray_tasks_equal_the_local_ones(tmp_path):
         assert all(torch.equal(a[k], b[k]) for k in a)
     a, b = weights("local", 0), weights("local", 1)
     assert not all(torch.equal(a[k], b[k]) for k in a)               # the seeds differ
+
+
+def test_ray_tune_finds_the_gains_of_the_local_search(tmp_path):
+    """`tune --backend ray`: Ray Tune runs the candidates as trials; same history, same gains."""
+    pytest.importorskip("ray")
+    args = ["tune", "--policy", "whirl-brake", "--env", "RotorDrop-Relevitate-v0", "--gain",
+            "kp=0.5:1.5", "--iterations", "2", "--population", "3", "--elite", "1", "--quiet",
+            "--no-plots"]
+    assert cli_main(args + ["--out", str(tmp_path / "local")]) == 0
+    assert cli_main(args + ["--out", str(tmp_path / "ray"), "--backend", "ray"]) == 0
+    a, b = (json.loads((tmp_path / d / "tune.json").read_text()) for d in ("local", "ray"))
+    assert b["backend"] == "ray" and (tmp_path / "ray" / "ray_tune").is_dir()
+    assert a["history"] == b["history"] and len(a["history"]) == 3
+    assert a["gains"] == b["gains"] and a["validation_score"] == b["validation_score"]
