@@ -111,11 +111,12 @@ def cmd_evaluate(args) -> int:
 
 
 def cmd_benchmark(args) -> int:
+    from physics.backend import Backend
     from .benchmark import benchmark
     try:
         benchmark(args.out, quick=args.quick, policies=args.policy, max_scenarios=args.scenarios,
                   episodes=args.episodes, progress=not args.quiet, plots=not args.no_plots,
-                  power_return=_power_return_s(args))
+                  power_return=_power_return_s(args), backend=Backend.from_args(args))
     except ERRORS as exc:
         return _fail("benchmark", exc)
     return 0
@@ -214,6 +215,7 @@ def register(sub) -> None:
     p.add_argument("--power-return-ms", type=float, default=None,
                    help="power-return delay of the re-levitation tasks [ms] (default: the "
                         "environments' 50 ms; the 'power back at 0.15 s' scenario keeps its own)")
+    add_backend_args(p, resume=False)
     _output_args(p, "out/benchmark")
     p.add_argument("--scenarios", type=int, default=None, help=argparse.SUPPRESS)
     p.add_argument("--episodes", type=int, default=None, help=argparse.SUPPRESS)

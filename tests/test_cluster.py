@@ -195,3 +195,17 @@ def test_ray_tune_finds_the_gains_of_the_local_search(tmp_path):
     assert b["backend"] == "ray" and (tmp_path / "ray" / "ray_tune").is_dir()
     assert a["history"] == b["history"] and len(a["history"]) == 3
     assert a["gains"] == b["gains"] and a["validation_score"] == b["validation_score"]
+
+
+def test_benchmark_on_ray_gives_the_local_leaderboard(tmp_path):
+    """`benchmark --backend ray`: threshold frictions and controllers as tasks (learned policies
+    travel as their paths), the same rows and leaderboard."""
+    pytest.importorskip("ray")
+    args = ["benchmark", "--quick", "--scenarios", "1", "--episodes", "1", "--quiet", "--no-plots"]
+    assert cli_main(args + ["--out", str(tmp_path / "local")]) == 0
+    assert cli_main(args + ["--out", str(tmp_path / "ray"), "--backend", "ray"]) == 0
+    a, b = (json.loads((tmp_path / d / "benchmark.json").read_text()) for d in ("local", "ray"))
+    assert b["backend"]["backend"] == "ray" and b["backend"]["tasks"] > len(a["threshold_sweep"]["grid"])
+    assert any(r["controller"].startswith("ppo-") for r in b["rows"])        # learned policies ran
+    assert a["threshold_sweep"] == b["threshold_sweep"]
+    assert a["rows"] == b["rows"] and a["leaderboard"] == b["leaderboard"]
