@@ -4,7 +4,7 @@
 
 The swept drops of the quick paper study (with the study's observables) run through
 :func:`physics.backend.run_drops`, interleaved per repeat: the local backend on 1 thread (and on
-2 threads when ``physics.batch`` is there), then Ray on this machine with 1 and with 2 CPUs
+2 threads when ``physics.sweep.run_chunk`` is there), then Ray on this machine with 1 and with 2 CPUs
 (``ray.init(num_cpus=N)`` by this script; its start-up is timed apart, the batch time includes
 the start of Ray's worker processes and their loading of the compiled kernels, as a user's run
 does). Prints medians over the repeats: the Ray overhead against local on the same cores, the
@@ -62,10 +62,10 @@ def main() -> None:
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--json", default=None)
     args = ap.parse_args()
-    try:
-        import physics.batch  # noqa: F401
+    import physics.sweep
+    if hasattr(physics.sweep, "run_chunk"):                # threads in one process
         configs = [("local", 1), ("local", 2), ("ray", 1), ("ray", 2)]
-    except ImportError:
+    else:
         configs = [("local", 1), ("ray", 1), ("ray", 2)]
     runs = quick_study_runs()
     local(runs[:2], 1)                                   # kernels compiled / cached once

@@ -1,7 +1,7 @@
 """Where batches of drops run: in this process (``local``) or on a Ray cluster (``ray``).
 
 A batch (a study, a sweep) is cut into chunks of :class:`physics.sweep.Run` s; each chunk is
-simulated by :func:`physics.batch.run_chunk` in one process, the only function a backend calls:
+simulated by :func:`physics.sweep.run_chunk` in one process, the only function a backend calls:
 
 * ``local`` runs the chunks one after the other in this process (``run_chunk`` spreads a chunk
   over ``--jobs`` threads);
@@ -89,8 +89,8 @@ class Session:
         pass
 
     def cpus(self) -> int:
-        from .batch import available_cores
-        return available_cores()
+        from . import sweep
+        return (getattr(sweep, "available_cores", None) or sweep.default_jobs)()
 
     def imap(self, fn: Callable, tasks: Sequence[tuple], num_cpus: int = TASK_CPUS
              ) -> Iterator[tuple[int, Any]]:
@@ -333,18 +333,18 @@ def _run_remote(session: Session, runs, todo: list[int], evaluate, store, bar) -
 
 
 def _run_chunk(runs: list[Run], evaluate, threads, on_outcome=None) -> list[Outcome]:
-    """:func:`physics.batch.run_chunk` (the unit of work of every backend)."""
-    try:
-        from .batch import run_chunk
-    except ImportError:          # before physics.batch: the single-drop path, same shape
-        from .sweep import simulate_run
-        out = []
-        for i, run in enumerate(runs):
-            out.append(simulate_run(run, evaluate))
-            if on_outcome is not None:
-                on_outcome(i, out[-1])
-        return out
-    return run_chunk(runs, evaluate, threads=threads, on_outcome=on_outcome)
+    """:func:`physics.sweep.run_chunk`, the unit of work of every backend (``threads`` threads
+    in this process; ``on_outcome(i, outcome)`` as each drop finishes)."""
+    from . import sweep
+    run_chunk = getattr(sweep, "run_chunk", None)
+    if run_chunk is not None:
+        return run_chunk(runs, evaluate, threads=threads, on_outcome=on_outcome)
+    out = []                     # before run_chunk: the single-drop path, same shape
+    for i, run in enumerate(runs):
+        out.append(sweep.simulate_run(run, evaluate))
+        if on_outcome is not None:
+            on_outcome(i, out[-1])
+    return out
 
 
 def _bar(enabled: bool, total: int, initial: int, desc: str):
