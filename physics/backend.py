@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 from typing import Any, Callable, Iterator, Sequence
 
 from .cli import UsageError
-from .sweep import Evaluate, Outcome, Run
+from .sweep import Evaluate, Outcome, Run, _bar, _tick
 
 BACKENDS = ("local", "ray")
 INSTALL = 'python3 -m pip install -e ".[cluster]"'
@@ -296,7 +296,9 @@ def run_drops(runs: Sequence[Run], evaluate: Evaluate | None = None, backend: Ba
         if todo:
             with backend.session() as session:
                 store.begin()
-                bar = _bar(progress, len(runs), info.resumed, desc)
+                bar = _bar(progress, len(runs), desc)
+                if bar is not None:
+                    bar.update(info.resumed)
                 if session.name == "local":
                     info.chunks = 1
                     _run_local(runs, todo, evaluate, jobs, store, bar)
@@ -316,7 +318,7 @@ def run_drops(runs: Sequence[Run], evaluate: Evaluate | None = None, backend: Ba
 def _run_local(runs, todo: list[int], evaluate, jobs, store, bar) -> None:
     def done(i: int, outcome: Outcome) -> None:
         store.add(todo[i], record(outcome))
-        _tick(bar, 1, outcome.ok)
+        _tick(bar, outcome)
     _run_chunk([runs[i] for i in todo], evaluate, jobs, done)
 
 
@@ -327,7 +329,7 @@ def _run_remote(session: Session, runs, todo: list[int], evaluate, store, bar) -
     for k, records in session.imap(chunk_task, tasks):
         for i, rec in zip(chunks[k], records):
             store.add(i, rec)
-            _tick(bar, 1, rec["ok"])
+            _tick(bar, Outcome(runs[i], **rec))
         store.sync()
     return len(chunks)
 
@@ -345,20 +347,3 @@ def _run_chunk(runs: list[Run], evaluate, threads, on_outcome=None) -> list[Outc
         if on_outcome is not None:
             on_outcome(i, out[-1])
     return out
-
-
-def _bar(enabled: bool, total: int, initial: int, desc: str):
-    if not enabled:
-        return None
-    from tqdm.auto import tqdm
-    return tqdm(total=total, initial=initial, desc=desc, unit="run")
-
-
-def _tick(bar, n: int, ok: bool) -> None:
-    if bar is None:
-        return
-    bar.update(n)
-    if not ok:
-        bar.failed = getattr(bar, "failed", 0) + 1
-        bar.set_postfix_str(f"{bar.failed} failed (reported, not dropped)", refresh=False)
-
