@@ -23,7 +23,10 @@ import math
 import os
 import socket
 import statistics
+import sys
+import tempfile
 import time
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any, Callable, Iterator, Sequence
 
@@ -33,6 +36,9 @@ from .sweep import Evaluate, Outcome, Run, _bar, _tick
 BACKENDS = ("local", "ray")
 INSTALL = 'python3 -m pip install -e ".[cluster]"'
 CONNECT_TIMEOUT_S = 3.0          # an address that does not answer within this fails at once
+#: while joining a cluster at an address: a cluster that refuses us (a wrong token) fails after a
+#: few seconds (ray.init retries ~20 s)
+CONNECT_ENV = {"RAY_gcs_server_port_wait_time_s": "3"}
 TASK_CPUS = 1                    # CPUs (and threads) of one Ray task
 TASKS_PER_CPU = 4                # chunks per cluster CPU: load balance vs per-task overhead
 MAX_RETRIES = 3                  # re-runs of a chunk whose worker or node died
@@ -113,19 +119,29 @@ class RaySession(Session):
         self.nodes: dict[str, int] = {}                # tasks finished per node address
 
     def __enter__(self) -> "RaySession":
+        quiet = {} if self.address in (None, "local", "auto") else CONNECT_ENV
+        saved = {k: os.environ.get(k) for k in quiet}
+        os.environ.update(quiet)
         try:
-            import ray
-        except ImportError:
-            raise BackendError(f"--backend ray needs Ray, which is not installed: {INSTALL}") from None
-        if ray.is_initialized():                           # inside a Ray program: use its Ray
-            self.address = self.address or "the running Ray"
-        else:
-            self._connect(ray)
-            self.started = True
+            try:
+                import ray
+            except ImportError:
+                raise BackendError(f"--backend ray needs Ray, which is not installed: {INSTALL}") from None
+            if ray.is_initialized():                       # inside a Ray program: use its Ray
+                self.address = self.address or "the running Ray"
+            else:
+                self._connect(ray, hint=bool(quiet))
+                self.started = True
+        finally:
+            for k, v in saved.items():
+                if v is None:
+                    os.environ.pop(k, None)
+                else:
+                    os.environ[k] = v
         self.at_start = dict(nodes=sum(1 for n in ray.nodes() if n.get("Alive")), cpus=self.cpus())
         return self
 
-    def _connect(self, ray) -> None:
+    def _connect(self, ray, hint: bool) -> None:
         kwargs: dict[str, Any] = dict(logging_level="ERROR", configure_logging=True)
         if self.address in (None, "local"):
             kwargs.update(include_dashboard=False)
@@ -134,11 +150,12 @@ class RaySession(Session):
             if not self.address.startswith("ray://") and _is_loopback(host):
                 kwargs["_node_ip_address"] = host         # a node of this machine: its address
         try:
-            ray.init(address=self.address, **kwargs)
+            with _quiet_stderr(hint):       # Ray's C++ client warns once per retry
+                ray.init(address=self.address, **kwargs)
         except Exception as exc:                          # ConnectionError, AuthenticationError...
             where = f"the Ray cluster at {self.address}" if self.address else "a local Ray"
             raise BackendError(f"--backend ray: cannot connect to {where}: {first_line(exc)}"
-                               + _token_hint(exc)) from None
+                               + (_token_hint() if hint else "")) from None
 
     def __exit__(self, *exc) -> None:
         if self.started:                                  # only a Ray this session started
@@ -216,12 +233,29 @@ def _is_loopback(host: str) -> bool:
         return host == "localhost"
 
 
-def _token_hint(exc: Exception) -> str:
-    text = str(exc).lower()
-    if "auth" in text or "token" in text:
-        return " (a cluster started with RAY_AUTH_MODE=token needs RAY_AUTH_MODE=token and its " \
-               "token in RAY_AUTH_TOKEN here too)"
-    return ""
+@contextmanager
+def _quiet_stderr(enabled: bool):
+    """File descriptor 2 to a scratch file while ``enabled`` (the error is reported instead)."""
+    if not enabled:
+        yield
+        return
+    sys.stderr.flush()
+    saved = os.dup(2)
+    with tempfile.TemporaryFile() as sink:
+        os.dup2(sink.fileno(), 2)
+        try:
+            yield
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+
+
+def _token_hint() -> str:
+    """Something answers at the address but Ray does not let us in: most often the token."""
+    if os.environ.get("RAY_AUTH_MODE", "").lower() == "token" and os.environ.get("RAY_AUTH_TOKEN"):
+        return " (is RAY_AUTH_TOKEN the cluster's token?)"
+    return (" (a cluster with token authentication needs RAY_AUTH_MODE=token and its token in "
+            "RAY_AUTH_TOKEN here too)")
 
 
 def first_line(exc: BaseException) -> str:

@@ -102,7 +102,9 @@ def test_a_sweep_across_two_nodes_survives_a_killed_worker(cluster, tmp_path):
     bad = subprocess.run([sys.executable, "-m", "agents.cli"] + SWEEP + [
         "--backend", "ray", "--address", address, "--out", str(tmp_path / "refused")],
         env=no_token, capture_output=True, text=True, timeout=120, cwd=ROOT)
-    assert bad.returncode != 0 and not (tmp_path / "refused" / "sweep.json").exists()
+    assert bad.returncode == 2 and not (tmp_path / "refused" / "sweep.json").exists()
+    assert bad.stderr.startswith("rotordrop: error: ") and bad.stderr.count("\n") == 1, bad.stderr
+    assert "RAY_AUTH_TOKEN" in bad.stderr
 
     out = tmp_path / "ray"
     driver = subprocess.Popen([sys.executable, "-c", "import sys; from agents.cli import main; "
