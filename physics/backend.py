@@ -25,7 +25,6 @@ import socket
 import statistics
 import sys
 import tempfile
-import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any, Callable, Iterator, Sequence
@@ -266,12 +265,11 @@ def first_line(exc: BaseException) -> str:
 # ------------------------------------------------------------------------------- batches --
 @dataclass
 class Dispatch:
-    """How a batch ran: backend, chunks, drops resumed from disk, bytes sent per task."""
+    """How a batch ran: the backend's description (:meth:`Session.describe`: tasks, nodes,
+    bytes sent per task) and the drops resumed from disk."""
     backend: dict = field(default_factory=dict)
     drops: int = 0
     resumed: int = 0
-    chunks: int = 0
-    wall_time_s: float = 0.0
 
     def note(self) -> str:
         """One line for the command's output ("" for a plain local run)."""
@@ -324,7 +322,6 @@ def run_drops(runs: Sequence[Run], evaluate: Evaluate | None = None, backend: Ba
              else DropStore.memory(runs))
     todo = store.missing()
     info = Dispatch(drops=len(runs), resumed=len(runs) - len(todo))
-    t0 = time.perf_counter()
     bar = None
     try:
         if todo:
@@ -334,10 +331,9 @@ def run_drops(runs: Sequence[Run], evaluate: Evaluate | None = None, backend: Ba
                 if bar is not None:
                     bar.update(info.resumed)
                 if session.name == "local":
-                    info.chunks = 1
                     _run_local(runs, todo, evaluate, jobs, store, bar)
                 else:
-                    info.chunks = _run_remote(session, runs, todo, evaluate, store, bar)
+                    _run_remote(session, runs, todo, evaluate, store, bar)
                 info.backend = session.describe()
         else:
             info.backend = dict(backend=backend.name)
@@ -345,7 +341,6 @@ def run_drops(runs: Sequence[Run], evaluate: Evaluate | None = None, backend: Ba
         if bar is not None:
             bar.close()
         store.close()
-    info.wall_time_s = time.perf_counter() - t0
     return [Outcome(run, **rec) for run, rec in zip(runs, store.records())], info
 
 
@@ -356,7 +351,7 @@ def _run_local(runs, todo: list[int], evaluate, jobs, store, bar) -> None:
     _run_chunk([runs[i] for i in todo], evaluate, jobs, done)
 
 
-def _run_remote(session: Session, runs, todo: list[int], evaluate, store, bar) -> int:
+def _run_remote(session: Session, runs, todo: list[int], evaluate, store, bar) -> None:
     size = max(1, math.ceil(len(todo) / (TASKS_PER_CPU * session.cpus())))
     chunks = [todo[k:k + size] for k in range(0, len(todo), size)]
     tasks = [([runs[i] for i in c], evaluate, TASK_CPUS) for c in chunks]
@@ -365,7 +360,6 @@ def _run_remote(session: Session, runs, todo: list[int], evaluate, store, bar) -
             store.add(i, rec)
             _tick(bar, Outcome(runs[i], **rec))
         store.sync()
-    return len(chunks)
 
 
 def _run_chunk(runs: list[Run], evaluate, threads, on_outcome=None) -> list[Outcome]:
