@@ -1,4 +1,5 @@
-"""The cross-entropy search (:class:`agents.search.CrossEntropy`) driven by Ray Tune.
+"""The cross-entropy search (:class:`agents.search.CrossEntropy`) on a backend: locally, or
+driven by Ray Tune (:func:`minimise`).
 
 Every candidate is one Ray Tune trial (``objective(theta)`` -> ``{"cost": ...}``), scheduled on
 the cluster as Tune schedules trials (one CPU each, retried when a node dies, its results under
@@ -13,7 +14,21 @@ from typing import Callable
 
 import numpy as np
 
-from .search import CrossEntropy
+from .search import CrossEntropy, cross_entropy
+
+
+def minimise(objective: Callable[[np.ndarray], float], names: list[str], iterations: int,
+             backend, storage: Path, progress: bool = True, desc: str = "cross-entropy search",
+             **search):
+    """The cross-entropy search (``search``: :class:`CrossEntropy`'s arguments) of
+    ``objective`` on ``backend`` (:class:`physics.backend.Backend`): here one candidate after the
+    other, or on Ray Tune (trials under ``storage``); the same result either way."""
+    if backend.name != "ray":
+        return cross_entropy(objective, iterations=iterations, progress=progress, desc=desc,
+                             **search)
+    with backend.session():
+        return ray_cross_entropy(objective, CrossEntropy(**search), names, iterations, storage,
+                                 progress=progress, desc=f"{desc} (Ray Tune)")
 
 
 def ray_cross_entropy(objective: Callable[[np.ndarray], float], search: CrossEntropy,

@@ -30,7 +30,7 @@ from .benchmark import TASKS, Validator, controller_env_kwargs
 from .controllers import BASELINES, Controller, controller_class, make_controller
 from .rollout import check_actor
 from .score import write_json
-from .search import CrossEntropy, cross_entropy
+from .ray_search import minimise
 
 
 def parse_gain(text: str) -> tuple[str, float, float]:
@@ -141,18 +141,11 @@ def tune(spec: str, env_id: str, gains: list[str], out, iterations: int = 12,
     score = objective.score
 
     t0 = time.perf_counter()
-    search = dict(mean=start, std=0.15 * (high - low), low=low, high=high, population=population,
-                  elite=elite, rng=np.random.default_rng(seed), min_std=0.01 * (high - low))
-    if backend.name == "ray":
-        from .ray_search import ray_cross_entropy
-        with backend.session():
-            best_cost, best, history = ray_cross_entropy(
-                objective, CrossEntropy(**search), names, iterations, Path(out) / "ray_tune",
-                progress=progress, desc=f"tuning {cls.name} (Ray Tune)")
-    else:
-        best_cost, best, history = cross_entropy(objective, iterations=iterations,
-                                                 progress=progress, desc=f"tuning {cls.name}",
-                                                 **search)
+    best_cost, best, history = minimise(
+        objective, names, iterations, backend, Path(out) / "ray_tune", progress=progress,
+        desc=f"tuning {cls.name}", mean=start, std=0.15 * (high - low), low=low, high=high,
+        population=population, elite=elite, rng=np.random.default_rng(seed),
+        min_std=0.01 * (high - low))
     final, rows = score(best)
     report = dict(controller=cls.name, spec=spec, env_id=env_id, backend=backend.name,
                   ranges={n: [lo, hi] for n, lo, hi in ranges},

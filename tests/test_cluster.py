@@ -197,6 +197,12 @@ def test_ray_tune_finds_the_gains_of_the_local_search(tmp_path):
     assert b["backend"] == "ray" and (tmp_path / "ray" / "ray_tune").is_dir()
     assert a["history"] == b["history"] and len(a["history"]) == 3
     assert a["gains"] == b["gains"] and a["validation_score"] == b["validation_score"]
+    # the research gain search runs on Ray Tune the same way
+    args = ["research", "tune-whirl-brake", "--iterations", "1", "--population", "2", "--elite", "1"]
+    assert cli_main(args + ["--out", str(tmp_path / "wb-local")]) == 0
+    assert cli_main(args + ["--out", str(tmp_path / "wb-ray"), "--backend", "ray"]) == 0
+    a, b = (json.loads((tmp_path / d / "tune.json").read_text()) for d in ("wb-local", "wb-ray"))
+    assert a["history"] == b["history"] and a["gains"] == b["gains"] and a["cost"] == b["cost"]
 
 
 def test_benchmark_on_ray_gives_the_local_leaderboard(tmp_path):
