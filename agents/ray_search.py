@@ -75,6 +75,9 @@ def _searcher_class():
             self.costs: dict[int, float] = {}
             self.size, self.generation_done = 1, False
 
+        def __getstate__(self):                          # Tune saves the searcher: no bar
+            return {**self.__dict__, "bar": None}
+
         def suggest(self, trial_id: str):
             if not self.queue:
                 if not self.generation_done:
@@ -96,7 +99,8 @@ def _searcher_class():
                 self.search.tell_start(self.costs[-1])
             else:
                 self.search.tell([self.costs[i] for i in range(self.size)])
-                self.bar.update(1)
+                if self.bar is not None:
+                    self.bar.update(1)
             self.generation_done = True
 
     return CrossEntropySearcher
