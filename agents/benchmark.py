@@ -80,19 +80,17 @@ class Scenario:
         return {"contact.friction": self.friction, "unbalance.angle_deg": phase, **self.overrides}
 
 
-def passive_threshold(phases=PHASES, grid=THRESHOLD_GRID, progress=None) -> dict:
-    """Whirl fraction of the passive drop on the friction grid and the threshold μ* (module doc)."""
-    fractions = []
-    for mu in grid:
-        whirls = []
-        for ph in phases:
-            ep = run_episodes("RotorDrop-Passive-v0", Passive, [0], dict(
-                EVAL_KWARGS, overrides={"contact.friction": mu, "unbalance.angle_deg": ph},
-                **monitor_kwargs({})))[0]
-            whirls.append(bool(ep.kpis["backward_whirl"]))
-            if progress is not None:
-                progress.update(1)
-        fractions.append(float(np.mean(whirls)))
+def passive_threshold(phases=PHASES, grid=THRESHOLD_GRID, progress=None, session=None) -> dict:
+    """Whirl fraction of the passive drop on the friction grid and the threshold μ* (module doc);
+    one task per friction on ``session`` (default: one after the other here)."""
+    from physics.backend import Session
+    session = session if session is not None else Session()
+    fractions = [0.0] * len(grid)
+    bar = progress if session.name == "local" else None
+    for i, whirls in session.imap(passive_whirls, [(mu, phases, bar) for mu in grid]):
+        fractions[i] = float(np.mean(whirls))
+        if progress is not None and bar is None:
+            progress.update(len(phases))
     threshold = None
     for i in range(len(grid)):
         if all(f >= 0.5 for f in fractions[i:]):
@@ -101,6 +99,19 @@ def passive_threshold(phases=PHASES, grid=THRESHOLD_GRID, progress=None) -> dict
     return dict(grid=list(grid), phases=list(phases), whirl_fraction=fractions, threshold=threshold,
                 rule="lowest grid friction from which the passive drop whirls in >= half of the "
                      "phases at every grid point")
+
+
+def passive_whirls(mu: float, phases, progress=None) -> list[bool]:
+    """Whether the passive drop at friction ``mu`` whirls, per unbalance phase."""
+    whirls = []
+    for ph in phases:
+        ep = run_episodes("RotorDrop-Passive-v0", Passive, [0], dict(
+            EVAL_KWARGS, overrides={"contact.friction": mu, "unbalance.angle_deg": ph},
+            **monitor_kwargs({})))[0]
+        whirls.append(bool(ep.kpis["backward_whirl"]))
+        if progress is not None:
+            progress.update(1)
+    return whirls
 
 
 def scenario_suite(threshold: float | None, quick: bool = False,
@@ -260,9 +271,14 @@ def episode_kwargs(entry: Entry, scenario: Scenario, phase: float) -> dict:
 
 def benchmark(out: str | Path, quick: bool = False, policies: list[str] | None = None,
               max_scenarios: int | None = None, episodes: int | None = None,
-              progress: bool = True, plots: bool = True, power_return: float | None = None) -> dict:
+              progress: bool = True, plots: bool = True, power_return: float | None = None,
+              backend=None) -> dict:
     """Run the suite and write benchmark.json, leaderboard.md and the plots into ``out``;
-    ``power_return`` [s]: see :func:`scenario_suite`."""
+    ``power_return`` [s]: see :func:`scenario_suite`. On ``backend`` ray every friction of the
+    threshold sweep and every controller is one Ray task (learned policies travel as their
+    paths and are loaded again on the node)."""
+    from physics.backend import Backend
+    backend = backend if backend is not None else Backend()
     if power_return is not None:
         check_power_return(power_return, "--power-return-ms")
     from tqdm.auto import tqdm
@@ -280,20 +296,19 @@ def benchmark(out: str | Path, quick: bool = False, policies: list[str] | None =
         check_actor(TASKS[e.task], e.make, e.env_kwargs)
 
     sweep_phases = PHASES if episodes is None else phases     # --quick: the full threshold sweep
-    bar = tqdm(total=len(THRESHOLD_GRID) * len(sweep_phases), desc="passive threshold", unit="ep",
-               disable=not progress)
-    sweep = passive_threshold(sweep_phases, THRESHOLD_GRID, bar)
-    bar.close()
-    scenarios = scenario_suite(sweep["threshold"], quick, power_return)
-    if max_scenarios is not None:
-        scenarios = scenarios[:max(1, max_scenarios)]
-
-    rows = []
-    bar = tqdm(total=sum(e.task in s.tasks for e in entries for s in scenarios) * len(phases),
-               desc="benchmark", unit="ep", disable=not progress)
-    for entry in entries:
-        rows += suite_rows(entry, scenarios, phases, bar)
-    bar.close()
+    with backend.session() as session:
+        bar = tqdm(total=len(THRESHOLD_GRID) * len(sweep_phases), desc="passive threshold",
+                   unit="ep", disable=not progress)
+        sweep = passive_threshold(sweep_phases, THRESHOLD_GRID, bar, session)
+        bar.close()
+        scenarios = scenario_suite(sweep["threshold"], quick, power_return)
+        if max_scenarios is not None:
+            scenarios = scenarios[:max(1, max_scenarios)]
+        bar = tqdm(total=sum(e.task in s.tasks for e in entries for s in scenarios) * len(phases),
+                   desc="benchmark", unit="ep", disable=not progress)
+        rows = entry_rows(session, entries, scenarios, phases, bar)
+        bar.close()
+        where = session.describe()
     board = leaderboard(rows, scenarios, sweep["threshold"])
     from rotordrop_env.env import DEFAULT_POWER_RETURN
     report = dict(quick=quick, episode_time_s=EPISODE_TIME, phases_deg=list(phases),
@@ -302,7 +317,8 @@ def benchmark(out: str | Path, quick: bool = False, policies: list[str] | None =
                   scenarios=[dict(name=s.name, friction=s.friction, overrides=s.overrides,
                                   group=s.group, env_kwargs=s.env_kwargs, tasks=list(s.tasks))
                              for s in scenarios],
-                  rows=rows, leaderboard=board, wall_time_s=time.perf_counter() - t0)
+                  rows=rows, leaderboard=board, backend=where,
+                  wall_time_s=time.perf_counter() - t0)
     write_json(out / "benchmark.json", report)
     (out / "leaderboard.md").write_text(leaderboard_markdown(report))
     if plots:
@@ -313,6 +329,18 @@ def benchmark(out: str | Path, quick: bool = False, policies: list[str] | None =
           + "".join(f", {f}" for f in report.get("figures", []))
           + f" in {report['wall_time_s']:.0f} s")
     return report
+
+
+def entry_rows(session, entries: list[Entry], scenarios: list[Scenario], phases, bar) -> list[dict]:
+    """Every entry's :func:`suite_rows`, one task per entry on ``session``, in entry order."""
+    local = session.name == "local"
+    done: dict[int, list[dict]] = {}
+    for i, rows in session.imap(suite_rows, [(e, scenarios, phases, bar if local else None)
+                                             for e in entries]):
+        done[i] = rows
+        if not local:
+            bar.update(len(rows) * len(phases))
+    return [r for i in range(len(entries)) for r in done[i]]
 
 
 def suite_rows(entry: Entry, scenarios: list[Scenario], phases, progress=None) -> list[dict]:

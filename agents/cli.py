@@ -14,6 +14,7 @@ from pathlib import Path
 
 from physics import accuracy, study
 from physics import cli as physics_cli
+from physics.backend import add_backend_args
 from physics.cli import at_least
 
 from . import research
@@ -71,17 +72,31 @@ def _number(text: str):
 
 
 def cmd_train(args) -> int:
+    from physics.backend import Backend
     from .hyperparams import ConfigError
     from .train import command_line, train
     try:
-        res = train(args.env, args.algo, args.out, timesteps=args.timesteps, n_envs=args.n_envs,
-                    config=args.config, seed=args.seed, resume=args.resume, threads=args.threads,
-                    progress=not args.quiet, verbose=args.verbose, command=command_line(),
-                    overwrite=args.overwrite, eval_freq=args.eval_freq,
-                    n_eval_episodes=args.eval_episodes, checkpoint_freq=args.save_freq)
+        backend = Backend.from_args(args)
+        common = dict(timesteps=args.timesteps, n_envs=args.n_envs, config=args.config,
+                      verbose=args.verbose, command=command_line(), overwrite=args.overwrite,
+                      eval_freq=args.eval_freq, n_eval_episodes=args.eval_episodes,
+                      checkpoint_freq=args.save_freq)
+        if args.seeds is None and backend.name == "local":
+            print(train(args.env, args.algo, args.out, seed=args.seed, resume=args.resume,
+                        threads=args.threads, progress=not args.quiet, **common).summary())
+            return 0
+        from .seeds import parse_seeds, seed_dir, train_seeds
+        if args.resume is not None:
+            raise ValueError("--resume continues one run on --backend local; leave out --seeds "
+                             "and --backend ray")
+        seeds = [args.seed] if args.seeds is None else parse_seeds(args.seeds)
+        outs = [args.out] if args.seeds is None else [seed_dir(args.out, s) for s in seeds]
+        results = train_seeds(seeds, args.env, args.algo, outs, backend, threads=args.threads,
+                              progress=not args.quiet, **common)
     except (ConfigError, *ERRORS) as exc:
         return _fail("train", exc)
-    print(res.summary())
+    for seed, res in zip(seeds, results):
+        print(f"seed {seed}: {res.summary()}")
     return 0
 
 
@@ -110,11 +125,12 @@ def cmd_export_policy(args) -> int:
 
 
 def cmd_benchmark(args) -> int:
+    from physics.backend import Backend
     from .benchmark import benchmark
     try:
         benchmark(args.out, quick=args.quick, policies=args.policy, max_scenarios=args.scenarios,
                   episodes=args.episodes, progress=not args.quiet, plots=not args.no_plots,
-                  power_return=_power_return_s(args))
+                  power_return=_power_return_s(args), backend=Backend.from_args(args))
     except ERRORS as exc:
         return _fail("benchmark", exc)
     return 0
@@ -140,11 +156,12 @@ def cmd_ride_through(args) -> int:
 
 
 def cmd_tune(args) -> int:
+    from physics.backend import Backend
     from .tune import tune
     try:
         r = tune(args.policy, args.env, args.gain, args.out, iterations=args.iterations,
                  population=args.population, elite=args.elite, seed=args.seed,
-                 progress=not args.quiet, plots=not args.no_plots)
+                 progress=not args.quiet, plots=not args.no_plots, backend=Backend.from_args(args))
     except ERRORS as exc:
         return _fail("tune", exc)
     print(f"{r['controller']} on {r['env_id']}: validation score {r['start_validation_score']:.2f} "
@@ -164,6 +181,10 @@ def register(sub) -> None:
                    help="YAML with hyperparameters keyed by env id (rl-zoo3 style), applied over "
                         "the shipped agents/configs/<algo>.yaml")
     p.add_argument("--seed", type=_SEED, default=0)
+    p.add_argument("--seeds", default=None, metavar="S1,S2,...",
+                   help="train one run per seed into --out/seed_<s>, side by side (on --backend "
+                        "ray one task each, holding --threads CPUs)")
+    add_backend_args(p, resume=False)
     p.add_argument("--resume", default=None, metavar="DIR|CHECKPOINT.zip",
                    help="continue from a checkpoint (or the newest one in a run directory)")
     p.add_argument("--threads", type=int, default=1,
@@ -227,6 +248,7 @@ def register(sub) -> None:
     p.add_argument("--power-return-ms", type=float, default=None,
                    help="power-return delay of the re-levitation tasks [ms] (default: the "
                         "environments' 50 ms; the 'power back at 0.15 s' scenario keeps its own)")
+    add_backend_args(p, resume=False)
     _output_args(p, "out/benchmark")
     p.add_argument("--scenarios", type=int, default=None, help=argparse.SUPPRESS)
     p.add_argument("--episodes", type=int, default=None, help=argparse.SUPPRESS)
@@ -245,6 +267,7 @@ def register(sub) -> None:
     p.add_argument("--population", type=int, default=24, help="candidates per generation")
     p.add_argument("--elite", type=int, default=6, help="best candidates the next generation is fitted to")
     p.add_argument("--seed", type=_SEED, default=0)
+    add_backend_args(p, resume=False)
     _output_args(p, "out/tune")
     p.set_defaults(func=cmd_tune)
 

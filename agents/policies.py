@@ -51,6 +51,14 @@ class LearnedPolicy:
     residual: str | None = None          # baseline whose action the policy corrects
     residual_scale: float = RESIDUAL_SCALE
     base: object | None = None
+    source: str | None = None            # the path it was loaded from
+
+    def __reduce__(self):
+        """Pickled as where it was loaded from (SB3 models and their statistics do not pickle):
+        a Ray task of ``rotordrop benchmark --backend ray`` loads it again on its node."""
+        if self.source is None:
+            raise TypeError(f"policy {self.name} was not loaded from a file and cannot be pickled")
+        return _reload, (self.source, self.name)
 
     def bound(self, plant: Plant) -> "LearnedPolicy":
         """Ready to drive the environment described by ``plant`` (checks that its observations
@@ -125,7 +133,11 @@ class LearnedPolicy:
         residual = hp.get("residual")
         scale = float(hp.get("residual_scale") or RESIDUAL_SCALE)
         return cls(name or meta.get("name") or f"{algo}-{task}", algo, env_id, env_kwargs, model,
-                   vn, meta, residual, scale)
+                   vn, meta, residual, scale, source=str(path.resolve()))
+
+
+def _reload(source: str, name: str) -> LearnedPolicy:
+    return LearnedPolicy.load(source, name=name)
 
 
 def _stats_candidates(model_zip: Path) -> list[Path]:

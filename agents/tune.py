@@ -19,15 +19,18 @@ from __future__ import annotations
 
 import inspect
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+
+from physics.backend import Backend
 
 from .benchmark import TASKS, Validator, controller_env_kwargs
 from .controllers import BASELINES, Controller, controller_class, make_controller
 from .rollout import check_actor
 from .score import write_json
-from .search import cross_entropy
+from .ray_search import minimise
 
 
 def parse_gain(text: str) -> tuple[str, float, float]:
@@ -74,6 +77,14 @@ def _check_gains(cls: type[Controller], env_id: str, start: dict) -> dict:
     return kw
 
 
+def _portable(spec: str) -> str:
+    """``spec`` with a ``file.py`` made absolute (a Ray Tune trial runs in its own directory)."""
+    path, sep, name = spec.rpartition(":")
+    if sep and path.endswith(".py"):
+        return f"{Path(path).resolve()}:{name}"
+    return spec
+
+
 def gain_names(cls: type[Controller]) -> list[str] | None:
     """The keyword arguments a controller class takes after ``plant`` (its ``GAINS`` when it
     takes ``**gains``); None when that cannot be told."""
@@ -83,10 +94,31 @@ def gain_names(cls: type[Controller]) -> list[str] | None:
     return [p.name for p in params if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)]
 
 
+@dataclass
+class GainObjective:
+    """Minus the validation score of the controller ``spec`` with the gains ``theta`` (picklable:
+    a Ray Tune trial rebuilds the class from ``spec``)."""
+    spec: str
+    env_id: str
+    env_kwargs: dict
+    names: list[str]
+    validator: Validator
+
+    def score(self, theta) -> tuple[float, list[dict]]:
+        cls = controller_class(self.spec)
+        g = dict(zip(self.names, map(float, theta)))
+        return self.validator.score(lambda plant: cls(plant, **g), self.env_kwargs)
+
+    def __call__(self, theta) -> float:
+        return -self.score(theta)[0]
+
+
 def tune(spec: str, env_id: str, gains: list[str], out, iterations: int = 12,
          population: int = 24, elite: int = 6, seed: int = 0, progress: bool = True,
-         plots: bool = True) -> dict:
-    """Run the search (module doc) and write ``tune.json`` / ``tune.png`` into ``out``."""
+         plots: bool = True, backend: Backend = Backend()) -> dict:
+    """Run the search (module doc) and write ``tune.json`` / ``tune.png`` into ``out``; on
+    ``--backend ray`` Ray Tune evaluates the candidates (:mod:`agents.ray_search`, its trials
+    under ``out/ray_tune``), with the same result."""
     if not gains:
         raise ValueError("--gain is required (NAME=LO:HI, repeatable)")
     ranges = [parse_gain(g) for g in gains]
@@ -105,22 +137,21 @@ def tune(spec: str, env_id: str, gains: list[str], out, iterations: int = 12,
     defaults = getattr(cls, "GAINS", {})
     start = np.clip([defaults.get(n, 0.5 * (lo + hi)) for n, lo, hi in ranges], low, high)
     env_kwargs = _check_gains(cls, env_id, dict(zip(names, start.tolist())))
-    validator = Validator(env_id)
-
-    def score(theta) -> tuple[float, list[dict]]:
-        g = dict(zip(names, map(float, theta)))
-        return validator.score(lambda plant: cls(plant, **g), env_kwargs)
+    objective = GainObjective(_portable(spec), env_id, env_kwargs, names, Validator(env_id))
+    score = objective.score
 
     t0 = time.perf_counter()
-    best_cost, best, history = cross_entropy(
-        lambda th: -score(th)[0], start, 0.15 * (high - low), low, high, iterations, population,
-        elite, np.random.default_rng(seed), min_std=0.01 * (high - low), progress=progress,
-        desc=f"tuning {cls.name}")
+    best_cost, best, history = minimise(
+        objective, names, iterations, backend, Path(out) / "ray_tune", progress=progress,
+        desc=f"tuning {cls.name}", mean=start, std=0.15 * (high - low), low=low, high=high,
+        population=population, elite=elite, rng=np.random.default_rng(seed),
+        min_std=0.01 * (high - low))
     final, rows = score(best)
-    report = dict(controller=cls.name, spec=spec, env_id=env_id, ranges={n: [lo, hi] for n, lo, hi in ranges},
+    report = dict(controller=cls.name, spec=spec, env_id=env_id, backend=backend.name,
+                  ranges={n: [lo, hi] for n, lo, hi in ranges},
                   start=dict(zip(names, start.tolist())), start_validation_score=-history[0]["best_cost"],
                   gains=dict(zip(names, best.tolist())), validation_score=final, rows=rows,
-                  passive_rows=validator.passive,
+                  passive_rows=objective.validator.passive,
                   history=[dict(iteration=h["iteration"], best_validation_score=-h["best_cost"],
                                 generation_best=-h["generation_best"],
                                 gains=dict(zip(names, h["best"].tolist()))) for h in history],

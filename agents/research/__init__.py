@@ -9,6 +9,7 @@ environments are imported by the handlers.
 """
 from __future__ import annotations
 
+from physics.backend import add_backend_args
 from physics.cli import UsageError, at_least
 
 
@@ -47,6 +48,7 @@ def register(subparsers) -> None:
     q.add_argument("--elite", type=at_least(1), default=6)
     q.add_argument("--seed", type=at_least(0), default=0)
     q.add_argument("--out", default="out/tune_whirl_brake")
+    add_backend_args(q, resume=False)
     q.set_defaults(func=cmd_tune_whirl_brake)
 
 

@@ -11,18 +11,21 @@ averaged over the set, in the re-levitation task (support damping at the scene's
 case; the Full task adds C_max on top of the same law).
 
     rotordrop research tune-whirl-brake --iterations 12 --population 24 --out out/tune
+    rotordrop research tune-whirl-brake --backend ray --address HEAD:6379    # on Ray Tune
 """
 from __future__ import annotations
 
 import json
 import time
+from functools import partial
 from pathlib import Path
 
 import numpy as np
 from agents.benchmark import EVAL_KWARGS, Entry, Scenario, controller_env_kwargs, episode_kwargs, task_of
 from agents.controllers import WhirlBrake
 from agents.rollout import run_episodes
-from agents.search import cross_entropy
+from agents.ray_search import minimise
+from physics.backend import Backend
 
 NAMES = ("kp", "kd", "kc", "kt", "kr", "ff")
 LOW = np.array([0.0, 0.0, -3.0, -0.5, -1.0, 0.0])
@@ -42,14 +45,21 @@ def cost(theta: np.ndarray, env_id: str) -> tuple[float, list[dict]]:
     return float(np.mean(c)), kpis
 
 
+def total_cost(theta: np.ndarray, env_id: str) -> float:
+    """The cost alone (the search's objective; module level, so a Ray Tune trial can run it)."""
+    return cost(theta, env_id)[0]
+
+
 def run(a) -> None:
     """``rotordrop research tune-whirl-brake`` with its parsed options ``a`` (agents/research)."""
     task_of(a.env)                      # a benchmark environment, else a one-line error
     rng = np.random.default_rng(a.seed)
     t0 = time.perf_counter()
-    _, best, hist = cross_entropy(
-        lambda x: cost(x, a.env)[0], [WhirlBrake.GAINS[n] for n in NAMES], 0.15 * (HIGH - LOW),
-        LOW, HIGH, a.iterations, a.population, a.elite, rng, min_std=0.01 * (HIGH - LOW))
+    _, best, hist = minimise(
+        partial(total_cost, env_id=a.env), list(NAMES), a.iterations, Backend.from_args(a),
+        Path(a.out) / "ray_tune", mean=[WhirlBrake.GAINS[n] for n in NAMES],
+        std=0.15 * (HIGH - LOW), low=LOW, high=HIGH, population=a.population, elite=a.elite,
+        rng=rng, min_std=0.01 * (HIGH - LOW))
     history = [dict(iteration=h["iteration"], best_cost=h["best_cost"],
                     generation_best=h["generation_best"], gains=dict(zip(NAMES, h["best"].tolist())))
                for h in hist]

@@ -2,7 +2,7 @@
 support damping, plus the sensitivity of the results to every assumed [A] parameter.
 
 :func:`plan_runs` turns a :class:`Plan` into :class:`physics.sweep.Run` s (each labelled with the
-study it belongs to), :func:`run_study` simulates them on all cores (keeping the full results of
+study it belongs to), :func:`run_study` simulates them on a backend (keeping the full results of
 the nominal drops the figures draw) and :func:`analyse` reduces
 the outcomes to the numbers written to ``study.json``; :mod:`physics.study.report` draws the
 figures and writes the Markdown report.
@@ -18,7 +18,8 @@ from ..metrics import worst_plane
 from ..results import Result
 from ..scene import Scene, SceneError, load_scene
 from ..simulate import IntegrationError, simulate
-from ..sweep import Outcome, Run, changes, outcome_of, reproduce_command, run_sweep
+from ..backend import Backend, Dispatch, run_drops
+from ..sweep import Outcome, Run, changes, outcome_of, reproduce_command
 from .checks import as_drop, warning_counts
 from .ensemble import ENSEMBLE_KEYS, onset, perturbations, probability_curve
 from .observables import drop_observables
@@ -152,28 +153,32 @@ def sensitivity_settings(scene: Scene) -> list[tuple[str, str, dict]]:
     return out
 
 
-def run_study(plan: Plan, base: StudyInput, jobs: int | None = None,
-              progress: bool = True) -> tuple[list[Outcome], dict[str, dict[float, Result]]]:
+def run_study(plan: Plan, base: StudyInput, jobs: int | None = None, progress: bool = True,
+              backend: Backend = Backend(), out=None, resume: bool = False
+              ) -> tuple[list[Outcome], dict[str, dict[float, Result]], Dispatch]:
     """Simulate every drop of the plan; outcomes in plan order.
 
     The nominal drops of the support studies (``member`` -1) are drawn in the figures, so they
     run here in this process and their full results come back too, as ``{study: {value:
     result}}``; an error in one of them stops the study, as a figure cannot be drawn without it.
-    The rest run on the process pool. A run that ended before the fault is a failed drop
-    (:func:`physics.study.checks.as_drop`).
+    The rest run on ``backend`` (:func:`physics.backend.run_drops`; with ``out`` each finished
+    drop is kept in ``out/drops``, and with ``resume`` only the missing ones run). A run that
+    ended before the fault is a failed drop (:func:`physics.study.checks.as_drop`).
     """
     runs = plan_runs(plan, base)
     nominal = {r: simulate_figure_drop(r, f"the nominal drop of the support {r.label['study']} study"
                                           f" (support.{r.label['study']} = {r.label['value']:g})")
                for r in runs if r.label["member"] == -1}
-    swept = iter(run_sweep([r for r in runs if r not in nominal], drop_observables, jobs=jobs,
-                           desc="study paper", progress=progress))
+    swept, dispatch = run_drops([r for r in runs if r not in nominal], drop_observables, backend,
+                                jobs=jobs, out=out, resume=resume, desc="study paper",
+                                progress=progress)
+    swept = iter(swept)
     outcomes = [as_drop(outcome_of(r, nominal[r], drop_observables) if r in nominal else next(swept))
                 for r in runs]
     results: dict[str, dict[float, Result]] = {}
     for r, result in nominal.items():
         results.setdefault(r.label["study"], {})[r.label["value"]] = result
-    return outcomes, results
+    return outcomes, results, dispatch
 
 
 def simulate_figure_drop(run: Run, what: str) -> Result:

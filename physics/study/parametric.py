@@ -29,7 +29,8 @@ import numpy as np
 
 from ..metrics import worst_plane
 from ..scene import SceneError, load_scene
-from ..sweep import Outcome, Run, plan_jobs, run_sweep
+from ..backend import Backend, plan_threads, run_drops
+from ..sweep import Outcome, Run
 from .checks import WARNING_KINDS, as_drop, counts_text, warning_counts, warnings_note
 from .ensemble import ENSEMBLE_KEYS, perturbations
 from .labels import PLANE_KPIS, value_label
@@ -139,13 +140,17 @@ def summarize_cell(outcomes: list[Outcome]) -> dict:
 
 def run_parametric(source: str, overrides: dict, vary: list[str], out_dir, members: int = 8,
                    seed: int = 0, jobs: int | None = None, progress: bool = True,
-                   plots: bool = True) -> dict:
-    """Plan, simulate and summarise the sweep; write ``sweep.json``, ``sweep.csv``, ``sweep.png``."""
+                   plots: bool = True, backend: Backend = Backend(), resume: bool = False) -> dict:
+    """Plan, simulate (on ``backend``; every finished drop kept in ``out_dir/drops``, and with
+    ``resume`` only the missing drops run) and summarise the sweep; write ``sweep.json``,
+    ``sweep.csv``, ``sweep.png``."""
     axes = make_axes(source, overrides, vary)
     runs = plan_runs(source, overrides, axes, members, seed)
-    jobs, jobs_note = plan_jobs(jobs, len(runs))
+    jobs, jobs_note = plan_threads(backend, jobs, len(runs))
     t0 = time.perf_counter()
-    outcomes = [as_drop(o) for o in run_sweep(runs, jobs=jobs, desc="study sweep", progress=progress)]
+    outcomes, dispatch = run_drops(runs, backend=backend, jobs=jobs, out=out_dir, resume=resume,
+                                   desc="study sweep", progress=progress)
+    outcomes = [as_drop(o) for o in outcomes]
     per_cell = len(runs) // math.prod(len(a.values) for a in axes)
     cells = []
     for i, cell in enumerate(product(*(a.values for a in axes))):
@@ -155,7 +160,8 @@ def run_parametric(source: str, overrides: dict, vary: list[str], out_dir, membe
                   members=per_cell, seed=seed, ensemble_keys=ensemble_keys(overrides, axes),
                   cells=cells, runs=[o.to_dict() for o in outcomes],
                   failed=sum(not o.ok for o in outcomes), warnings=warning_counts(outcomes),
-                  jobs=jobs, jobs_note=jobs_note, wall_time_s=time.perf_counter() - t0)
+                  jobs=jobs, jobs_note=jobs_note, backend=dispatch.backend,
+                  dispatch_note=dispatch.note(), wall_time_s=time.perf_counter() - t0)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     (out / "sweep.json").write_text(json.dumps(report, indent=1))
@@ -219,8 +225,10 @@ def summary_table(report: dict) -> str:
 
 
 def notes(report: dict, members: int) -> list[str]:
-    """The lines printed under the table: capped --jobs, fixed ensemble, failed and flagged drops."""
+    """The lines printed under the table: capped --jobs, backend and resumed drops, fixed
+    ensemble, failed and flagged drops."""
     out = [f"note: {report['jobs_note']}"] if report["jobs_note"] else []
+    out += [report["dispatch_note"]] if report.get("dispatch_note") else []
     if report["members"] < members:
         out.append(f"note: --set/--vary fix {' and '.join(ENSEMBLE_KEYS)}, the keys that make the "
                    f"ensemble, so each cell is {report['members']} drop, not {members}")

@@ -200,7 +200,7 @@ def write_report(a: dict, out: Path, figures: dict[str, list[str]], meta: dict) 
       + (" with " + ", ".join(f"`--set {k}={v}`" for k, v in a["overrides"].items())
          if a["overrides"] else "")
       + f". {a['runs']['total']} drops, {a['runs']['failed']} failed; "
-      f"{meta['wall_s']:.0f} s wall on {meta['jobs']} process(es)"
+      f"{meta['wall_s']:.0f} s wall {meta['where']}"
       + (" (**quick** mode: coarse grid, small ensembles — statistics are indicative only)"
          if meta["quick"] else "") + ".\n")
     w(_checks_text(a))

@@ -6,7 +6,7 @@ import time
 from pathlib import Path
 
 from ..scene import load_scene
-from ..sweep import plan_jobs
+from ..backend import Backend, plan_threads
 from . import report
 from .checks import warnings_note
 from .claims import claims
@@ -15,15 +15,19 @@ from .paper import (SENSITIVITY, Plan, StudyInput, analyse, plan_runs, run_study
 
 
 def run_paper_study(source: str, overrides: dict, out_dir, quick: bool = False,
-                    jobs: int | None = None, progress: bool = True) -> str:
-    """Run the study, write ``study.json``, ``report.md`` and the figures; return a summary."""
+                    jobs: int | None = None, progress: bool = True, backend: Backend = Backend(),
+                    resume: bool = False) -> str:
+    """Run the study (its drops on ``backend``, each kept in ``out_dir/drops`` as it finishes;
+    ``resume`` runs only the missing ones), write ``study.json``, ``report.md`` and the
+    figures; return a summary."""
     plan = Plan.make(quick)
     base = StudyInput(source, dict(overrides))          # refuses --set on the studies' own keys
-    jobs, jobs_note = plan_jobs(jobs, len(plan_runs(plan, base)))
+    jobs, jobs_note = plan_threads(backend, jobs, len(plan_runs(plan, base)))
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
-    outcomes, nominal = run_study(plan, base, jobs=jobs, progress=progress)
+    outcomes, nominal, dispatch = run_study(plan, base, jobs=jobs, progress=progress,
+                                            backend=backend, out=out, resume=resume)
     a = analyse(plan, base, outcomes)
     scene = base.scene
     a["claims"] = claims(a, scene.contact.clearance * 1e6)
@@ -40,20 +44,28 @@ def run_paper_study(source: str, overrides: dict, out_dir, quick: bool = False,
     wall = time.perf_counter() - t0
     a["wall_time_s"] = wall
     a["jobs"] = jobs
+    a["backend"] = dispatch.backend
     a["quick"] = quick
     (out / "study.json").write_text(json.dumps(a, indent=1, default=_json))
-    meta = dict(wall_s=wall, jobs=jobs, quick=quick, commands=commands,
+    meta = dict(wall_s=wall, where=where(dispatch.backend, jobs), quick=quick, commands=commands,
                 calibration=calibration_text(a["calibration"], source),
                 ranges={f.name: f.why for f in SENSITIVITY})
     path = report.write_report(a, out, figures, meta)
     th = a["friction_threshold"]
     ok = sum(c["reproduced"] for c in a["claims"])
     flagged = warnings_note(a["warnings"]["total"])
-    notes = ([f"note: {jobs_note}"] if jobs_note else []) + ([flagged] if flagged else [])
+    notes = [n for n in (jobs_note and f"note: {jobs_note}", dispatch.note(), flagged) if n]
     return (f"whirl threshold (50 %): paper slip {th['paper']}, kinematic {th['kinematic']}; "
             f"{ok}/{len(a['claims'])} claims reproduced; {a['runs']['failed']} of "
             f"{a['runs']['total']} runs failed; {wall:.0f} s\n" + "".join(n + "\n" for n in notes)
             + f"wrote {path}, {out / 'study.json'}")
+
+
+def where(backend: dict, jobs: int | None) -> str:
+    """Where the drops ran, for the report's first line."""
+    if backend.get("backend") == "ray":
+        return f"on Ray ({backend['nodes']} node(s), {backend['cpus']} CPU(s))"
+    return f"on {jobs} core(s)" if jobs else "(every drop resumed from disk)"
 
 
 def friction_runs(base: StudyInput, plan: Plan) -> dict:
