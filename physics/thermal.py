@@ -45,9 +45,14 @@ def parameters(scene) -> tuple[float, ...]:
 
 @njit
 def friction_coefficient(mu0, theta, kappa, r_min, r_max):
-    """mu(theta) = mu_0 clamp(1 + kappa theta, r_min, r_max): linear in the temperature rise,
-    bounded (a floor for oxide films, a ceiling for the paper's rise with heat and wear)."""
-    r = 1.0 + kappa * theta
+    """mu(theta) = mu_0 clamp(1 + kappa max(theta, 0), r_min, r_max): linear in the temperature
+    rise, bounded (a floor for oxide films, a ceiling for the paper's rise with heat and wear).
+    Friction cannot cool a sleeve below ambient: a negative contact friction power (possible
+    under the paper's slip definition, which sets the friction direction from Omega r + omega_s R
+    rather than the surface slip) is kept in the heat audit but does not move mu; otherwise
+    the sub-ambient "temperature" and mu feed each other (a 0.5 s undamped drop ran to
+    -4e4 K and -29 MJ of friction work)."""
+    r = 1.0 + kappa * max(theta, 0.0)
     if r < r_min:
         r = r_min
     elif r > r_max:
