@@ -1,7 +1,10 @@
-"""``rotordrop train | evaluate | benchmark | oracle | tune | ride-through`` (registered into
-``physics.cli``).
+"""The ``rotordrop`` command line (entry point :func:`main`) and agents' commands ``train |
+evaluate | benchmark | oracle | tune | ride-through`` (and ``research``, :mod:`agents.research`).
 
-Registration is light: SB3, torch and the environments are imported inside the handlers.
+This top-layer module builds the parser from every layer's ``register(subparsers)``: physics'
+``drop``, ``params`` (:mod:`physics.cli`), ``study`` and ``accuracy``, then agents' own. Registration
+is light: SB3, torch and the environments are imported inside the handlers, so ``rotordrop drop``
+works without the rl extra and an RL command without it says so in one line.
 """
 from __future__ import annotations
 
@@ -9,8 +12,13 @@ import argparse
 import sys
 from pathlib import Path
 
+from physics import accuracy, study
+from physics import cli as physics_cli
 from physics.cli import at_least
 
+from . import research
+
+OPTIONAL_RL_MODULES = ("gymnasium", "stable_baselines3", "torch", "tensorboard", "yaml")
 
 ERRORS = (KeyError, ValueError, FileNotFoundError)      # bad input: one line, exit 2
 _SEED = at_least(0)                 # every --seed: what numpy and gymnasium accept
@@ -250,3 +258,30 @@ def register(sub) -> None:
     p.add_argument("--quick", action="store_true", help="3 frictions x 3 delays x 2 phases")
     _output_args(p, "out/ride_through")
     p.set_defaults(func=cmd_ride_through)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="rotordrop", description="AMB rotor drop onto retainer "
+                                     "bearings: simulation, studies, Gymnasium environments and agents")
+    sub = parser.add_subparsers(dest="command", required=True)
+    for register_commands in (physics_cli.register, study.register, accuracy.register, register,
+                              research.register):
+        register_commands(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return physics_cli.run(args)
+    except ModuleNotFoundError as exc:      # an RL command without the rl extra
+        if exc.name and exc.name.split(".")[0] in OPTIONAL_RL_MODULES:
+            print(f"rotordrop: error: `rotordrop {args.command}` needs {exc.name.split('.')[0]}, "
+                  "part of the rl extra: python3 -m pip install -c constraints.txt -e \".[rl]\"",
+                  file=sys.stderr)
+            return 2
+        raise
+
+
+if __name__ == "__main__":
+    sys.exit(main())

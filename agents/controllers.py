@@ -303,7 +303,7 @@ class WhirlBrake(Controller):
     friction drive the magnets cannot out-pull (about 1 kN of magnet force against 10 kN of
     whirl contact force). The gains were found by cross-entropy search on a tuning set of
     frictions and unbalance phases that the benchmark does not use
-    (``benchmarks/tune_whirl_brake.py``).
+    (``rotordrop research tune-whirl-brake``).
     """
 
     name = "whirl-brake"

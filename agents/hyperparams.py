@@ -36,14 +36,14 @@ from __future__ import annotations
 
 import ast
 import copy
-import difflib
 import functools
 import inspect
-import math
 import re
 from importlib import resources
 from pathlib import Path
 from typing import Any
+
+from .config_checks import ConfigError, check_keys, is_finite_number
 
 ALGOS = ("ppo", "sac", "td3")
 META_KEYS = ("n_timesteps", "n_envs", "policy", "policy_kwargs", "normalize", "env_kwargs",
@@ -62,10 +62,6 @@ INTEGERS = {"n_timesteps": 1, "n_envs": 1, "eval_freq": 0, "n_eval_episodes": 1,
 FRACTIONS = ("gamma", "gae_lambda", "tau")
 #: SB3 arguments that take a tuple, which YAML writes as a list (``train_freq: [1, episode]``)
 TUPLES = ("train_freq",)
-
-
-class ConfigError(ValueError):
-    """A hyperparameter file or value is invalid; the message names the key."""
 
 
 def _yaml():
@@ -257,10 +253,6 @@ def _check_episodic(train_freq: Any, n_envs: int) -> None:
                           f"got n_envs {n_envs}")
 
 
-def is_finite_number(value: Any) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
-
-
 def _integer(value: Any, key: str, lo: int) -> int:
     """``value`` as an int (YAML writes 1e6 as a float) if it is a whole number >= ``lo``."""
     try:
@@ -272,15 +264,6 @@ def _integer(value: Any, key: str, lo: int) -> int:
     if number < lo:
         raise ConfigError(f"{key} must be >= {lo}, got {int(number)}")
     return int(number)
-
-
-def check_keys(kind: str, given, allowed) -> None:
-    """ConfigError naming the first key of ``given`` not in ``allowed`` (and a close match)."""
-    unknown = [k for k in given if k not in allowed]
-    if unknown:
-        close = difflib.get_close_matches(str(unknown[0]), list(allowed), n=1)
-        hint = f" (did you mean {close[0]}?)" if close else ""
-        raise ConfigError(f"{kind}: unknown key {unknown[0]!r}{hint}; allowed: {', '.join(allowed)}")
 
 
 def signature_keys(fn, skip: tuple[str, ...] = ("self",)) -> tuple[str, ...]:

@@ -25,6 +25,8 @@ import numpy as np
 
 from physics.metrics import WHIRL_MIN_REVOLUTIONS
 
+from .config_checks import ConfigError, check_keys, is_finite_number
+
 PEAK_KEYS = ("kpi_peak_whirl_revolutions", "kpi_peak_contact_force_N", "kpi_max_displacement_um")
 #: the ``reward_kwargs`` and their defaults
 WEIGHTS = dict(w_whirl=1.0, w_force=0.5, w_disp=0.5, force_ref=1e4, disp_ref_um=800.0,
@@ -34,7 +36,6 @@ REFERENCES = ("force_ref", "disp_ref_um")
 
 def check_reward_kwargs(kwargs: dict) -> None:
     """ConfigError unless ``kwargs`` are known weights >= 0 and references > 0."""
-    from .hyperparams import ConfigError, check_keys, is_finite_number
     check_keys("reward_kwargs", kwargs, tuple(WEIGHTS))
     for key, value in kwargs.items():
         positive = key in REFERENCES

@@ -1,6 +1,6 @@
 """Cross-entropy search (CEM): the derivative-free optimiser behind the gain tuning of
-``whirl-brake`` (``benchmarks/tune_whirl_brake.py``) and the open-loop whirl bound
-(``benchmarks/whirl_bound.py``). Deterministic for a given ``rng``."""
+``whirl-brake`` (:mod:`agents.research.tune_whirl_brake`) and the open-loop whirl bound
+(:mod:`agents.research.whirl_bound`). Deterministic for a given ``rng``."""
 from __future__ import annotations
 
 from typing import Callable

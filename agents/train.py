@@ -342,7 +342,7 @@ def _build(env_id: str, algo: str, meta: dict, algo_kwargs: dict, seed: int, ckp
            verbose: int):
     """(training env's VecMonitor, evaluation env, model): a new one, or the checkpoint's.
     Nothing is written yet: the monitor's log is attached once ``out`` is ready."""
-    from .plant import make_vec_env
+    from .training_env import make_vec_env
     rw = dict(reward=meta["reward"], reward_kwargs=meta["reward_kwargs"],
               residual=meta.get("residual"), residual_scale=meta.get("residual_scale"))
     monitor = make_vec_env(env_id, meta.get("n_envs", 1), seed, meta["env_kwargs"], **rw)

@@ -1,21 +1,18 @@
-"""The ``rotordrop`` command line.
+"""physics' part of the ``rotordrop`` command line: ``drop``, ``params`` and the argparse helpers
+every layer's commands share.
 
-Subcommands ``drop`` and ``params`` live here; other modules add theirs through a
-``register(subparsers)`` function listed in ``COMMAND_MODULES`` (missing optional extras are
-reported when the command is used, not when the CLI starts). Registration must stay light:
-heavy imports (SB3, torch) happen inside the handlers.
+The ``rotordrop`` entry point is ``agents.cli:main`` (the top layer): it calls each layer's
+``register(subparsers)`` (this module's, :mod:`physics.study`'s, :mod:`physics.accuracy`'s and
+agents') and runs the chosen command through :func:`run`. Registration must stay light: heavy
+imports happen inside the handlers (docs/architecture.md).
 """
 from __future__ import annotations
 
 import argparse
-import importlib
 import json
 import os
 import sys
 from pathlib import Path
-
-COMMAND_MODULES = ("physics.study", "physics.accuracy", "agents.cli")
-OPTIONAL_RL_MODULES = ("gymnasium", "stable_baselines3", "torch", "tensorboard", "yaml")
 
 
 class UsageError(ValueError):
@@ -178,10 +175,8 @@ def scene_parameter_rows(scene) -> list[dict]:
     return [dict(r, value=scene.get(r["key"])) for r in parameter_table()]
 
 
-def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="rotordrop", description=__doc__.splitlines()[0])
-    sub = parser.add_subparsers(dest="command", required=True)
-
+def register(sub) -> None:
+    """``drop`` and ``params``."""
     p = sub.add_parser("drop", help="simulate a drop: summary table, metrics.json, time series, plots")
     add_scene_args(p)
     p.add_argument("--t-end", type=float, default=None, help="simulated time [s] (solver.t_end)")
@@ -197,37 +192,21 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--presets", action="store_true", help="list the preset scene names")
     p.set_defaults(func=cmd_params)
 
-    for name in COMMAND_MODULES:
-        try:
-            module = importlib.import_module(name)
-        except ImportError as exc:          # an optional extra is not installed
-            if exc.name and name.startswith(exc.name):
-                continue
-            raise
-        module.register(sub)
-    return parser
 
-
-def main(argv: list[str] | None = None) -> int:
+def run(args) -> int:
+    """``args.func(args)``; a bad scene, integration or usage error is one line on stderr, exit 2."""
     from .scene import SceneError
     from .simulate import IntegrationError
-    args = build_parser().parse_args(argv)
     try:
         return args.func(args)
     except (SceneError, IntegrationError, UsageError) as exc:
         print(f"rotordrop: error: {exc}", file=sys.stderr)
         return 2
-    except ModuleNotFoundError as exc:
-        if exc.name and exc.name.split(".")[0] in OPTIONAL_RL_MODULES:
-            print(f"rotordrop: error: `rotordrop {args.command}` needs {exc.name.split('.')[0]}, "
-                  "part of the rl extra: python3 -m pip install -c constraints.txt -e \".[rl]\"",
-                  file=sys.stderr)
-            return 2
-        raise
     except BrokenPipeError:                  # `rotordrop params | head`: the reader left
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+if __name__ == "__main__":        # the dispatcher sits in the top layer (docs/architecture.md)
+    sys.exit("rotordrop: the command line starts in the top layer: run `rotordrop ...` "
+             "or `python -m agents.cli ...`")

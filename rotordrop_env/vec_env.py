@@ -47,7 +47,6 @@ class BatchedRotorDropVecEnv(VecEnv):
 
     def __init__(self, env_id: str, n_envs: int, seed: int | None = None,
                  n_threads: int | None = None, **env_kwargs: Any):
-        import rotordrop_env  # noqa: F401  (registers the ids)
         if int(n_envs) != n_envs or n_envs < 1:
             raise ValueError(f"n_envs = {n_envs!r} must be a positive integer")
         if "max_episode_steps" in env_kwargs:     # gym.make's TimeLimit: .unwrapped drops it

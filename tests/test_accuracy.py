@@ -5,7 +5,7 @@ import json
 import pytest
 
 from physics.accuracy import TOLERANCE, recommend
-from physics.cli import main as cli_main
+from agents.cli import main as cli_main
 from physics.scene import Scene
 
 

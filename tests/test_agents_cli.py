@@ -5,7 +5,7 @@ import pytest
 
 from agents.controllers import BASELINES
 
-from physics.cli import main
+from agents.cli import main
 
 
 def test_evaluate_a_baseline_against_passive(tmp_path):

@@ -7,7 +7,7 @@ import shutil
 import numpy as np
 import pytest
 
-from physics.cli import main
+from agents.cli import main
 
 
 def _strict(text: str):

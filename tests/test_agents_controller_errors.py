@@ -158,7 +158,7 @@ class Typo(Controller):
 
 
 def test_the_cli_reports_a_controller_bug_in_one_line(tmp_path, capsys):
-    from physics.cli import main
+    from agents.cli import main
     path = tmp_path / "bad.py"
     path.write_text(BAD_FILE)
     assert main(["evaluate", "--policy", f"{path}:Typo", "--env", "RotorDrop-Damping-v0",

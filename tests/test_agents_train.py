@@ -114,7 +114,7 @@ def test_training_resumes_from_a_checkpoint(trained, tmp_path):
 
 
 def test_evaluate_a_trained_policy_against_passive(trained, tmp_path):
-    from physics.cli import main
+    from agents.cli import main
     res, _ = trained
     out = tmp_path / "eval"
     assert main(["evaluate", "--policy", str(res.out), "--episodes", "2", "--set",
@@ -144,7 +144,7 @@ def _final_potential(info: dict) -> float:
 def test_kpi_reward_returns_minus_the_episode_cost():
     """The KPI reward telescopes: an episode's return is minus the potential of its final KPIs
     (peak backward revolutions capped at 3, peak force, max displacement; weights as given)."""
-    from agents.plant import make_vec_env
+    from agents.training_env import make_vec_env
     venv = make_vec_env("RotorDrop-Damping-v0", 2, 0, dict(
         episode_time=0.06, terminate_on_failure=False, overrides={"contact.friction": 0.6}),
         reward="kpi", reward_kwargs=W)
@@ -167,7 +167,7 @@ def test_kpi_reward_returns_minus_the_episode_cost():
 def test_residual_zero_action_is_the_base_controller():
     """With residual: max-damping, an agent action of 0 commands C_max: the damper state follows
     its 10 ms first-order lag to C_max (spec §6); an action of -1 commands C_min."""
-    from agents.plant import make_vec_env
+    from agents.training_env import make_vec_env
     from physics.scene import load_scene
     s = load_scene("paper").support
     for a, target in ((0.0, s.damping_max), (-1.0, s.damping_min)):
@@ -183,7 +183,7 @@ def test_residual_zero_action_is_the_base_controller():
 def test_kpi_reward_charges_the_time_before_relevitation():
     """Re-levitation tasks: the return is minus the final KPI potential, plus w_relevitate once,
     minus w_time * dt / T for every step before re-levitation (the score's T_R / T term)."""
-    from agents.plant import make_vec_env
+    from agents.training_env import make_vec_env
     kw = dict(episode_time=0.15, terminate_on_failure=False, command="discrete",
               power_return_time=0.02, overrides={"contact.friction": 0.1})
     venv = make_vec_env("RotorDrop-Relevitate-v0", 1, 0, kw, reward="kpi",
@@ -292,7 +292,7 @@ def test_config_errors_of_the_action_space_and_the_algorithm(tmp_path):
 
 
 def test_config_errors_reach_the_cli_as_one_line(tmp_path, capsys):
-    from physics.cli import main
+    from agents.cli import main
     cfg = _tiny(tmp_path, "  learning_rat: 1.0e-3\n")
     assert main(["train", "--env", "RotorDrop-Damping-v0", "--algo", "ppo", "--config", str(cfg),
                  "--out", str(tmp_path / "run"), "--quiet"]) == 2

@@ -6,7 +6,7 @@ import sys
 import numpy as np
 import pytest
 
-from physics.cli import main
+from agents.cli import main
 from physics.metrics import worst_plane
 
 
@@ -64,7 +64,7 @@ def test_params_lists_every_key(capsys):
 
 
 def test_bad_override_is_a_one_line_error_not_a_traceback():
-    proc = subprocess.run([sys.executable, "-m", "physics.cli", "drop", "--set",
+    proc = subprocess.run([sys.executable, "-m", "agents.cli", "drop", "--set",
                            "contact.friction=2", "--out", "/tmp/never"], capture_output=True, text=True)
     assert proc.returncode == 2
     assert "contact.friction" in proc.stderr and "[0, 1]" in proc.stderr
@@ -73,7 +73,7 @@ def test_bad_override_is_a_one_line_error_not_a_traceback():
 
 def test_a_closed_pipe_is_not_a_traceback():
     """`rotordrop params | head -1`: the reader leaves early; no BrokenPipeError traceback."""
-    proc = subprocess.run(f"{sys.executable} -m physics.cli params | head -1", shell=True,
+    proc = subprocess.run(f"{sys.executable} -m agents.cli params | head -1", shell=True,
                           capture_output=True, text=True)
     assert proc.stdout.count("\n") == 1
     assert "Traceback" not in proc.stderr and "BrokenPipe" not in proc.stderr

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from physics import SceneError, build_model, compute_metrics, load_scene, simulate
-from physics.cli import main
+from agents.cli import main
 from physics.integrate import NOT_FINITE, STEP_COLLAPSE, TOO_MANY_STEPS
 from physics.metrics import PEAK_TOLERANCE, SAMPLES_PER_PERIOD, contact_period
 from physics.model import axis_motion

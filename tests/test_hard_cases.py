@@ -23,7 +23,7 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from physics import IntegrationError, SceneError, load_scene, simulate
-from physics.cli import main as cli_main
+from agents.cli import main as cli_main
 from physics.scene import GROUPS, Scene, parameter_table
 
 from helpers import energy_residual

@@ -8,7 +8,7 @@ import pytest
 
 from physics import SceneError, load_scene, simulate
 from physics.accuracy import AccuracyPlan, plan_runs
-from physics.cli import main as cli_main
+from agents.cli import main as cli_main
 from physics.metrics import compute_metrics, worst_plane
 from physics.scene import Scene, param_meta
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from physics import load_scene
-from physics.cli import main as cli_main
+from agents.cli import main as cli_main
 from physics.study.ensemble import JITTER_S, logistic_fit, onset, perturbations, probability_curve
 from physics.study.paper import DAMPING
 from physics.study.parametric import PLANE_KPIS

@@ -8,7 +8,8 @@ import os
 import pytest
 
 from physics import SceneError, load_scene, simulate
-from physics.cli import UsageError, main as cli_main
+from agents.cli import main as cli_main
+from physics.cli import UsageError
 from physics.metrics import compute_metrics
 from physics.study.ensemble import perturbations
 from physics.study.paper import StudyInput

@@ -32,15 +32,11 @@ from ..scene import SceneError, load_scene
 from ..sweep import Outcome, Run, plan_jobs, run_sweep
 from .checks import WARNING_KINDS, as_drop, counts_text, warning_counts, warnings_note
 from .ensemble import ENSEMBLE_KEYS, perturbations
+from .labels import PLANE_KPIS, value_label
 
 MAX_KEYS = 3
 MAX_VALUES = 1000       # per key
 MAX_RUNS = 20000
-PLANE_KPIS = {"whirl_revolutions": "whirl revolutions", "peak_contact_force_N": "peak contact force [N]",
-              "max_displacement_um": "max displacement [µm]",
-              "peak_bearing_load_N": "peak retainer-bearing load [N]",
-              "friction_heat_J": "contact friction heat [J]",
-              "max_contact_pressure_MPa": "max ball-race contact pressure [MPa]"}
 
 
 @dataclass(frozen=True)
@@ -77,11 +73,6 @@ def parse_vary(text: str) -> tuple[str, list[str]]:
         raise SceneError(f"--vary {key}: more than {MAX_VALUES} values in {spec!r}; "
                          f"at most {MAX_VALUES} per key")
     return key, values
-
-
-def value_label(value) -> str:
-    """A grid value as the table and the plot show it (``2790``, ``1e+05``, ``kinematic``)."""
-    return f"{value:g}" if isinstance(value, float) else str(value)
 
 
 def make_axes(source: str, overrides: dict, vary: list[str]) -> list[Axis]:

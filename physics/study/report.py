@@ -14,7 +14,7 @@ from ..results import Result  # noqa: E402
 from .checks import counts_text, warnings_note  # noqa: E402
 from .claims import PAPER_SOFT_Y_UM, PAPER_THRESHOLD  # noqa: E402
 from .paper import BASE, SOFT  # noqa: E402
-from .parametric import PLANE_KPIS, value_label  # noqa: E402
+from .labels import PLANE_KPIS, value_label  # noqa: E402
 
 PLANE = "RB1"           # the paper's figures are at retainer bearing 1
 

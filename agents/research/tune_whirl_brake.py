@@ -10,11 +10,10 @@ rotor that does not whirl. Cost per episode (lower is better):
 averaged over the set, in the re-levitation task (support damping at the scene's C_s, the harder
 case; the Full task adds C_max on top of the same law).
 
-    python benchmarks/tune_whirl_brake.py --iterations 12 --population 24 --out out/tune
+    rotordrop research tune-whirl-brake --iterations 12 --population 24 --out out/tune
 """
 from __future__ import annotations
 
-import argparse
 import json
 import time
 from pathlib import Path
@@ -43,15 +42,9 @@ def cost(theta: np.ndarray, env_id: str) -> tuple[float, list[dict]]:
     return float(np.mean(c)), kpis
 
 
-def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--env", default="RotorDrop-Relevitate-v0")
-    ap.add_argument("--iterations", type=int, default=12)
-    ap.add_argument("--population", type=int, default=24)
-    ap.add_argument("--elite", type=int, default=6)
-    ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--out", default="out/tune_whirl_brake")
-    a = ap.parse_args(argv)
+def run(a) -> None:
+    """``rotordrop research tune-whirl-brake`` with its parsed options ``a`` (agents/research)."""
+    task_of(a.env)                      # a benchmark environment, else a one-line error
     rng = np.random.default_rng(a.seed)
     t0 = time.perf_counter()
     _, best, hist = cross_entropy(
@@ -70,7 +63,3 @@ def main(argv=None):
     for (mu, ph), k in zip(TUNING_SET, kpis):
         print(f"mu={mu:.2f} phase={ph:5.1f}: peak revs {k['peak_whirl_revolutions']:5.2f} whirl {k['backward_whirl']!s:5}"
               f" relevitated {k['relevitated']!s:5} t_R {k['relevitation_time_s']:.3f}")
-
-
-if __name__ == "__main__":
-    main()

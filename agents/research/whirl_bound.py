@@ -9,18 +9,17 @@ override the baseline entirely. The search knows the scenario in advance, which 
 does: its peak revolutions are an empirical lower bound for what feedback control can reach
 there. Cost: the peak net backward orbit revolutions of the episode (3 make a whirl).
 
-As a cross-check that needs no search, the script also runs the baseline with its law in the
+As a cross-check that needs no search, the command also runs the baseline with its law in the
 outer half of the clearance replaced by a saturated push (full current) at a fixed angle to the
 orbit radius (0° outwards, 90° along a forward orbit, 180° to the centre), for 12 angles.
 
-    python benchmarks/whirl_bound.py --friction 0.48 --friction 0.53 --out out/whirl_bound
+    rotordrop research whirl-bound --friction 0.48 --friction 0.53 --out out/whirl_bound
 
 prints the baseline's and the best sequence's peak revolutions per scenario and writes
 ``whirl_bound.json``.
 """
 from __future__ import annotations
 
-import argparse
 import json
 import time
 from pathlib import Path
@@ -122,39 +121,22 @@ def bound(env_id: str, baseline: str, friction: float, phase: float, delay: floa
                 correction=theta.tolist())
 
 
-def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--env", default="RotorDrop-Relevitate-v0", choices=RELEVITATION_ENVS)
-    ap.add_argument("--baseline", default="whirl-brake",
-                    help="a controller that commands the AMB currents: baseline name, "
-                         "module:Class or file.py:Class")
-    ap.add_argument("--friction", type=float, action="append", default=None,
-                    help="repeatable; default 0.48 and 0.53 (the benchmark's mu* + 0.10, + 0.15)")
-    ap.add_argument("--phase", type=float, action="append", default=None,
-                    help="unbalance phase [deg], repeatable; default 0 and 180")
-    ap.add_argument("--delay-ms", type=float, default=50.0, help="power-return delay [ms]")
-    ap.add_argument("--segments", type=int, default=16)
-    ap.add_argument("--steps", type=int, default=2, help="control steps per segment")
-    ap.add_argument("--iterations", type=int, default=25)
-    ap.add_argument("--population", type=int, default=32)
-    ap.add_argument("--std", type=float, default=0.5, help="initial search spread (current limit = 1)")
-    ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--out", default="out/whirl_bound")
-    a = ap.parse_args(argv)
-    try:
-        cls = controller_class(a.baseline)
-    except (ValueError, FileNotFoundError) as exc:
-        ap.error(str(exc))
+def run(a) -> None:
+    """``rotordrop research whirl-bound`` with its parsed options ``a`` (agents/research)."""
+    if a.env not in RELEVITATION_ENVS:
+        raise ValueError(f"--env must be one of {', '.join(RELEVITATION_ENVS)}, got {a.env!r}")
+    cls = controller_class(a.baseline)
     if cls is None or command_for(cls) != "continuous":
-        ap.error(f"--baseline {a.baseline!r} must be a controller that commands the AMB currents "
-                 f"(needs 'currents'), e.g. whirl-brake or pid-relevitate")
+        raise ValueError(f"--baseline {a.baseline!r} must be a controller that commands the AMB "
+                         f"currents (needs 'currents'), e.g. whirl-brake or pid-relevitate")
     t0 = time.perf_counter()
     rows = [bound(a.env, a.baseline, mu, ph, a.delay_ms * 1e-3, a.segments, a.steps, a.iterations,
                   a.population, a.std, a.seed)
             for mu in (a.friction or [0.48, 0.53]) for ph in (a.phase or [0.0, 180.0])]
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
-    rec = dict(env=a.env, baseline=a.baseline, settings=vars(a), whirl_revolutions=WHIRL_MIN_REVOLUTIONS,
+    settings = {k: v for k, v in vars(a).items() if k not in ("command", "research", "func")}
+    rec = dict(env=a.env, baseline=a.baseline, settings=settings, whirl_revolutions=WHIRL_MIN_REVOLUTIONS,
                rows=rows, wall_time_s=time.perf_counter() - t0)
     (out / "whirl_bound.json").write_text(json.dumps(rec, indent=2))
     print(f"{a.env}, power back at {a.delay_ms:g} ms, open-loop correction of {a.baseline} over "
@@ -166,7 +148,3 @@ def main(argv=None):
               f"{r['best_peak_revolutions']:11.2f}{r['best_backward_whirl']!s:>7}"
               f"{r['best_push_revolutions']:8.2f} at {r['best_push_deg']:3d}°")
     print(f"wrote {out / 'whirl_bound.json'} in {rec['wall_time_s']:.0f} s")
-
-
-if __name__ == "__main__":
-    main()

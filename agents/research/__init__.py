@@ -1,0 +1,69 @@
+"""``rotordrop research whirl-bound | tune-whirl-brake``: research probes of the re-levitation
+task (docs/agents.md), kept apart from the speed scripts in ``benchmarks/``.
+
+``whirl-bound`` (:mod:`agents.research.whirl_bound`) searches the AMB current sequence with the
+fewest backward-whirl revolutions in a known scenario, an empirical lower bound for feedback
+control; ``tune-whirl-brake`` (:mod:`agents.research.tune_whirl_brake`) tunes the gains of the
+``whirl-brake`` baseline on scenarios the benchmark does not use. Registration is light: the
+environments are imported by the handlers.
+"""
+from __future__ import annotations
+
+from physics.cli import UsageError, at_least
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser("research", help="research probes of the re-levitation task: the "
+                                               "oracle whirl bound, whirl-brake gain tuning")
+    sub = p.add_subparsers(dest="research", required=True)
+
+    q = sub.add_parser("whirl-bound", help="how few backward-whirl revolutions can any AMB current "
+                                           "sequence reach once the power is back? (whirl_bound.json)")
+    q.add_argument("--env", default="RotorDrop-Relevitate-v0",
+                   help="RotorDrop-Relevitate-v0 or RotorDrop-Full-v0")
+    q.add_argument("--baseline", default="whirl-brake",
+                   help="a controller that commands the AMB currents: baseline name, "
+                        "module:Class or file.py:Class")
+    q.add_argument("--friction", type=float, action="append", default=None,
+                   help="repeatable; default 0.48 and 0.53 (the benchmark's mu* + 0.10, + 0.15)")
+    q.add_argument("--phase", type=float, action="append", default=None,
+                   help="unbalance phase [deg], repeatable; default 0 and 180")
+    q.add_argument("--delay-ms", type=float, default=50.0, help="power-return delay [ms]")
+    q.add_argument("--segments", type=at_least(1), default=16)
+    q.add_argument("--steps", type=at_least(1), default=2, help="control steps per segment")
+    q.add_argument("--iterations", type=at_least(1), default=25)
+    q.add_argument("--population", type=at_least(1), default=32)
+    q.add_argument("--std", type=float, default=0.5, help="initial search spread (current limit = 1)")
+    q.add_argument("--seed", type=at_least(0), default=0)
+    q.add_argument("--out", default="out/whirl_bound")
+    q.set_defaults(func=cmd_whirl_bound)
+
+    q = sub.add_parser("tune-whirl-brake", help="tune the whirl-brake baseline's gains by "
+                                                "cross-entropy search on a tuning set (tune.json)")
+    q.add_argument("--env", default="RotorDrop-Relevitate-v0",
+                   help="RotorDrop-Relevitate-v0 or RotorDrop-Full-v0")
+    q.add_argument("--iterations", type=at_least(1), default=12)
+    q.add_argument("--population", type=at_least(1), default=24)
+    q.add_argument("--elite", type=at_least(1), default=6)
+    q.add_argument("--seed", type=at_least(0), default=0)
+    q.add_argument("--out", default="out/tune_whirl_brake")
+    q.set_defaults(func=cmd_tune_whirl_brake)
+
+
+def cmd_whirl_bound(args) -> int:
+    from .whirl_bound import run
+    return _usage_errors(run, args)
+
+
+def cmd_tune_whirl_brake(args) -> int:
+    from .tune_whirl_brake import run
+    return _usage_errors(run, args)
+
+
+def _usage_errors(run, args) -> int:
+    """``run(args)``; a bad option value (ValueError, FileNotFoundError) is a one-line UsageError."""
+    try:
+        run(args)
+    except (ValueError, FileNotFoundError) as exc:
+        raise UsageError(exc.args[0] if len(exc.args) == 1 else exc) from None
+    return 0
