@@ -146,7 +146,8 @@ def cmd_oracle(args) -> int:
     try:
         report = oracle(args.out, scenarios=args.scenarios, population=args.population,
                         iterations=args.iterations, seed=args.seed, policies=args.policy,
-                        progress=not args.quiet, plots=not args.no_plots)
+                        progress=not args.quiet, plots=not args.no_plots,
+                        search=not args.no_search, scenario_seed=args.scenario_seed)
     except ERRORS as exc:
         return _fail("oracle", exc)
     _wrote(args.out, ["oracle.json", *report.get("figures", [])], report["wall_time_s"])
@@ -218,7 +219,11 @@ def register(sub) -> None:
     p.add_argument("--population", type=at_least(2), default=24,
                    help="command sequences per generation (one batched rollout)")
     p.add_argument("--iterations", type=at_least(0), default=10, help="generations (default 10)")
-    p.add_argument("--seed", type=_SEED, default=0, help="search seed (the scenarios are fixed)")
+    p.add_argument("--seed", type=_SEED, default=0, help="search seed")
+    p.add_argument("--scenario-seed", type=_SEED, default=10_000,
+                   help="seed of the first drawn scenario (default 10000; scenario i uses it + i)")
+    p.add_argument("--no-search", action="store_true",
+                   help="score the rows only (no oracle search), e.g. on 200 scenarios")
     p.add_argument("--policy", action="append", default=None,
                    help="extra rows: a training directory / model .zip or module:Class (repeatable)")
     _output_args(p, "out/oracle")

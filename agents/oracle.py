@@ -24,7 +24,8 @@ the benchmark's formula, score = 100 (1 - sum J / sum J_passive).
 Outputs in ``--out``: ``oracle.json`` (settings, scenarios, per-scenario KPIs and J of every row,
 the oracle's command sequence and search history, the summary table) and ``oracle.png``. The
 search is written after every scenario; a rerun with the same settings continues where it
-stopped and re-scores the rows (add ``--policy`` runs without searching again).
+stopped and re-scores the rows (add ``--policy`` runs without searching again). ``--no-search``
+scores the rows alone, e.g. on 200 scenarios from another ``--scenario-seed``.
 """
 from __future__ import annotations
 
@@ -210,9 +211,10 @@ def score_rows(per_scenario: list[dict], names: list[str]) -> list[dict]:
 
 def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iterations: int = 10,
            seed: int = 0, policies: list[str] | None = None, progress: bool = True,
-           plots: bool = True) -> dict:
+           plots: bool = True, search: bool = True, scenario_seed: int = SCENARIO_SEED) -> dict:
     """Search the command sequence of each scenario, score every row on the same scenarios and
-    write ``oracle.json`` (and ``oracle.png``) into ``out`` (module doc)."""
+    write ``oracle.json`` (and ``oracle.png``) into ``out`` (module doc). ``search=False``
+    scores the rows only (no oracle row): the same comparison on many more scenarios."""
     from tqdm.auto import tqdm
     from .score import fmt_or_dash
     if scenarios < 1 or population < 2 or iterations < 0:
@@ -226,11 +228,14 @@ def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iteration
                     segment_edges_ms=list(SEGMENT_EDGES_MS), segment_actions=list(SEGMENT_ACTIONS),
                     max_delay_s=MAX_DELAY, control_dt=CONTROL_DT, shaping=SHAPING,
                     episode_time_s=EPISODE_TIME)
+    settings["scenario_seed"] = scenario_seed
     done = _previous(out / "oracle.json", settings)
     entries = row_entries(policies)
     t0 = time.perf_counter()
     per_scenario = []
-    drawn = draw_scenarios(scenarios)
+    drawn = draw_scenarios(scenarios, scenario_seed)
+    if not search:
+        done = {}
     bar = tqdm(total=scenarios, desc="oracle scenarios", unit="sc", disable=not progress)
     for i, values in enumerate(drawn):
         sc, phase = as_benchmark(values, f"#{i}")
@@ -240,19 +245,21 @@ def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iteration
             rows[entry.name] = kpi_row(kpis)
         for row in rows.values():
             row["J"] = episode_cost(row, rows["passive"])
-        search = done.get(i) or search_scenario(sc, phase, rows["passive"], population, iterations,
-                                                seed + i, progress)
-        rows["oracle"] = dict(search["kpis"], J=search["J"])
-        per_scenario.append(dict(index=i, scenario=values, rows=rows, search=search))
-        report = _report(settings, per_scenario, [e.name for e in entries], t0)
+        found = None
+        if search:
+            found = done.get(i) or search_scenario(sc, phase, rows["passive"], population,
+                                                   iterations, seed + i, progress)
+            rows["oracle"] = dict(found["kpis"], J=found["J"])
+        per_scenario.append(dict(index=i, scenario=values, rows=rows, search=found))
+        report = _report(settings, per_scenario, [e.name for e in entries], t0, search)
         write_json(out / "oracle.json", report)              # after every scenario: resumable
         bar.update(1)
     bar.close()
     if plots:
         report["figures"] = [plot_oracle(report, out / "oracle.png").name]
         write_json(out / "oracle.json", report)
-    print(f"oracle bound, {ENV_ID} command={COMMAND}, {scenarios} scenarios "
-          f"(friction 0.38-0.6, power back 30-70 ms):")
+    print(f"{'oracle bound' if search else 'rows'}, {ENV_ID}, {scenarios} scenarios "
+          f"(friction 0.38-0.6, power back 30-70 ms, seeds from {scenario_seed}):")
     print("| controller | score | whirl rate | whirl where passive whirls | re-levitated |")
     print("|---|---:|---:|---:|---:|")
     for e in report["summary"]:
@@ -262,15 +269,17 @@ def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iteration
     return report
 
 
-def _report(settings: dict, per_scenario: list[dict], names: list[str], t0: float) -> dict:
-    summary = score_rows(per_scenario, names + ["oracle"])
+def _report(settings: dict, per_scenario: list[dict], names: list[str], t0: float,
+            search: bool = True) -> dict:
+    summary = score_rows(per_scenario, names + (["oracle"] if search else []))
     learned = {n for n in names if n not in BASELINES}
     designed = [e for e in summary if e["controller"] in BASELINES and e["controller"] != "passive"]
     best = designed[0] if designed else None
-    orc = next(e for e in summary if e["controller"] == "oracle")
+    orc = next((e for e in summary if e["controller"] == "oracle"), None)
     return dict(settings=settings, per_scenario=per_scenario, summary=summary,
                 learned=sorted(learned), best_designed=best["controller"] if best else None,
-                oracle_gain_over_best_designed=orc["score"] - best["score"] if best else None,
+                oracle_gain_over_best_designed=(orc["score"] - best["score"]
+                                                if best and orc else None),
                 wall_time_s=time.perf_counter() - t0)
 
 
@@ -285,7 +294,7 @@ def _previous(path: Path, settings: dict) -> dict[int, dict]:
         return {}
     if old.get("settings") != settings:
         return {}
-    return {s["index"]: s["search"] for s in old.get("per_scenario", [])}
+    return {s["index"]: s["search"] for s in old.get("per_scenario", []) if s.get("search")}
 
 
 def plot_oracle(report: dict, path: Path) -> Path:
@@ -300,11 +309,12 @@ def plot_oracle(report: dict, path: Path) -> Path:
     y = np.arange(len(names))[::-1]
     axes[0].barh(y, [e["score"] for e in summary], color=colors)
     axes[0].set(yticks=y, yticklabels=names, xlabel="score (benchmark formula)",
-                title=f"{len(report['per_scenario'])} scenarios, Full, supervisor")
+                title=f"{len(report['per_scenario'])} scenarios, RotorDrop-Full-v0")
     axes[1].barh(y, [e["whirl_rate"] for e in summary], color=colors)
     axes[1].set(yticks=y, yticklabels=[], xlabel="backward-whirl rate", xlim=(0, 1))
     idx = np.arange(len(report["per_scenario"]))
-    show = ["passive", report["best_designed"], "oracle", *report["learned"]]
+    show = ["passive", report["best_designed"], *(["oracle"] if "oracle" in names else []),
+            *report["learned"]]
     for name in dict.fromkeys(n for n in show if n):
         axes[2].plot(idx, [s["rows"][name]["J"] for s in report["per_scenario"]], "o-", ms=3,
                      label=name)

@@ -65,3 +65,13 @@ def test_oracle_never_worse_than_its_start_and_resumes(tmp_path):
     saved = json.loads((tmp_path / "oracle.json").read_text())
     again = oracle(tmp_path, scenarios=1, population=4, iterations=1, progress=False, plots=False)
     assert again["per_scenario"][0]["search"] == saved["per_scenario"][0]["search"]     # reused
+
+
+def test_rows_only_on_other_scenarios(tmp_path):
+    rep = oracle(tmp_path, scenarios=2, search=False, scenario_seed=20_000, progress=False,
+                 plots=True)
+    names = [e["controller"] for e in rep["summary"]]
+    assert "oracle" not in names and "inner-loop" in names
+    assert rep["oracle_gain_over_best_designed"] is None
+    assert rep["per_scenario"][0]["scenario"] == draw_scenarios(1, 20_000)[0]
+    assert (tmp_path / "oracle.png").is_file()
