@@ -255,9 +255,11 @@ def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iteration
         write_json(out / "oracle.json", report)              # after every scenario: resumable
         bar.update(1)
     bar.close()
+    report["whirl_by_friction"] = whirl_by_friction(report)
     if plots:
-        report["figures"] = [plot_oracle(report, out / "oracle.png").name]
-        write_json(out / "oracle.json", report)
+        report["figures"] = [plot_oracle(report, out / "oracle.png").name,
+                             plot_whirl_by_friction(report, out / "whirl_by_friction.png").name]
+    write_json(out / "oracle.json", report)
     print(f"{'oracle bound' if search else 'rows'}, {ENV_ID}, {scenarios} scenarios "
           f"(friction 0.38-0.6, power back 30-70 ms, seeds from {scenario_seed}):")
     print("| controller | score | whirl rate | whirl where passive whirls | re-levitated |")
@@ -320,6 +322,46 @@ def plot_oracle(report: dict, path: Path) -> Path:
                      label=name)
     axes[2].set(xlabel="scenario", ylabel="J (lower is better)", title="cost per scenario")
     axes[2].legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+FRICTION_BINS = (0.38, 0.44, 0.50, 0.55, 0.60)
+
+
+def whirl_by_friction(report: dict, edges=FRICTION_BINS) -> dict:
+    """Backward-whirl rate of every row per friction bin of the scenarios: {"edges", "counts",
+    "rates": {row: [rate per bin, None where the bin is empty]}}."""
+    mu = np.array([s["scenario"]["contact.friction"] for s in report["per_scenario"]])
+    which = np.clip(np.searchsorted(edges, mu, side="right") - 1, 0, len(edges) - 2)
+    counts = [int(np.sum(which == b)) for b in range(len(edges) - 1)]
+    rates = {}
+    for e in report["summary"]:
+        w = np.array([s["rows"][e["controller"]]["backward_whirl"] for s in report["per_scenario"]])
+        rates[e["controller"]] = [float(w[which == b].mean()) if counts[b] else None
+                                  for b in range(len(edges) - 1)]
+    return dict(edges=list(edges), counts=counts, rates=rates)
+
+
+def plot_whirl_by_friction(report: dict, path: Path) -> Path:
+    """Whirl rate per friction bin of passive, the best designed row, the oracle (if searched)
+    and the learned rows."""
+    import matplotlib.pyplot as plt
+    table = report.get("whirl_by_friction") or whirl_by_friction(report)
+    edges = table["edges"]
+    mid = [0.5 * (a + b) for a, b in zip(edges[:-1], edges[1:])]
+    fig, ax = plt.subplots(figsize=(7, 4))
+    show = ["passive", report["best_designed"], "inner-loop", "oracle", *report["learned"]]
+    for name in dict.fromkeys(n for n in show if n in table["rates"]):
+        rates = [np.nan if r is None else r for r in table["rates"][name]]
+        ax.plot(mid, rates, "o-", label=name)
+    ax.set(xlabel="friction coefficient (bin centre)", ylabel="backward-whirl rate", ylim=(-0.02, 1.02),
+           title="drops per bin: " + ", ".join(str(c) for c in table["counts"]))
+    ax.axhline(0.05, color="k", lw=0.8, ls=":")
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)

@@ -75,3 +75,12 @@ def test_rows_only_on_other_scenarios(tmp_path):
     assert rep["oracle_gain_over_best_designed"] is None
     assert rep["per_scenario"][0]["scenario"] == draw_scenarios(1, 20_000)[0]
     assert (tmp_path / "oracle.png").is_file()
+
+
+def test_whirl_by_friction_bins_the_scenarios():
+    from agents.oracle import whirl_by_friction
+    per = [dict(scenario={"contact.friction": mu}, rows={"a": {"backward_whirl": w}})
+           for mu, w in ((0.39, 1.0), (0.40, 0.0), (0.52, 1.0), (0.60, 1.0))]
+    t = whirl_by_friction(dict(per_scenario=per, summary=[{"controller": "a"}]))
+    assert t["counts"] == [2, 0, 1, 1]                  # 0.60 falls in the last bin
+    assert t["rates"]["a"] == [0.5, None, 1.0, 1.0]
