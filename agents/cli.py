@@ -225,7 +225,8 @@ def register(sub) -> None:
     p.add_argument("--no-search", action="store_true",
                    help="score the rows only (no oracle search), e.g. on 200 scenarios")
     p.add_argument("--policy", action="append", default=None,
-                   help="extra rows: a training directory / model .zip or module:Class (repeatable)")
+                   help="extra rows: a training directory / model .zip or module:Class "
+                        "(repeatable)")
     _output_args(p, "out/oracle")
     p.set_defaults(func=cmd_oracle)
 

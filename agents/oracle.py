@@ -132,7 +132,8 @@ def kpi_row(k: dict) -> dict:
                 peak_contact_force_N=float(k["peak_contact_force_N"]),
                 max_displacement_um=float(k["max_displacement_um"]),
                 relevitated=float(bool(k.get("relevitated"))),
-                relevitation_time_s=(k.get("relevitation_time_s") if k.get("relevitated") else None),
+                relevitation_time_s=(k.get("relevitation_time_s") if k.get("relevitated")
+                                     else None),
                 peak_whirl_revolutions=float(k["peak_whirl_revolutions"]))
 
 
@@ -357,8 +358,8 @@ def plot_whirl_by_friction(report: dict, path: Path) -> Path:
     for name in dict.fromkeys(n for n in show if n in table["rates"]):
         rates = [np.nan if r is None else r for r in table["rates"][name]]
         ax.plot(mid, rates, "o-", label=name)
-    ax.set(xlabel="friction coefficient (bin centre)", ylabel="backward-whirl rate", ylim=(-0.02, 1.02),
-           title="drops per bin: " + ", ".join(str(c) for c in table["counts"]))
+    ax.set(xlabel="friction coefficient (bin centre)", ylabel="backward-whirl rate",
+           ylim=(-0.02, 1.02), title="drops per bin: " + ", ".join(str(c) for c in table["counts"]))
     ax.axhline(0.05, color="k", lw=0.8, ls=":")
     ax.legend(fontsize=7)
     ax.grid(alpha=0.3)

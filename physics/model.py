@@ -316,8 +316,9 @@ def rhs(t, y, P, I, U, dy, aux):
                     i_int, i_q = I[I_AMB_INT] + j, I[I_AMB_FILT] + j
                     i_cmd, e, de_int = _actuator_command(
                         t, d, y[i_int], y[i_q], U[U_AMB_DIRECT], U[U_AMB_POWER], U[U_ICMD + j],
-                        U[U_T_ON], U[U_REF0 + j], oy if a == 1 else ox, P[P_AMB_ILIM], P[P_AMB_RAMP],
-                        P[P_AMB_IFF1 + k] if a == 1 else 0.0, U[U_AMB_GAIN] * P[P_AMB_KP],
+                        U[U_T_ON], U[U_REF0 + j], oy if a == 1 else ox, P[P_AMB_ILIM],
+                        P[P_AMB_RAMP], P[P_AMB_IFF1 + k] if a == 1 else 0.0,
+                        U[U_AMB_GAIN] * P[P_AMB_KP],
                         U[U_AMB_GAIN] * P[P_AMB_KI], U[U_AMB_GAIN] * P[P_AMB_KD], P[P_AMB_TD])
                     i_act = i_cmd
                     if I[I_AMB_COIL] >= 0:               # first-order coil lag
@@ -570,7 +571,8 @@ def amb_currents(t, y, P, I, U, out):
         out[j] = _actuator_command(
             t, dyy if j % 2 == 1 else dx, y[I[I_AMB_INT] + j], y[I[I_AMB_FILT] + j],
             U[U_AMB_DIRECT], U[U_AMB_POWER], U[U_ICMD + j], U[U_T_ON], U[U_REF0 + j],
-            oy if j % 2 == 1 else ox, P[P_AMB_ILIM], P[P_AMB_RAMP], P[P_AMB_IFF1 + k] if j % 2 == 1 else 0.0,
+            oy if j % 2 == 1 else ox, P[P_AMB_ILIM], P[P_AMB_RAMP],
+            P[P_AMB_IFF1 + k] if j % 2 == 1 else 0.0,
             U[U_AMB_GAIN] * P[P_AMB_KP], U[U_AMB_GAIN] * P[P_AMB_KI], U[U_AMB_GAIN] * P[P_AMB_KD],
             P[P_AMB_TD])[0]
 

@@ -50,7 +50,8 @@ def test_whirl_brake_sup_turns_whirl_brake_terms_into_offsets():
     a, _ = ctrl.predict(obs)
     g = WhirlBrake.GAINS
     per = plant.current_limit / plant.pid[0] / plant.clearance
-    cols = [plant.action_names.index(n) for n in ("offset_r1", "offset_t1", "offset_r2", "offset_t2")]
+    cols = [plant.action_names.index(n)
+            for n in ("offset_r1", "offset_t1", "offset_r2", "offset_t2")]
     np.testing.assert_allclose(a[cols], np.array([-g["kr"], g["kt"]] * 2) * per, rtol=1e-6)
     assert a[plant.action_names.index("levitate")] == 1.0
     assert a[plant.action_names.index("gain")] == 0.0

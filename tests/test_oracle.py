@@ -42,7 +42,8 @@ def test_batched_rollout_of_the_inner_loop_sequence_is_the_inner_loop_row():
     from rotordrop_env import BatchedRotorDropVecEnv
     values = draw_scenarios(1)[0]
     sc, phase = as_benchmark(values, "#0")
-    entry = Entry("inner-loop", "full", InnerLoop, {"command": "supervisor", "control_dt": CONTROL_DT})
+    entry = Entry("inner-loop", "full", InnerLoop,
+                  {"command": "supervisor", "control_dt": CONTROL_DT})
     kw = episode_kwargs(entry, sc, phase)
     venv = BatchedRotorDropVecEnv(ENV_ID, 2, seed=0, **kw)
     rows = [kpi_row(k) for k in rollout(venv, np.stack([inner_loop_theta()] * 2), sc.env_kwargs[
