@@ -1,5 +1,5 @@
 """The ``rotordrop`` command line (entry point :func:`main`) and agents' commands ``train |
-evaluate | benchmark | tune | ride-through | export-policy`` (and ``research``, :mod:`agents.research`).
+evaluate | benchmark | oracle | tune | ride-through | export-policy`` (and ``research``, :mod:`agents.research`).
 
 This top-layer module builds the parser from every layer's ``register(subparsers)``: physics'
 ``drop``, ``params`` (:mod:`physics.cli`), ``study`` and ``accuracy``, then agents' own. Registration
@@ -171,6 +171,19 @@ def cmd_tune(args) -> int:
     return 0
 
 
+def cmd_oracle(args) -> int:
+    from .oracle import oracle
+    try:
+        report = oracle(args.out, scenarios=args.scenarios, population=args.population,
+                        iterations=args.iterations, seed=args.seed, policies=args.policy,
+                        progress=not args.quiet, plots=not args.no_plots,
+                        search=not args.no_search, scenario_seed=args.scenario_seed)
+    except ERRORS as exc:
+        return _fail("oracle", exc)
+    _wrote(args.out, ["oracle.json", *report.get("figures", [])], report["wall_time_s"])
+    return 0
+
+
 def register(sub) -> None:
     p = sub.add_parser("train", help="train an SB3 agent on a rotor-drop environment")
     p.add_argument("--env", required=True, help="environment id, e.g. RotorDrop-Damping-v0")
@@ -253,6 +266,23 @@ def register(sub) -> None:
     p.add_argument("--scenarios", type=int, default=None, help=argparse.SUPPRESS)
     p.add_argument("--episodes", type=int, default=None, help=argparse.SUPPRESS)
     p.set_defaults(func=cmd_benchmark)
+
+    p = sub.add_parser("oracle", help="per-scenario optimised command sequences of the supervisor "
+                                      "interface: the score no controller can beat by much")
+    p.add_argument("--scenarios", type=at_least(1), default=20, help="drawn scenarios (default 20)")
+    p.add_argument("--population", type=at_least(2), default=24,
+                   help="command sequences per generation (one batched rollout)")
+    p.add_argument("--iterations", type=at_least(0), default=10, help="generations (default 10)")
+    p.add_argument("--seed", type=_SEED, default=0, help="search seed")
+    p.add_argument("--scenario-seed", type=_SEED, default=10_000,
+                   help="seed of the first drawn scenario (default 10000; scenario i uses it + i)")
+    p.add_argument("--no-search", action="store_true",
+                   help="score the rows only (no oracle search), e.g. on 200 scenarios")
+    p.add_argument("--policy", action="append", default=None,
+                   help="extra rows: a training directory / model .zip or module:Class "
+                        "(repeatable)")
+    _output_args(p, "out/oracle")
+    p.set_defaults(func=cmd_oracle)
 
     p = sub.add_parser("tune", help="tune a controller's gains for the benchmark score on the "
                                     "validation suite (scenarios the benchmark does not use)")

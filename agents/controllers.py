@@ -24,6 +24,11 @@ Baselines (spec §5-6):
 ``builtin-relevitate``
     ``command="discrete"``: switches the environment's built-in PID (the same law, evaluated
     continuously inside the integrator, same ramp) on as soon as power is back.
+``whirl-brake``
+    Continuous currents: PD, gravity feed-forward and terms against backward whirl (class doc).
+``inner-loop``, ``whirl-brake-sup``
+    ``command="supervisor"``: the built-in PID switched on at power return with C_max, alone
+    (zero reference offsets) or with whirl-brake's whirl terms as reference offsets.
 
 The PID starts when the ``amb_power`` observation shows the power (from the control step whose
 action can first use it); the built-in switch needs no observation and engages in the very step
@@ -321,15 +326,70 @@ class WhirlBrake(Controller):
         p, g = self.plant, self.g
         pos = p.positions(obs) / p.clearance
         vel = p.velocities(obs) * 1e-3 / p.clearance
-        spin = p.spin_sign(obs)[:, None]
-        r = np.repeat(np.hypot(pos[:, 0::2], pos[:, 1::2]), 2, axis=1)
-        unit = pos / np.maximum(r, 1e-9)
-        outer = r > g["r_on"]
-        u = (g["ff"] * p.gravity_currents - g["kp"] * pos - g["kd"] * vel + g["kc"] * spin * _rot90(vel)
-             + np.where(outer, g["kt"] * spin * _rot90(unit) - g["kr"] * unit, 0.0))
+        u = (g["ff"] * p.gravity_currents - g["kp"] * pos - g["kd"] * vel
+             + whirl_terms(g, pos, vel, p.spin_sign(obs))[0])
         out = {"currents": np.where(p.power_available(obs)[:, None], np.clip(u, -1.0, 1.0), 0.0)}
         if "damping" in p.channels:
             out["damping"] = np.ones((len(obs), 2))
+        return out
+
+
+def whirl_terms(g: dict, pos: np.ndarray, vel: np.ndarray, spin: np.ndarray):
+    """whirl-brake's terms against backward whirl, k_c s J v τ/c + [|x| > r_on c](k_t s J x̂ −
+    k_r x̂), in normalised current per axis (x1, y1, x2, y2), and the unit radius vectors x̂;
+    ``pos`` = x/c, ``vel`` = v τ/c (n, 4), ``spin`` (n,) the spin sign."""
+    spin = spin[:, None]
+    r = np.repeat(np.hypot(pos[:, 0::2], pos[:, 1::2]), 2, axis=1)
+    unit = pos / np.maximum(r, 1e-9)
+    u = g["kc"] * spin * _rot90(vel) + np.where(r > g["r_on"], g["kt"] * spin * _rot90(unit)
+                                                - g["kr"] * unit, 0.0)
+    return u, unit
+
+
+class InnerLoop(Controller):
+    """``command="supervisor"`` with nothing on top: the built-in PID switched on as soon as
+    power is back, zero reference offsets, the scene's gains, C_max in the Full task (the
+    "inner loop only" row: the same trajectory as ``builtin-relevitate`` with C_max)."""
+
+    name = "inner-loop"
+    needs = ("levitate", "offsets")
+    sensors = False
+
+    def commands(self, obs):
+        n = len(obs)
+        out = {"levitate": np.ones(n), "gain": np.zeros(n), "offsets": np.zeros((n, 4))}
+        if "damping" in self.plant.channels:
+            out["damping"] = np.ones((n, 2))
+        return out
+
+
+class WhirlBrakeSupervisor(InnerLoop):
+    """whirl-brake's whirl terms (:func:`whirl_terms`, its tuned gains) written as supervisor
+    commands over the built-in PID: the term's current Δu (1 = the current limit) becomes the
+    reference offset δ = Δu i_max / k_p that makes the PID add it (i = −k_p (x − x_ref) + ...),
+    split into the sensed orbit's radial and tangential axes; the PID replaces whirl-brake's
+    own PD and feed-forward. C_max in the Full task."""
+
+    name = "whirl-brake-sup"
+    sensors = True
+
+    def __init__(self, plant: Plant, **gains):
+        super().__init__(plant)
+        self.g = WhirlBrake(plant, **gains).g
+        self.per_offset = plant.current_limit / plant.pid[0] / plant.clearance
+
+    def commands(self, obs):
+        p = self.plant
+        out = super().commands(obs)
+        pos = p.positions(obs) / p.clearance
+        vel = p.velocities(obs) * 1e-3 / p.clearance
+        spin = p.spin_sign(obs)
+        du, unit = whirl_terms(self.g, pos, vel, spin)
+        tang = spin[:, None] * _rot90(unit)
+        radial = (du * unit).reshape(-1, 2, 2).sum(axis=2)       # per plane
+        tangential = (du * tang).reshape(-1, 2, 2).sum(axis=2)
+        offsets = np.stack([radial, tangential], axis=2).reshape(-1, 4) * self.per_offset
+        out["offsets"] = np.clip(offsets, -1.0, 1.0)
         return out
 
 
@@ -342,13 +402,19 @@ def _rot90(v: np.ndarray) -> np.ndarray:
 
 
 BASELINES: dict[str, type[Controller]] = {c.name: c for c in (
-    Passive, MaxDamping, WhirlSwitch, PidRelevitate, BuiltinRelevitate, WhirlBrake)}
+    Passive, MaxDamping, WhirlSwitch, PidRelevitate, BuiltinRelevitate, WhirlBrake, InnerLoop,
+    WhirlBrakeSupervisor)}
 
 
 def command_for(cls: type[Controller]) -> str | None:
     """The re-levitation command (env kwarg ``command``) a controller's channels need:
-    ``continuous`` for ``currents``, ``discrete`` for ``levitate``, None otherwise."""
-    return "continuous" if "currents" in cls.needs else "discrete" if "levitate" in cls.needs else None
+    ``continuous`` for ``currents``, ``supervisor`` for ``gain`` or ``offsets``, ``discrete``
+    for ``levitate``, None otherwise."""
+    if "currents" in cls.needs:
+        return "continuous"
+    if {"gain", "offsets"} & set(cls.needs):
+        return "supervisor"
+    return "discrete" if "levitate" in cls.needs else None
 
 
 def is_controller_spec(spec: str) -> bool:

@@ -12,6 +12,10 @@ channel       meaning of the value a controller gives (per environment)
               (``command="discrete"``)
 ``currents``  (n, 4) control currents / current limit, AMB1 x, AMB1 y, AMB2 x, AMB2 y
               (``command="continuous"``)
+``gain``      (n,) or (n, 1) PID gain scale 2^value (``command="supervisor"``; 0 = the
+              scene's gains)
+``offsets``   (n, 4) reference offsets / clearance: radial and tangential (along a forward
+              orbit) of AMB plane 1, then plane 2 (``command="supervisor"``)
 ============  =========================================================================
 
 Channels a controller does not set (or sets to None) stay passive (damping held at its value at
@@ -29,6 +33,7 @@ from functools import cached_property
 import numpy as np
 
 from rotordrop_env.layout import CURRENT_ACTIONS as CURRENT_NAMES
+from rotordrop_env.layout import SUPERVISOR_ACTIONS
 
 SENSORS = ("x1", "y1", "vx1", "vy1", "x2", "y2", "vx2", "vy2", "rotor_speed")
 #: the damper values of housing 1, 2: sensor observations, else those of the full state
@@ -36,10 +41,16 @@ DAMPING_OBS = (("damping1", "damping2"), ("RB1.Cs", "RB2.Cs"))
 POSITIONS = ("x1", "y1", "x2", "y2")
 VELOCITIES = ("vx1", "vy1", "vx2", "vy2")
 #: columns per environment of each channel, and what its normalised value means
-CHANNEL_WIDTH = {"damping": 2, "levitate": 1, "currents": 4}
+CHANNEL_WIDTH = {"damping": 2, "levitate": 1, "currents": 4, "gain": 1, "offsets": 4}
 CHANNEL_UNITS = {"damping": "-1 = C_min, +1 = C_max, not N s/m",
                  "levitate": "1 = on, 0 = off",
-                 "currents": "current / current limit, not A"}
+                 "currents": "current / current limit, not A",
+                 "gain": "log2 of the PID gain scale",
+                 "offsets": "reference offset / clearance, not m"}
+#: action columns of each channel (continuous action spaces)
+CHANNEL_ACTIONS = {"damping": ("damping1", "damping2"), "levitate": ("levitate",),
+                   "currents": CURRENT_NAMES, "gain": SUPERVISOR_ACTIONS[1:2],
+                   "offsets": SUPERVISOR_ACTIONS[2:]}
 ROUND_OFF = 1e-6        # tolerated excess over |value| = 1 (clipped away)
 
 
@@ -175,22 +186,13 @@ class Plant:
     # --------------------------------------------------------------------- actions --
     @cached_property
     def channels(self) -> tuple[str, ...]:
-        ch = []
-        if "damping1" in self.action_names:
-            ch.append("damping")
-        if "levitate" in self.action_names:
-            ch.append("levitate")
-        if CURRENT_NAMES[0] in self.action_names:
-            ch.append("currents")
-        return tuple(ch)
+        return tuple(ch for ch, names in CHANNEL_ACTIONS.items() if names[0] in self.action_names)
 
     @cached_property
     def _action_columns(self) -> dict[str, list[int]]:
         """Action columns of each channel (continuous action spaces)."""
         names = self.action_names
-        cols = {"damping": ["damping1", "damping2"], "levitate": ["levitate"],
-                "currents": list(CURRENT_NAMES)}
-        return {ch: [names.index(n) for n in cols[ch]] for ch in self.channels}
+        return {ch: [names.index(n) for n in CHANNEL_ACTIONS[ch]] for ch in self.channels}
 
     def checked(self, commands, n: int, who: str = "controller") -> dict[str, np.ndarray]:
         """``commands`` (channel -> value) as (n, width) float arrays, None values dropped;
@@ -248,6 +250,7 @@ class Plant:
                 a[:, cols["damping"]] = d
         if "levitate" in cols:
             a[:, cols["levitate"][0]] = -1.0 if lev is None else np.where(lev > 0.5, 1.0, -1.0)
-        if "currents" in c:
-            a[:, cols["currents"]] = c["currents"]
+        for ch in ("currents", "gain", "offsets"):
+            if ch in c:
+                a[:, cols[ch]] = c[ch]
         return np.clip(a, -1.0, 1.0)                  # round-off within ROUND_OFF only

@@ -58,13 +58,16 @@ class CrossEntropy:
 
 def cross_entropy(cost: Callable[[np.ndarray], float], mean, std, low, high, iterations: int,
                   population: int, elite: int, rng: np.random.Generator, min_std=0.0,
-                  progress: bool = True, desc: str = "cross-entropy search"):
+                  progress: bool = True, desc: str = "cross-entropy search", batch: bool = False):
     """Minimise ``cost`` over the box [low, high] (arrays of ``mean``'s shape) with
-    :class:`CrossEntropy`, evaluating the candidates one after the other. Returns
-    ``(best cost, best candidate, history)``."""
+    :class:`CrossEntropy`, evaluating the candidates one after the other, or with
+    ``batch=True`` a generation in one call (``cost`` takes a stack of k candidates and returns
+    their k costs, e.g. one batched rollout). Returns ``(best cost, best candidate, history)``."""
     from tqdm.auto import tqdm
+    costs_of = (lambda xs: np.asarray(cost(xs), dtype=float)) if batch else \
+        (lambda xs: np.array([cost(x) for x in xs]))
     search = CrossEntropy(mean, std, low, high, population, elite, rng, min_std)
-    search.tell_start(cost(search.start()))
+    search.tell_start(costs_of(search.start()[None])[0])
     for _ in tqdm(range(1, iterations + 1), desc=desc, unit="gen", disable=not progress):
-        search.tell([cost(x) for x in search.ask()])
+        search.tell(costs_of(search.ask()))
     return search.best[0], search.best[1], search.history

@@ -80,8 +80,12 @@ LAW_PAPER, LAW_HERTZ_LINE = 0, 1
 # U_CS1/2: support damping of each housing (the damper's command with effects.semi_active_damper).
 # Actuator level only: U_AMB_DIRECT > 0 applies the control currents U_ICMD + j (j = axis, see
 # AMB_AXES) instead of the PID; U_T_ON is the time the PID was switched on and U_REF0 + j the
-# reference it ramps from (spec §5 reactivation).
-U_AMB_POWER, U_CS1, U_CS2, U_AMB_DIRECT, U_ICMD, U_T_ON, U_REF0, N_U = 0, 1, 2, 3, 4, 8, 9, 13
+# reference it ramps from (spec §5 reactivation). A supervisor over the PID (the environments'
+# ``command="supervisor"``) shifts the reference of AMB plane k by U_REF_OFF + 2k (radial) and
+# U_REF_OFF + 2k + 1 (tangential, along a forward orbit) [m] in the frame of the sensed orbit
+# (:func:`orbit_offset`) and scales the three PID gains by U_AMB_GAIN (1 = the scene's gains).
+(U_AMB_POWER, U_CS1, U_CS2, U_AMB_DIRECT, U_ICMD, U_T_ON, U_REF0, U_REF_OFF, U_AMB_GAIN,
+ N_U) = 0, 1, 2, 3, 4, 8, 9, 13, 17, 18
 
 # ------------------------------------------------------------------- diagnostics aux --
 # per plane k at aux[k*N_AUX_PLANE + j]
@@ -120,6 +124,7 @@ class Model:
         U = np.zeros(N_U)
         U[U_AMB_POWER] = 1.0 if amb_power else 0.0
         U[U_CS1] = U[U_CS2] = self.scene.support.damping
+        U[U_AMB_GAIN] = 1.0
         return U
 
 
@@ -344,6 +349,8 @@ def rhs(t, y, P, I, U, dy, aux):
         for k in range(2):
             z = P[P_Z_AMB1 + k]
             dx, dyy, ddx, ddy = axis_motion(y, I, z)
+            ox, oy = orbit_offset(dx, dyy, U[U_REF_OFF + 2 * k], U[U_REF_OFF + 2 * k + 1],
+                                  y[I[S_W]], P[P_CLR])
             if amb == AMB_LINEAR:
                 fx = amb_mod.linear_force(dx, ddx, P[P_K_AMB], P[P_C_AMB], 0.0)
                 fy = amb_mod.linear_force(dyy, ddy, P[P_K_AMB], P[P_C_AMB], P[P_AMB_BIAS1 + k])
@@ -355,9 +362,10 @@ def rhs(t, y, P, I, U, dy, aux):
                     i_int, i_q = I[I_AMB_INT] + j, I[I_AMB_FILT] + j
                     i_cmd, e, de_int = _actuator_command(
                         t, d, y[i_int], y[i_q], U[U_AMB_DIRECT], U[U_AMB_POWER], U[U_ICMD + j],
-                        U[U_T_ON], U[U_REF0 + j], P[P_AMB_ILIM], P[P_AMB_RAMP],
-                        P[P_AMB_IFF1 + k] if a == 1 else 0.0,
-                        P[P_AMB_KP], P[P_AMB_KI], P[P_AMB_KD], P[P_AMB_TD])
+                        U[U_T_ON], U[U_REF0 + j], oy if a == 1 else ox, P[P_AMB_ILIM],
+                        P[P_AMB_RAMP], P[P_AMB_IFF1 + k] if a == 1 else 0.0,
+                        U[U_AMB_GAIN] * P[P_AMB_KP],
+                        U[U_AMB_GAIN] * P[P_AMB_KI], U[U_AMB_GAIN] * P[P_AMB_KD], P[P_AMB_TD])
                     i_act = i_cmd
                     if I[I_AMB_COIL] >= 0:               # first-order coil lag
                         ic = I[I_AMB_COIL] + j
@@ -595,14 +603,15 @@ def rhs(t, y, P, I, U, dy, aux):
 
 
 @njit
-def _actuator_command(t, d, z_int, q, u_direct, u_power, u_icmd, t_on, ref0, lim, ramp, i_ff,
-                      kp, ki, kd, td):
+def _actuator_command(t, d, z_int, q, u_direct, u_power, u_icmd, t_on, ref0, offset, lim, ramp,
+                      i_ff, kp, ki, kd, td):
     """Commanded control current of one actuator axis, its error e and integral rate (spec §5).
 
     ``d``: displacement at the axis; ``z_int``, ``q``: its PID integral and derivative-filter
     states; ``u_*``, ``t_on``, ``ref0``: its controls (``U_AMB_DIRECT``, ``U_AMB_POWER``,
-    ``U_ICMD + j``, ``U_T_ON``, ``U_REF0 + j``); the rest its parameters (``P_AMB_*``; ``i_ff``
-    the gravity feed-forward current, zero on x axes). Scalars only, so that ``rhs`` inlines it.
+    ``U_ICMD + j``, ``U_T_ON``, ``U_REF0 + j``, ``U_REF_OFF + j``); the rest its parameters
+    (``P_AMB_*``, the gains already scaled by ``U_AMB_GAIN``; ``i_ff`` the gravity feed-forward
+    current, zero on x axes). Scalars only, so that ``rhs`` inlines it.
 
     Direct mode: ``u_icmd`` clipped to the current limit (U is a public input). PID mode:
     feed-forward minus PID of e = d - ramped reference, with conditional-integration anti-windup
@@ -613,11 +622,29 @@ def _actuator_command(t, d, z_int, q, u_direct, u_power, u_icmd, t_on, ref0, lim
         return amb_mod.clamp(u_icmd, -lim, lim), 0.0, 0.0
     if u_power <= 0.0:
         return 0.0, 0.0, 0.0
-    e = d - amb_mod.ramp_reference(t, t_on, ref0, ramp)
+    e = d - amb_mod.ramp_reference(t, t_on, ref0, ramp) - offset
     raw = amb_mod.pid_current(e, z_int, q, kp, ki, kd, td, i_ff)
     if (raw > lim and e < 0.0) or (raw < -lim and e > 0.0):
         return (lim if raw > lim else -lim), e, 0.0
     return amb_mod.clamp(raw, -lim, lim), e, e
+
+
+#: the orbit frame's unit vectors are regularised within this fraction of the clearance of the
+#: centre (an offset fades out there instead of jumping with the direction of a tiny orbit)
+ORBIT_FRAME_CORE = 0.05
+
+
+@njit
+def orbit_offset(dx, dy, radial, tangential, spin, clearance):
+    """(x, y) reference offset [m] of ``radial`` along the sensed displacement (dx, dy) and
+    ``tangential`` perpendicular to it along a forward orbit (the direction of ``spin``), with
+    unit vectors (dx, dy) / sqrt(r^2 + r_0^2), r_0 = ``ORBIT_FRAME_CORE`` x clearance."""
+    if radial == 0.0 and tangential == 0.0:
+        return 0.0, 0.0
+    n = math.sqrt(dx * dx + dy * dy + (ORBIT_FRAME_CORE * clearance) ** 2)
+    ux, uy = dx / n, dy / n
+    s = 1.0 if spin >= 0.0 else -1.0
+    return radial * ux - tangential * s * uy, radial * uy + tangential * s * ux
 
 
 @njit
@@ -630,11 +657,15 @@ def amb_currents(t, y, P, I, U, out):
             continue
         k = j // 2
         dx, dyy, _, _ = axis_motion(y, I, P[P_Z_AMB1 + k])
+        ox, oy = orbit_offset(dx, dyy, U[U_REF_OFF + 2 * k], U[U_REF_OFF + 2 * k + 1], y[I[S_W]],
+                              P[P_CLR])
         out[j] = _actuator_command(
             t, dyy if j % 2 == 1 else dx, y[I[I_AMB_INT] + j], y[I[I_AMB_FILT] + j],
             U[U_AMB_DIRECT], U[U_AMB_POWER], U[U_ICMD + j], U[U_T_ON], U[U_REF0 + j],
-            P[P_AMB_ILIM], P[P_AMB_RAMP], P[P_AMB_IFF1 + k] if j % 2 == 1 else 0.0,
-            P[P_AMB_KP], P[P_AMB_KI], P[P_AMB_KD], P[P_AMB_TD])[0]
+            oy if j % 2 == 1 else ox, P[P_AMB_ILIM], P[P_AMB_RAMP],
+            P[P_AMB_IFF1 + k] if j % 2 == 1 else 0.0,
+            U[U_AMB_GAIN] * P[P_AMB_KP], U[U_AMB_GAIN] * P[P_AMB_KI], U[U_AMB_GAIN] * P[P_AMB_KD],
+            P[P_AMB_TD])[0]
 
 
 @njit

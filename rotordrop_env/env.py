@@ -20,10 +20,17 @@ from physics.simulate import IntegrationError, _explain
 
 from . import kernels as K
 from .buffers import Buffers
-from .layout import action_layout, observation_layout
+from .layout import COMMANDS, action_layout, observation_layout
 from .scenario import (POWER_RETURN, POWER_RETURN_LIMITS, fault_state, resolve_ranges, sample,
                        scenario_scene)
 
+#: the kernel's re-levitation mode of each ``command``
+LEV_CODES = {"discrete": K.LEV_DISCRETE, "continuous": K.LEV_CONTINUOUS,
+             "supervisor": K.LEV_SUPERVISOR}
+#: command="supervisor": |offset| <= SUPERVISOR_OFFSET x clearance; gain scale in
+#: [2^-SUPERVISOR_OCTAVES, 2^SUPERVISOR_OCTAVES]
+SUPERVISOR_OFFSET = 1.0
+SUPERVISOR_OCTAVES = 1.0
 REWARD_TERMS = ("whirl", "contact", "displacement", "effort", "success", "failure")
 _O_TERMS = (K.O_R_WHIRL, K.O_R_CONTACT, K.O_R_DISP, K.O_R_EFFORT, K.O_R_SUCCESS, K.O_R_FAILURE)
 DEFAULT_POWER_RETURN = 0.05
@@ -69,7 +76,8 @@ class RotorDropEnv(gym.Env):
     randomization               None        {key: (low, high) | (law, low, high) | None};
                                             needs randomize=True, no range for a fixed key
     full_state                  False       observe the whole state vector (research)
-    command                     "discrete"  re-levitation envs: "discrete" or "continuous"
+    command                     "discrete"  re-levitation envs: "discrete", "continuous" or
+                                            "supervisor"
     power_return_time           0.05        re-levitation envs: power returns [s after fault]
     samples_per_step            5           monitor samples per control step (dense output)
     relevitation_hold           0.02        re-levitated after this long in the success region [s]
@@ -149,7 +157,8 @@ class RotorDropEnv(gym.Env):
         self.model = model = fs.model
 
         self.obs_names, self.obs_scale = observation_layout(
-            model, self._damping, self._relevitate, self.full_state, self.episode_time)
+            model, self._damping, self._relevitate, self.full_state, self.episode_time,
+            self.command)
         self.action_space, self.action_names = action_layout(self._damping, self._relevitate,
                                                              self.command)
         n_obs = len(self.obs_names)
@@ -199,8 +208,9 @@ class RotorDropEnv(gym.Env):
             if power_return_time is not None:
                 raise ValueError(f"power_return_time= applies to the re-levitation environments "
                                  f"only, not {name}")
-        if command not in (None, "discrete", "continuous"):
-            raise ValueError(f"command = {command!r} must be 'discrete' or 'continuous'")
+        if command is not None and command not in COMMANDS:
+            raise ValueError(f"command = {command!r} is not a command mode; the modes are "
+                             + ", ".join(repr(c) for c in COMMANDS))
         if power_return_time is not None:
             _positive(POWER_RETURN, power_return_time, *POWER_RETURN_LIMITS)
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
@@ -250,8 +260,8 @@ class RotorDropEnv(gym.Env):
         C = b.C
         C[K.C_DT] = self.dt
         C[K.C_DAMP] = 1.0 if self._damping else 0.0
-        C[K.C_LEV] = (K.LEV_NONE if not self._relevitate else
-                      K.LEV_DISCRETE if self.command == "discrete" else K.LEV_CONTINUOUS)
+        C[K.C_LEV] = LEV_CODES[self.command] if self._relevitate else K.LEV_NONE
+        C[K.C_SUP_OFFSET], C[K.C_SUP_OCTAVES] = supervisor_scales(self.base_scene)
         C[K.C_WHIRL_RADIUS], C[K.C_WHIRL_REVS] = WHIRL_RADIUS_FRACTION, WHIRL_MIN_REVOLUTIONS
         w = self.weights
         C[K.C_W_WHIRL], C[K.C_W_CONTACT], C[K.C_W_DISP] = w["w_whirl"], w["w_contact"], w["w_displacement"]
@@ -536,6 +546,11 @@ def real_action(action, space: gym.Space, names) -> np.ndarray:
     return a
 
 
+def supervisor_scales(scene: Scene) -> tuple[float, float]:
+    """(largest reference offset [m], gain-scale octaves) of ``command="supervisor"``."""
+    return SUPERVISOR_OFFSET * scene.contact.clearance, SUPERVISOR_OCTAVES
+
+
 def _positive(name: str, value, lo: float, hi: float) -> None:
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
         raise ValueError(f"{name} = {value!r} must be a real number in [{lo:g}, {hi:g}], "
@@ -634,6 +649,13 @@ class RelevitateEnv(RotorDropEnv):
     AMB1 x, AMB1 y, AMB2 x, AMB2 y, normalised by ``amb.current_limit``; the bias current is on
     whenever power is.
 
+    Action space, ``command="supervisor"``: ``Box(-1, 1, (6,), float32)``: ``levitate`` (> 0
+    switches the built-in PID on, as in discrete mode), ``gain`` (PID gains x 2^a),
+    ``offset_r1``, ``offset_t1``, ``offset_r2``, ``offset_t2`` (reference shift of AMB plane 1, 2
+    by a x clearance along the radius and along a forward orbit of the sensed orbit, applied
+    inside the physics step). The observation gains ``orbit_radius1/2`` (scale: clearance) and
+    ``orbit_rate1/2`` (rad/s along the spin; scale: initial speed). See docs/environments.md.
+
     Observation: the passive table (indices 0-11), then
 
     =====  ===============  ================================================  =============
@@ -657,7 +679,8 @@ class FullEnv(RotorDropEnv):
 
     Action space: ``Box(-1, 1, float32)``: ``damping1``, ``damping2`` (as in Damping), then
     with ``command="discrete"`` one entry ``levitate`` (> 0 switches the built-in controller on;
-    it stays on), or with ``command="continuous"`` the 4 normalised control currents.
+    it stays on), with ``command="continuous"`` the 4 normalised control currents, or with
+    ``command="supervisor"`` the 6 supervisor entries (see Relevitate).
 
     Observation: passive indices 0-10, ``damping1``, ``damping2``, ``time``, then the
     re-levitation entries ``amb_power``, ``controller_on``, ``i1x``, ``i1y``, ``i2x``, ``i2y``.

@@ -21,16 +21,19 @@ import numba
 from physics._jit import njit, njit_parallel
 from physics.integrate import integrate_segment
 from physics.model import (A_FR, A_QMAX, A_WS, I_AMB_FILT, I_AMB_INT, I_CS, N_AUX_PLANE, P_CLR,
-                           P_Z_AMB1, P_Z_RB1, S_W, U_AMB_DIRECT, U_AMB_POWER, U_CS1, U_ICMD,
-                           U_REF0, U_T_ON, amb_currents, axis_motion, rhs, sleeve_motion)
+                           P_Z_AMB1, P_Z_RB1, S_W, U_AMB_DIRECT, U_AMB_GAIN, U_AMB_POWER, U_CS1,
+                           U_ICMD, U_REF0, U_REF_OFF, U_T_ON, amb_currents, axis_motion, rhs,
+                           sleeve_motion)
 
 # ------------------------------------------------------------------------ configuration C --
 (C_DT, C_T_FAULT, C_T_END, C_T_POWER, C_DAMP, C_LEV,
  C_RTOL, C_HMAX, C_HMIN, C_FIXED, C_MAXSTEPS,
  C_W_WHIRL, C_W_CONTACT, C_W_DISP, C_W_EFFORT, C_W_SUCCESS, C_W_FAILURE,
  C_F_REF, C_GAP, C_LOAD_RATING, C_HOLD, C_TERMINATE, C_FULL, C_CS_MIN, C_CS_MAX, C_ILIM,
- C_RELEV_RADIUS, C_WHIRL_RADIUS, C_WHIRL_REVS, N_C) = range(30)
-LEV_NONE, LEV_DISCRETE, LEV_CONTINUOUS = 0, 1, 2
+ C_RELEV_RADIUS, C_WHIRL_RADIUS, C_WHIRL_REVS, C_SUP_OFFSET, C_SUP_OCTAVES, N_C) = range(32)
+LEV_NONE, LEV_DISCRETE, LEV_CONTINUOUS, LEV_SUPERVISOR = 0, 1, 2, 3
+#: supervisor: below this fraction of the clearance the observed orbit rate is zero
+SUP_MIN_RADIUS = 0.05
 
 # ------------------------------------------------------------------------------ monitor M --
 (M_T, M_H, M_REV1, M_REV2, M_WHIRL, M_PEAK_F, M_MAX_DISP, M_OK_START, M_RELEV,
@@ -110,11 +113,13 @@ def apply_action(a, y, P, I, U, C, M):
             M[M_POWER] = 1.0
         o = 2 if C[C_DAMP] > 0.0 else 0          # after the damper commands, if any
         if M[M_POWER] > 0.0:
-            if lev == LEV_DISCRETE:
+            if lev == LEV_DISCRETE or lev == LEV_SUPERVISOR:
                 want = a[o] >= 0.5 if a.shape[0] == 1 else a[o] > 0.0
                 if want and M[M_CTRL_ON] == 0.0:
                     _switch_on(t, y, P, I, U)
                     M[M_CTRL_ON] = 1.0
+                if lev == LEV_SUPERVISOR and M[M_CTRL_ON] > 0.0:
+                    supervise(a, o + 1, U, C)
             else:
                 U[U_AMB_DIRECT] = 1.0
                 for j in range(4):
@@ -122,6 +127,29 @@ def apply_action(a, y, P, I, U, C, M):
                 M[M_CTRL_ON] = 1.0
         n_eff += 4
     return effort, n_eff
+
+
+@njit
+def orbit_frame(y, P, I, k):
+    """Sensed orbit at AMB plane k: radius r [m] and angular rate relative to the spin direction
+    [rad/s] (< 0: the orbit turns backwards; 0 below ``SUP_MIN_RADIUS`` x clearance, where the
+    direction of the orbit is noise)."""
+    px, py, vx, vy = axis_motion(y, I, P[P_Z_AMB1 + k])
+    spin = 1.0 if y[I[S_W]] >= 0.0 else -1.0
+    r = math.sqrt(px * px + py * py)
+    rate = spin * (px * vy - py * vx) / (r * r) if r > SUP_MIN_RADIUS * P[P_CLR] else 0.0
+    return r, rate
+
+
+@njit
+def supervise(a, o, U, C):
+    """The supervisor's commands (action entries o: gain, o+1...o+4: radial and tangential
+    offset of AMB plane 1 and 2) onto the built-in PID: gain scale 2^(a C_SUP_OCTAVES), reference
+    offsets a x C_SUP_OFFSET along the radial and tangential axes of the sensed orbit, which
+    the PID evaluates continuously (:func:`physics.model.orbit_offset`)."""
+    U[U_AMB_GAIN] = 2.0 ** (C[C_SUP_OCTAVES] * min(max(a[o], -1.0), 1.0))
+    for j in range(4):
+        U[U_REF_OFF + j] = min(max(a[o + 1 + j], -1.0), 1.0) * C[C_SUP_OFFSET]
 
 
 @njit
@@ -154,6 +182,12 @@ def observe(t, y, P, I, U, C, M, aux, cur, scale, obs):
         for j in range(4):
             obs[n + 2 + j] = cur[j]
         n += 6
+        if int(C[C_LEV]) == LEV_SUPERVISOR:
+            for k in range(2):
+                r, rate = orbit_frame(y, P, I, k)
+                obs[n + k] = r
+                obs[n + 2 + k] = rate
+            n += 4
     for i in range(n):
         obs[i] /= scale[i]
 

@@ -15,10 +15,15 @@ from physics.model import VELOCITY, Model
 SENSOR_NAMES = ("x1", "y1", "vx1", "vy1", "x2", "y2", "vx2", "vy2")
 LEV_NAMES = ("amb_power", "controller_on", "i1x", "i1y", "i2x", "i2y")
 CURRENT_ACTIONS = ("current_amb1_x", "current_amb1_y", "current_amb2_x", "current_amb2_y")
+#: command="supervisor": switch, PID gain scale, reference offsets (radial, tangential) per plane
+SUPERVISOR_ACTIONS = ("levitate", "gain", "offset_r1", "offset_t1", "offset_r2", "offset_t2")
+SUPERVISOR_OBS = ("orbit_radius1", "orbit_radius2", "orbit_rate1", "orbit_rate2")
+COMMANDS = ("discrete", "continuous", "supervisor")
 
 
 def observation_layout(model: Model, damping: bool, relevitate: bool, full_state: bool,
-                       episode_time: float) -> tuple[list[str], np.ndarray]:
+                       episode_time: float, command: str | None = None
+                       ) -> tuple[list[str], np.ndarray]:
     """Names and SI scales of the observation entries."""
     s = model.scene
     c = s.contact.clearance
@@ -42,6 +47,9 @@ def observation_layout(model: Model, damping: bool, relevitate: bool, full_state
     if relevitate:
         names += list(LEV_NAMES)
         scale += [1.0, 1.0] + [max(s.amb.current_limit, 1e-9)] * 4
+        if command == "supervisor":
+            names += list(SUPERVISOR_OBS)
+            scale += [c, c, omega0, omega0]
     return names, np.asarray(scale, dtype=np.float64)
 
 
@@ -55,6 +63,8 @@ def action_layout(damping: bool, relevitate: bool, command: str | None):
             if not damping:
                 return spaces.Discrete(2), ["levitate"]
             names.append("levitate")
+        elif command == "supervisor":
+            names += list(SUPERVISOR_ACTIONS)
         else:
             names += list(CURRENT_ACTIONS)
     if not names:

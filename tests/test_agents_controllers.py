@@ -13,7 +13,9 @@ LEV = {"power_return_time": 0.005}
 ENVS = [("RotorDrop-Damping-v0", {}), ("RotorDrop-Relevitate-v0", {"command": "discrete", **LEV}),
         ("RotorDrop-Relevitate-v0", {"command": "continuous", **LEV}),
         ("RotorDrop-Full-v0", {"command": "discrete", **LEV}),
-        ("RotorDrop-Full-v0", {"command": "continuous", **LEV})]
+        ("RotorDrop-Full-v0", {"command": "continuous", **LEV}),
+        ("RotorDrop-Relevitate-v0", {"command": "supervisor", **LEV}),
+        ("RotorDrop-Full-v0", {"command": "supervisor", **LEV})]
 
 
 @pytest.mark.parametrize("env_id,kw", ENVS)

@@ -16,7 +16,8 @@ def test_three_policies_ship_with_their_recipe():
         assert pol.meta["seed"] == 0 and pol.meta["learning_curve"]
 
 
-@pytest.mark.parametrize("name", ["ppo-damping", "ppo-relevitate", "ppo-full"])
+@pytest.mark.parametrize("name", ["ppo-damping", "ppo-relevitate", "ppo-full", "ppo-full-scratch",
+                                  "sac-full-scratch"])
 def test_shipped_policy_acts_inside_the_action_space(name):
     pol = load_shipped(name)
     kw = {k: v for k, v in pol.env_kwargs.items() if k not in ("randomize", "randomization")}

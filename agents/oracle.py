@@ -1,0 +1,369 @@
+"""``rotordrop oracle``: the best any command sequence of the supervisor interface reaches, per
+scenario, as a bound for learned and designed controllers on the same scenarios.
+
+For each of ``--scenarios`` drops drawn where whirl is decided (``ORACLE_RANGES``: friction
+0.38-0.6, power back 30-70 ms rounded up to the 5 ms control grid, any unbalance phase, the
+environments' default ranges for the rest; seeds from ``SCENARIO_SEED``, disjoint from training
+and evaluation seeds) a
+cross-entropy search (:mod:`agents.search`) optimises an open-loop command sequence of
+``RotorDrop-Full-v0`` with ``command="supervisor"``: piecewise constant over the segments
+``SEGMENT_EDGES_MS`` after the fault, per segment both damper commands, the PID gain scale and
+the four orbit-frame reference offsets, plus one delay after the power return before the
+built-in PID is switched on. The search knows the scenario in advance, which no controller
+does, and starts from the ``inner-loop`` commands (C_max, switch on at once, zero offsets), so
+it never ends worse than that row. Because the offsets act in the frame of the sensed orbit,
+inside the physics step, the "open-loop" sequence is still a feedback law of the inner loop.
+
+Cost of an episode: the benchmark's J (:func:`agents.score.row_cost`, against the passive drop
+of the same scenario); the search adds ``SHAPING`` x min(peak backward revolutions / 3, 1) so
+that it sees progress towards a whirl-free drop before the whirl verdict flips; the oracle's
+sequence is the rollout of lowest J among all the search ran. Every row
+(baselines, shipped and ``--policy`` policies, the oracle) is scored on the same scenarios with
+the benchmark's formula, score = 100 (1 - sum J / sum J_passive).
+
+Outputs in ``--out``: ``oracle.json`` (settings, scenarios, per-scenario KPIs and J of every row,
+the oracle's command sequence and search history, the summary table) and ``oracle.png``. The
+search is written after every scenario; a rerun with the same settings continues where it
+stopped and re-scores the rows (add ``--policy`` runs without searching again). ``--no-search``
+scores the rows alone, e.g. on 200 scenarios from another ``--scenario-seed``.
+"""
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .benchmark import (EPISODE_TIME, TASKS, Entry, Scenario, controller_entry, episode_kwargs,
+                        extras)
+from .controllers import BASELINES, Passive
+from .plant import plant_of
+from .policies import load_shipped, shipped_names
+from .rollout import final_kpis, run_episodes
+from .score import overall_score, row_cost, write_json
+
+ENV_ID = TASKS["full"]
+COMMAND = "supervisor"
+ORACLE_RANGES = {"contact.friction": (0.38, 0.6), "power_return_time": (0.03, 0.07),
+                 "unbalance.angle_deg": (0.0, 360.0)}
+SCENARIO_SEED = 10_000
+SEGMENT_EDGES_MS = (0, 10, 20, 30, 45, 60, 90, 300)
+SEGMENT_ACTIONS = ("damping1", "damping2", "gain", "offset_r1", "offset_t1", "offset_r2",
+                   "offset_t2")
+MAX_DELAY = 0.04            # switch-on delay after the power return: (theta + 1) / 2 x this [s]
+CONTROL_DT = 0.005          # the commands are piecewise constant over >= 10 ms segments
+SHAPING = 0.25
+WHIRL_REVOLUTIONS = 3.0
+
+
+def draw_scenarios(n: int, seed: int = SCENARIO_SEED) -> list[dict]:
+    """``n`` scenario dicts (dotted scene keys and ``power_return_time``) drawn by the Full
+    environment's own sampler from ``ORACLE_RANGES`` and the default ranges."""
+    from .plant import make_env
+    env = make_env(ENV_ID, randomize=True, randomization=dict(ORACLE_RANGES), episode_time=0.01)
+    try:
+        return [on_grid(env.reset(seed=seed + i)[1]["scenario"]) for i in range(n)]
+    finally:
+        env.close()
+
+
+def as_benchmark(values: dict, name: str) -> tuple[Scenario, float]:
+    """The benchmark :class:`Scenario` and unbalance phase of a drawn scenario."""
+    rest = {k: v for k, v in values.items()
+            if k not in ("contact.friction", "unbalance.angle_deg", "power_return_time")}
+    sc = Scenario(name, float(values["contact.friction"]), rest,
+                  env_kwargs={"power_return_time": float(values["power_return_time"])})
+    return sc, float(values["unbalance.angle_deg"])
+
+
+def on_grid(values: dict) -> dict:
+    """``values`` with the power return rounded up to the oracle's control grid (``CONTROL_DT``),
+    as the environment rounds it: every row then sees the power at the same instant, whatever
+    its control step."""
+    steps = np.ceil(values["power_return_time"] / CONTROL_DT - 1e-9)
+    return {**values, "power_return_time": round(float(steps * CONTROL_DT), 12)}
+
+
+def n_params() -> int:
+    return (len(SEGMENT_EDGES_MS) - 1) * len(SEGMENT_ACTIONS) + 1
+
+
+def inner_loop_theta() -> np.ndarray:
+    """The ``inner-loop`` row as a command sequence: C_max, nominal gain, no offsets, no delay."""
+    seg = np.zeros((len(SEGMENT_EDGES_MS) - 1, len(SEGMENT_ACTIONS)))
+    seg[:, :2] = 1.0
+    return np.concatenate([seg.ravel(), [-1.0]])
+
+
+def sequence_actions(thetas: np.ndarray, t: float, power_return: float,
+                     action_names: list[str]) -> np.ndarray:
+    """(n, n_actions) actions at time ``t`` after the fault for the command sequences
+    ``thetas`` (n, :func:`n_params`)."""
+    n_seg = len(SEGMENT_EDGES_MS) - 1
+    seg = min(int(np.searchsorted(SEGMENT_EDGES_MS, 1e3 * t + 1e-9, side="right")) - 1, n_seg - 1)
+    body = thetas[:, :-1].reshape(len(thetas), n_seg, len(SEGMENT_ACTIONS))[:, seg]
+    delay = 0.5 * (thetas[:, -1] + 1.0) * MAX_DELAY
+    a = np.zeros((len(thetas), len(action_names)), dtype=np.float32)
+    for j, name in enumerate(SEGMENT_ACTIONS):
+        a[:, action_names.index(name)] = body[:, j]
+    a[:, action_names.index("levitate")] = np.where(t >= power_return + delay - 1e-9, 1.0, -1.0)
+    return np.clip(a, -1.0, 1.0)
+
+
+def rollout(venv, thetas: np.ndarray, power_return: float) -> list[dict]:
+    """Episode KPIs of each command sequence on the (identical) environments of ``venv``."""
+    names = list(venv.envs[0].action_names)
+    n_steps = venv.envs[0].n_steps
+    dt = venv.envs[0].dt
+    venv.reset()
+    kpis: list[dict] = []
+    for k in range(n_steps):
+        _, _, dones, infos = venv.step(sequence_actions(thetas, k * dt, power_return, names))
+        if k == n_steps - 1:
+            if not dones.all():
+                raise RuntimeError("oracle rollouts must all end at the time limit")
+            kpis = [final_kpis(info) for info in infos]
+    return kpis
+
+
+def kpi_row(k: dict) -> dict:
+    """The benchmark row fields of one episode's KPIs."""
+    return dict(backward_whirl=float(bool(k["backward_whirl"])),
+                peak_contact_force_N=float(k["peak_contact_force_N"]),
+                max_displacement_um=float(k["max_displacement_um"]),
+                relevitated=float(bool(k.get("relevitated"))),
+                relevitation_time_s=(k.get("relevitation_time_s") if k.get("relevitated")
+                                     else None),
+                peak_whirl_revolutions=float(k["peak_whirl_revolutions"]))
+
+
+def episode_cost(row: dict, passive: dict) -> float:
+    return row_cost(row, passive, EPISODE_TIME, True)
+
+
+def search_scenario(sc: Scenario, phase: float, passive: dict, population: int, iterations: int,
+                    seed: int, progress: bool) -> dict:
+    """Cross-entropy search of the command sequence of one scenario (module doc); each
+    generation is one batched rollout of ``population`` identical environments."""
+    from rotordrop_env import BatchedRotorDropVecEnv
+    from .search import cross_entropy
+    entry = Entry("oracle", "full", None, {"command": COMMAND, "control_dt": CONTROL_DT})
+    kw = episode_kwargs(entry, sc, phase)
+    power_return = sc.env_kwargs["power_return_time"]
+    venvs: dict[int, object] = {}
+    seen: dict[bytes, tuple[float, dict]] = {}
+
+    def costs(thetas: np.ndarray) -> list[float]:
+        n = len(thetas)
+        if n not in venvs:
+            venvs[n] = BatchedRotorDropVecEnv(ENV_ID, n, seed=0, **kw)
+        out = []
+        for th, k in zip(thetas, rollout(venvs[n], thetas, power_return)):
+            row = kpi_row(k)
+            j = episode_cost(row, passive)
+            seen[th.tobytes()] = (j, row)
+            out.append(j + SHAPING * min(row["peak_whirl_revolutions"] / WHIRL_REVOLUTIONS, 1.0))
+        return out
+
+    mean = inner_loop_theta()
+    t0 = time.perf_counter()
+    best, theta, history = cross_entropy(
+        costs, mean, np.full(mean.shape, 0.5), -1.0, 1.0, iterations, population,
+        max(2, population // 5), np.random.default_rng(seed), min_std=0.05, progress=progress,
+        desc=f"oracle {sc.name}", batch=True)
+    for v in venvs.values():
+        v.close()
+    key = min(seen, key=lambda k: seen[k][0])           # the lowest true J of every rollout
+    j, row = seen[key]
+    theta = np.frombuffer(key, dtype=float)
+    return dict(theta=theta.tolist(), search_cost=best, J=j, kpis=row,
+                inner_loop_J=seen[mean.tobytes()][0],
+                rollouts=1 + iterations * population, wall_time_s=time.perf_counter() - t0,
+                history=[dict(iteration=h["iteration"], best_cost=h["best_cost"],
+                              generation_best=h["generation_best"]) for h in history])
+
+
+def row_entries(policies: list[str] | None) -> list[Entry]:
+    """Every baseline with channels in the Full task, the shipped Full policies and the
+    ``--policy`` extras (paths or controller classes), as the benchmark builds them."""
+    from .benchmark import _entries, check_unique_names
+    extra, custom = extras(policies or [])
+    loaded = [load_shipped(n) for n in shipped_names()] + extra
+    return check_unique_names([e for e in _entries(loaded, custom) if e.task == "full"])
+
+
+def score_rows(per_scenario: list[dict], names: list[str]) -> list[dict]:
+    """Summary per row (benchmark score over the scenarios, whirl and re-levitation rates)."""
+    passive = [s["rows"]["passive"] for s in per_scenario]
+    p_costs = [r["J"] for r in passive]
+    whirls = [r["backward_whirl"] >= 0.5 for r in passive]
+    table = []
+    for name in names:
+        rows = [s["rows"][name] for s in per_scenario]
+        where = [r["backward_whirl"] for r, w in zip(rows, whirls) if w]
+        table.append(dict(controller=name, score=overall_score([r["J"] for r in rows], p_costs),
+                          whirl_rate=float(np.mean([r["backward_whirl"] for r in rows])),
+                          whirl_rate_where_passive_whirls=float(np.mean(where)) if where else None,
+                          relevitation_rate=float(np.mean([r["relevitated"] for r in rows])),
+                          mean_J=float(np.mean([r["J"] for r in rows]))))
+    table.sort(key=lambda e: -e["score"])
+    return table
+
+
+def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iterations: int = 10,
+           seed: int = 0, policies: list[str] | None = None, progress: bool = True,
+           plots: bool = True, search: bool = True, scenario_seed: int = SCENARIO_SEED) -> dict:
+    """Search the command sequence of each scenario, score every row on the same scenarios and
+    write ``oracle.json`` (and ``oracle.png``) into ``out`` (module doc). ``search=False``
+    scores the rows only (no oracle row): the same comparison on many more scenarios."""
+    from tqdm.auto import tqdm
+    from .score import fmt_or_dash
+    if scenarios < 1 or population < 2 or iterations < 0:
+        raise ValueError(f"need --scenarios >= 1, --population >= 2, --iterations >= 0 (got "
+                         f"{scenarios}, {population}, {iterations})")
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    settings = dict(env_id=ENV_ID, command=COMMAND, scenarios=scenarios, population=population,
+                    iterations=iterations, seed=seed, scenario_seed=SCENARIO_SEED,
+                    ranges={k: list(v) for k, v in ORACLE_RANGES.items()},
+                    segment_edges_ms=list(SEGMENT_EDGES_MS), segment_actions=list(SEGMENT_ACTIONS),
+                    max_delay_s=MAX_DELAY, control_dt=CONTROL_DT, shaping=SHAPING,
+                    episode_time_s=EPISODE_TIME)
+    settings["scenario_seed"] = scenario_seed
+    done = _previous(out / "oracle.json", settings)
+    entries = row_entries(policies)
+    t0 = time.perf_counter()
+    per_scenario = []
+    drawn = draw_scenarios(scenarios, scenario_seed)
+    if not search:
+        done = {}
+    bar = tqdm(total=scenarios, desc="oracle scenarios", unit="sc", disable=not progress)
+    for i, values in enumerate(drawn):
+        sc, phase = as_benchmark(values, f"#{i}")
+        rows = {}
+        for entry in entries:
+            kpis = run_episodes(ENV_ID, entry.make, [0], episode_kwargs(entry, sc, phase))[0].kpis
+            rows[entry.name] = kpi_row(kpis)
+        for row in rows.values():
+            row["J"] = episode_cost(row, rows["passive"])
+        found = None
+        if search:
+            found = done.get(i) or search_scenario(sc, phase, rows["passive"], population,
+                                                   iterations, seed + i, progress)
+            rows["oracle"] = dict(found["kpis"], J=found["J"])
+        per_scenario.append(dict(index=i, scenario=values, rows=rows, search=found))
+        report = _report(settings, per_scenario, [e.name for e in entries], t0, search)
+        write_json(out / "oracle.json", report)              # after every scenario: resumable
+        bar.update(1)
+    bar.close()
+    report["whirl_by_friction"] = whirl_by_friction(report)
+    if plots:
+        report["figures"] = [plot_oracle(report, out / "oracle.png").name,
+                             plot_whirl_by_friction(report, out / "whirl_by_friction.png").name]
+    write_json(out / "oracle.json", report)
+    print(f"{'oracle bound' if search else 'rows'}, {ENV_ID}, {scenarios} scenarios "
+          f"(friction 0.38-0.6, power back 30-70 ms, seeds from {scenario_seed}):")
+    print("| controller | score | whirl rate | whirl where passive whirls | re-levitated |")
+    print("|---|---:|---:|---:|---:|")
+    for e in report["summary"]:
+        print(f"| {e['controller']} | {e['score']:.2f} | {e['whirl_rate']:.2f} | "
+              f"{fmt_or_dash(e['whirl_rate_where_passive_whirls'], '.2f')} | "
+              f"{e['relevitation_rate']:.2f} |")
+    return report
+
+
+def _report(settings: dict, per_scenario: list[dict], names: list[str], t0: float,
+            search: bool = True) -> dict:
+    summary = score_rows(per_scenario, names + (["oracle"] if search else []))
+    learned = {n for n in names if n not in BASELINES}
+    designed = [e for e in summary if e["controller"] in BASELINES and e["controller"] != "passive"]
+    best = designed[0] if designed else None
+    orc = next((e for e in summary if e["controller"] == "oracle"), None)
+    return dict(settings=settings, per_scenario=per_scenario, summary=summary,
+                learned=sorted(learned), best_designed=best["controller"] if best else None,
+                oracle_gain_over_best_designed=(orc["score"] - best["score"]
+                                                if best and orc else None),
+                wall_time_s=time.perf_counter() - t0)
+
+
+def _previous(path: Path, settings: dict) -> dict[int, dict]:
+    """The searches of an earlier run with the same settings, by scenario index."""
+    import json
+    if not path.is_file():
+        return {}
+    try:
+        old = json.loads(path.read_text())
+    except ValueError:
+        return {}
+    if old.get("settings") != settings:
+        return {}
+    return {s["index"]: s["search"] for s in old.get("per_scenario", []) if s.get("search")}
+
+
+def plot_oracle(report: dict, path: Path) -> Path:
+    """Score and whirl rate of every row on the oracle's scenarios (oracle and best designed
+    highlighted), and each scenario's J for passive, best designed, oracle and learned rows."""
+    import matplotlib.pyplot as plt
+    summary = report["summary"]
+    names = [e["controller"] for e in summary]
+    colors = ["tab:red" if n == "oracle" else "tab:green" if n in report["learned"] else
+              "tab:blue" for n in names]
+    fig, axes = plt.subplots(1, 3, figsize=(16, 0.35 * len(names) + 2.5))
+    y = np.arange(len(names))[::-1]
+    axes[0].barh(y, [e["score"] for e in summary], color=colors)
+    axes[0].set(yticks=y, yticklabels=names, xlabel="score (benchmark formula)",
+                title=f"{len(report['per_scenario'])} scenarios, RotorDrop-Full-v0")
+    axes[1].barh(y, [e["whirl_rate"] for e in summary], color=colors)
+    axes[1].set(yticks=y, yticklabels=[], xlabel="backward-whirl rate", xlim=(0, 1))
+    idx = np.arange(len(report["per_scenario"]))
+    show = ["passive", report["best_designed"], *(["oracle"] if "oracle" in names else []),
+            *report["learned"]]
+    for name in dict.fromkeys(n for n in show if n):
+        axes[2].plot(idx, [s["rows"][name]["J"] for s in report["per_scenario"]], "o-", ms=3,
+                     label=name)
+    axes[2].set(xlabel="scenario", ylabel="J (lower is better)", title="cost per scenario")
+    axes[2].legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+FRICTION_BINS = (0.38, 0.44, 0.50, 0.55, 0.60)
+
+
+def whirl_by_friction(report: dict, edges=FRICTION_BINS) -> dict:
+    """Backward-whirl rate of every row per friction bin of the scenarios: {"edges", "counts",
+    "rates": {row: [rate per bin, None where the bin is empty]}}."""
+    mu = np.array([s["scenario"]["contact.friction"] for s in report["per_scenario"]])
+    which = np.clip(np.searchsorted(edges, mu, side="right") - 1, 0, len(edges) - 2)
+    counts = [int(np.sum(which == b)) for b in range(len(edges) - 1)]
+    rates = {}
+    for e in report["summary"]:
+        w = np.array([s["rows"][e["controller"]]["backward_whirl"] for s in report["per_scenario"]])
+        rates[e["controller"]] = [float(w[which == b].mean()) if counts[b] else None
+                                  for b in range(len(edges) - 1)]
+    return dict(edges=list(edges), counts=counts, rates=rates)
+
+
+def plot_whirl_by_friction(report: dict, path: Path) -> Path:
+    """Whirl rate per friction bin of passive, the best designed row, the oracle (if searched)
+    and the learned rows."""
+    import matplotlib.pyplot as plt
+    table = report.get("whirl_by_friction") or whirl_by_friction(report)
+    edges = table["edges"]
+    mid = [0.5 * (a + b) for a, b in zip(edges[:-1], edges[1:])]
+    fig, ax = plt.subplots(figsize=(7, 4))
+    show = ["passive", report["best_designed"], "inner-loop", "oracle", *report["learned"]]
+    for name in dict.fromkeys(n for n in show if n in table["rates"]):
+        rates = [np.nan if r is None else r for r in table["rates"][name]]
+        ax.plot(mid, rates, "o-", label=name)
+    ax.set(xlabel="friction coefficient (bin centre)", ylabel="backward-whirl rate",
+           ylim=(-0.02, 1.02), title="drops per bin: " + ", ".join(str(c) for c in table["counts"]))
+    ax.axhline(0.05, color="k", lw=0.8, ls=":")
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

@@ -1,0 +1,87 @@
+"""``rotordrop oracle``: command sequences of the supervisor interface, their batched rollouts,
+and a search that can only improve on the inner-loop row it starts from."""
+import json
+
+import numpy as np
+import pytest
+
+from agents.benchmark import Entry, episode_kwargs
+from agents.controllers import InnerLoop
+from agents.oracle import (CONTROL_DT, ENV_ID, MAX_DELAY, as_benchmark, draw_scenarios,
+                           inner_loop_theta, kpi_row, n_params, oracle, rollout,
+                           sequence_actions)
+from agents.rollout import run_episodes
+
+NAMES = ["damping1", "damping2", "levitate", "gain", "offset_r1", "offset_t1", "offset_r2",
+         "offset_t2"]
+
+
+def test_sequence_actions_switch_on_after_power_and_delay():
+    theta = np.stack([inner_loop_theta(), inner_loop_theta()])
+    theta[1, -1] = 1.0                                   # the longest switch-on delay
+    before = sequence_actions(theta, 0.029, 0.03, NAMES)
+    after = sequence_actions(theta, 0.03, 0.03, NAMES)
+    late = sequence_actions(theta, 0.03 + MAX_DELAY, 0.03, NAMES)
+    lev = NAMES.index("levitate")
+    assert list(before[:, lev]) == [-1.0, -1.0]
+    assert list(after[:, lev]) == [1.0, -1.0] and list(late[:, lev]) == [1.0, 1.0]
+    np.testing.assert_array_equal(after[:, :2], 1.0)     # C_max
+    np.testing.assert_array_equal(after[:, 3:], 0.0)     # nominal gain, no offsets
+    assert theta.shape[1] == n_params()
+
+
+def test_segments_follow_the_edges():
+    theta = np.zeros((1, n_params()))
+    theta[0, :-1] = np.repeat(np.arange(n_params() - 1) // 7, 1) / 10.0   # segment index / 10
+    for t, seg in ((0.0, 0), (0.0099, 0), (0.01, 1), (0.05, 4), (0.2, 6)):
+        a = sequence_actions(theta, t, 0.05, NAMES)
+        assert a[0, NAMES.index("gain")] == pytest.approx(seg / 10.0), t
+
+
+def test_batched_rollout_of_the_inner_loop_sequence_is_the_inner_loop_row():
+    from rotordrop_env import BatchedRotorDropVecEnv
+    values = draw_scenarios(1)[0]
+    sc, phase = as_benchmark(values, "#0")
+    entry = Entry("inner-loop", "full", InnerLoop,
+                  {"command": "supervisor", "control_dt": CONTROL_DT})
+    kw = episode_kwargs(entry, sc, phase)
+    venv = BatchedRotorDropVecEnv(ENV_ID, 2, seed=0, **kw)
+    rows = [kpi_row(k) for k in rollout(venv, np.stack([inner_loop_theta()] * 2), sc.env_kwargs[
+        "power_return_time"])]
+    ref = kpi_row(run_episodes(ENV_ID, InnerLoop, [0], kw)[0].kpis)
+    assert rows[0] == rows[1] == ref
+
+
+def test_oracle_never_worse_than_its_start_and_resumes(tmp_path):
+    rep = oracle(tmp_path, scenarios=1, population=4, iterations=1, progress=False, plots=False)
+    s = rep["per_scenario"][0]
+    assert s["rows"]["oracle"]["J"] <= s["search"]["inner_loop_J"]
+    # the same commands at a 1 ms control step: the same drop up to the integrator's segments
+    assert s["search"]["inner_loop_J"] == pytest.approx(s["rows"]["inner-loop"]["J"], rel=1e-3)
+    assert s["scenario"]["power_return_time"] * 200 == pytest.approx(
+        round(s["scenario"]["power_return_time"] * 200))                # on the 5 ms grid
+    names = [e["controller"] for e in rep["summary"]]
+    assert {"oracle", "passive", "inner-loop", "whirl-brake-sup", "whirl-brake"} <= set(names)
+    assert next(e for e in rep["summary"] if e["controller"] == "passive")["score"] == 0.0
+    saved = json.loads((tmp_path / "oracle.json").read_text())
+    again = oracle(tmp_path, scenarios=1, population=4, iterations=1, progress=False, plots=False)
+    assert again["per_scenario"][0]["search"] == saved["per_scenario"][0]["search"]     # reused
+
+
+def test_rows_only_on_other_scenarios(tmp_path):
+    rep = oracle(tmp_path, scenarios=2, search=False, scenario_seed=20_000, progress=False,
+                 plots=True)
+    names = [e["controller"] for e in rep["summary"]]
+    assert "oracle" not in names and "inner-loop" in names
+    assert rep["oracle_gain_over_best_designed"] is None
+    assert rep["per_scenario"][0]["scenario"] == draw_scenarios(1, 20_000)[0]
+    assert (tmp_path / "oracle.png").is_file()
+
+
+def test_whirl_by_friction_bins_the_scenarios():
+    from agents.oracle import whirl_by_friction
+    per = [dict(scenario={"contact.friction": mu}, rows={"a": {"backward_whirl": w}})
+           for mu, w in ((0.39, 1.0), (0.40, 0.0), (0.52, 1.0), (0.60, 1.0))]
+    t = whirl_by_friction(dict(per_scenario=per, summary=[{"controller": "a"}]))
+    assert t["counts"] == [2, 0, 1, 1]                  # 0.60 falls in the last bin
+    assert t["rates"]["a"] == [0.5, None, 1.0, 1.0]
