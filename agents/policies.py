@@ -125,15 +125,13 @@ class LearnedPolicy:
         model = algo_class(algo).load(str(model_path), device="cpu")
         task = env_id.split("-")[1].lower() if env_id.count("-") >= 2 else "policy"
         if is_self_contained(model):        # normalisation and residual are inside the zip
-            inside = model.policy.rotordrop
-            return cls(name or meta.get("name") or f"{algo}-{task}", algo, env_id, env_kwargs,
-                       model, None, meta, inside.get("residual"),
-                       float(inside.get("residual_scale") or RESIDUAL_SCALE))
-        vn = _load_stats(model_path, vn_paths, hp.get("normalize", False))
-        residual = hp.get("residual")
-        scale = float(hp.get("residual_scale") or RESIDUAL_SCALE)
+            vn, settings = None, model.policy.rotordrop
+        else:
+            vn, settings = _load_stats(model_path, vn_paths, hp.get("normalize", False)), hp
         return cls(name or meta.get("name") or f"{algo}-{task}", algo, env_id, env_kwargs, model,
-                   vn, meta, residual, scale, source=str(path.resolve()))
+                   vn, meta, settings.get("residual"),
+                   float(settings.get("residual_scale") or RESIDUAL_SCALE),
+                   source=str(path.resolve()))
 
 
 def _reload(source: str, name: str) -> LearnedPolicy:

@@ -55,6 +55,18 @@ def test_a_shipped_zip_acts_under_plain_sb3_as_under_the_project_loader(name):
     assert not np.array_equal(net, plain.policy.network_predict(obs, deterministic=True)[0])
 
 
+
+def test_a_shipped_policy_pickles_as_its_file_and_acts_the_same():
+    """A Ray task of ``rotordrop benchmark --backend ray`` receives the policy pickled as the
+    path it was loaded from (self-contained zips included) and loads it again."""
+    pol = load_shipped("ppo-full")
+    env = gym.make(pol.env_id, **pol.env_kwargs)
+    plant = Plant.from_env(env)
+    again = pickle.loads(pickle.dumps(pol))
+    assert again.source == pol.source and again.residual == pol.residual
+    obs = _episode_obs(env, pol.bound(plant), seeds=(3,), steps=20)
+    assert np.array_equal(again.bound(plant).predict(obs)[0], pol.predict(obs)[0])
+
 def _trained_run(tmp_path, algo, residual=None):
     """A tiny model of ``algo`` with VecNormalize statistics from a few hundred steps."""
     from stable_baselines3.common.env_util import make_vec_env
