@@ -13,6 +13,7 @@ from .model import (I_PLANES, J_HX, J_SX, N_PLANE_IDX, P_G, P_HALF_PLAY,
                     AMB_LINEAR, S_PHI, S_VX, S_X, S_W, Model, AMB_ACTUATOR, AMB_AXES, I_AMB_INT,
                     I_AMB_FILT, I_AMB_COIL, P_AMB_IFF1, I_CS, I_THERM)
 from .amb import actuator_constants, pid_dynamic_stiffness, pid_steady_states
+from .roots import bisect_decreasing
 from .rotor import steady_unbalance_orbit
 
 
@@ -27,14 +28,8 @@ def sleeve_rest_offset(P: np.ndarray, I: np.ndarray) -> float:
     def lift(uy):                       # upward bearing force on the inner ring
         return -ball_forces(0.0, uy, 0.0, int(P[P_NB]), P[P_HALF_PLAY], 0.0, P[P_KTOT])[1]
 
-    lo, hi = -P[P_HALF_PLAY] - 1e-3, 0.0    # lift(lo) >> weight, lift(0) = 0
-    for _ in range(200):                # bisection: robust for the clearance kink
-        mid = 0.5 * (lo + hi)
-        if lift(mid) > weight:
-            lo = mid
-        else:
-            hi = mid
-    return 0.5 * (lo + hi)
+    # lift(lo) >> weight, lift(0) = 0; bisection is robust for the clearance kink
+    return bisect_decreasing(lift, weight, -P[P_HALF_PLAY] - 1e-3, 0.0)
 
 
 def levitated_state(model: Model) -> np.ndarray:

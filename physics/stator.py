@@ -19,6 +19,7 @@ import math
 
 from ._jit import njit
 from .contact import geometry, smooth_sign
+from .roots import bisect_decreasing
 
 
 def restitution_of_damping(zeta: float) -> float:
@@ -37,14 +38,7 @@ def damping_ratio(e: float) -> float:
     strictly decreasing in ζ from 1 at ζ = 0 to 0 as ζ → 1)."""
     if e >= 1.0:
         return 0.0
-    lo, hi = 0.0, 1.0 - 1e-12
-    for _ in range(200):
-        mid = 0.5 * (lo + hi)
-        if restitution_of_damping(mid) > e:
-            lo = mid
-        else:
-            hi = mid
-    return 0.5 * (lo + hi)
+    return bisect_decreasing(restitution_of_damping, e, 0.0, 1.0 - 1e-12)
 
 
 def damping_coefficient(stiffness: float, mass: float, e: float) -> float:
