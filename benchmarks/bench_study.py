@@ -1,6 +1,7 @@
 """Ensemble speed: `rotordrop study paper` against its floor, one drop's cost times its drops.
 
     python benchmarks/bench_study.py [--quick] [--repeats 5] [--sample 40] [--json out.json]
+    python benchmarks/bench_study.py --quick --cores 1,2 [--rounds 3]     # speed-up 1 -> 2 cores
 
 Study ratio = study wall time / (simulated seconds of all its drops x one drop's wall time per
 simulated second / cores), all measured in this run:
@@ -15,6 +16,10 @@ simulated second / cores), all measured in this run:
 * cores: the CPUs this process may use;
 * by CPU time: the study's CPU seconds (all threads) over its drops' integration CPU seconds
   (the sample's mean per drop times the drops): the overhead alone, whatever the load.
+
+``--cores 1,2``: instead, the study's wall time on 1 and on 2 threads (``--jobs``), the runs
+interleaved over ``--rounds`` rounds, medians and the speed-up (on a machine shared with other
+work the second core is only as free as the load average, printed before and after, says).
 
 Ratio 1 is the study at the cost of its drops' integration alone, perfectly parallel; what is
 above it is the output sampling, diagnostics, metrics, figures and threading. The CPU time per
@@ -71,6 +76,28 @@ def sample_rate(runs, k: int) -> tuple[float, dict]:
     return statistics.fmean(rates), {k: statistics.fmean(v) for k, v in parts.items()}
 
 
+def core_scaling(quick: bool, cores: list[int], rounds: int) -> dict:
+    """Wall seconds of the whole study on each thread count of ``cores``, interleaved over
+    ``rounds`` (the order alternates); medians and the speed-up over the first count."""
+    walls: dict[int, list[float]] = {c: [] for c in cores}
+    print(f"{'quick' if quick else 'full'} paper study on {', '.join(map(str, cores))} threads, "
+          f"{rounds} interleaved rounds; {load()}")
+    for k in range(rounds):
+        for c in (cores if k % 2 == 0 else cores[::-1]):
+            t0 = time.perf_counter()
+            with tempfile.TemporaryDirectory() as out:
+                run_paper_study("paper", {}, out, quick=quick, jobs=c, progress=False)
+            walls[c].append(time.perf_counter() - t0)
+            print(f"  round {k + 1}, {c} thread(s): {walls[c][-1]:.1f} s; {load()}", flush=True)
+    med = {c: statistics.median(w) for c, w in walls.items()}
+    base = cores[0]
+    for c in cores:
+        print(f"{c} thread(s): median {med[c]:.1f} s, speed-up over {base}: "
+              f"{med[base] / med[c]:.2f}x (runs: {', '.join(f'{w:.1f}' for w in walls[c])})")
+    return dict(walls=walls, median=med, speedup={c: med[base] / med[c] for c in cores},
+                load_after=os.getloadavg())
+
+
 def load() -> str:
     return "load average " + ", ".join(f"{x:.2f}" for x in os.getloadavg())
 
@@ -81,9 +108,20 @@ def main() -> None:
     ap.add_argument("--repeats", type=int, default=5, help="paper drops before and after")
     ap.add_argument("--sample", type=int, default=40, help="study drops run one at a time")
     ap.add_argument("--json", default=None)
+    ap.add_argument("--keep", default=None, metavar="DIR",
+                    help="write the study there (study.json, report, drops) instead of a temporary folder")
+    ap.add_argument("--cores", default=None, help="e.g. 1,2: the study's speed-up from 1 to 2 "
+                    "threads instead of its ratio")
+    ap.add_argument("--rounds", type=int, default=3, help="interleaved rounds of --cores")
     args = ap.parse_args()
     paper = load_scene("paper")
     warm_up(build_model(paper))
+    if args.cores:
+        res = core_scaling(args.quick, [int(c) for c in args.cores.split(",")], args.rounds)
+        if args.json:
+            with open(args.json, "w") as f:
+                json.dump(res, f, indent=2)
+        return
     base = StudyInput("paper", {})
     runs = plan_runs(Plan.make(args.quick), base)
     sim_s = sum(r.to_scene().solver.t_end for r in runs)
@@ -93,8 +131,8 @@ def main() -> None:
 
     before = drop_rate(paper, args.repeats)
     t0, c0 = time.perf_counter(), time.process_time()
-    with tempfile.TemporaryDirectory() as out:
-        run_paper_study("paper", {}, out, quick=args.quick, progress=False)
+    with tempfile.TemporaryDirectory() as tmp:
+        run_paper_study("paper", {}, args.keep or tmp, quick=args.quick, progress=False)
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     after = drop_rate(paper, args.repeats)
     mix, parts = sample_rate(runs, max(1, len(runs) // args.sample))

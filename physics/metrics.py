@@ -52,11 +52,11 @@ def whirl(result: Result, plane: str, after: float) -> dict:
     WHIRL_MIN_REVOLUTIONS net backward revolutions; its frequency is the backward angular rate
     over the samples that counted. Also reports the mean orbit angular momentum sign.
     """
-    sel = result.t >= after
+    i = int(np.searchsorted(result.t, after, "left"))       # the samples t >= after (a suffix)
     e = result.orbit_after(plane, after, relative=True)
-    t = result.t[sel]
+    t = result.t[i:]
     c = result.model.scene.contact.clearance
-    spin = np.sign(result.rotor_speed[sel].mean()) or 1.0
+    spin = np.sign(result.rotor_speed[i:].mean()) or 1.0
     r = result.radius_after(plane, after, relative=True)
     ang = np.arctan2(e[:, 1], e[:, 0])
     far = r > WHIRL_RADIUS_FRACTION * c
