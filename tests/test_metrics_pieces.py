@@ -64,3 +64,27 @@ def test_the_sensitivity_drops_skip_only_their_observables(whirling):
     assert a.extra == drop_observables(whirling) and a.extra["max_x_um"] > 0.0 and b.extra == {}
     drop_timing = lambda m: {k: v for k, v in m.items() if k not in ("wall_time_s", "compile_time_s")}
     assert drop_timing(a.metrics) == drop_timing(b.metrics) == drop_timing(compute_metrics(whirling))
+
+
+def test_the_bisection_stops_early_with_the_result_of_all_its_iterations():
+    """bisect_decreasing (the sleeve's rest offset, the stator's damping ratio) leaves the loop
+    once the bracket stops moving: the root is bit for bit that of the 200 iterations."""
+    from physics.roots import bisect_decreasing
+
+    def all_iterations(f, target, lo, hi):
+        for _ in range(200):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if f(mid) > target else (lo, mid)
+        return 0.5 * (lo + hi)
+
+    for a in (0.3, 1.0, 7.0):
+        for target in (-2.0, 0.0, 1e-9, 3.0, -(a * 0.5 ** 3 + 0.5)):   # the last one hit exactly
+            calls = []
+
+            def f(x, a=a):
+                calls.append(x)
+                return -a * x ** 3 - x
+            root = bisect_decreasing(f, target, -10.0, 10.0)
+            # it stopped early (a root at 0 moves on through the denormals for all 200)
+            assert len(calls) < 100 or target == 0.0
+            assert root == all_iterations(f, target, -10.0, 10.0)
