@@ -34,7 +34,7 @@ class Result:
     # after the fault, per plane (RB1, RB2): the contact force, bearing load and largest ball load
     # at every accepted integrator step (physics.integrate.P_*), whatever the output rate
     step_peaks: np.ndarray | None = None
-    _axes: dict = field(default_factory=dict, init=False, repr=False, compare=False)  # _memo's
+    _derived: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     # -- rotor ----------------------------------------------------------------------------
     def state(self, name: str) -> np.ndarray:
@@ -88,11 +88,12 @@ class Result:
         return self._memo(("radius", plane, t0, relative), radius)
 
     def _memo(self, key, compute) -> np.ndarray:
-        if key not in self._axes:
+        """``compute()`` once per result and ``key``, kept read-only (derived time series)."""
+        if key not in self._derived:
             a = compute()
             a.flags.writeable = False
-            self._axes[key] = a
-        return self._axes[key]
+            self._derived[key] = a
+        return self._derived[key]
 
     def orbit_velocity(self, plane: str) -> np.ndarray:
         return self._axis(self.model.P[P_Z_RB1 + self._plane(plane)], offset=4)
