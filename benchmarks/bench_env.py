@@ -12,12 +12,15 @@ a machine shared with other jobs) or by the wall clock (``--clock wall``).
   env (no action) and the damping env (uniform random actions, seeded), for the paper scene as
   it is (mu = 0.25: drop, bounces, no whirl) and at mu = 0.5, which whirls backward (run on
   through the whirl with ``terminate_on_failure=False``; the physics is costliest there);
-* cost split (passive env, same trajectory): physics alone (``integrate_segment`` over each
-  1 ms step, in one compiled loop), the step kernel (physics + sub-sampled monitors, reward,
-  observation), the Python ``step`` and Gymnasium's wrappers;
+* cost split (passive and damping env, each on one trajectory: the damping env's random actions
+  are replayed as the controls they set): physics alone (``integrate_segment`` over each 1 ms
+  step, in one compiled loop), the step kernel (physics + sub-sampled monitors, reward,
+  observation), the Python ``step`` and Gymnasium's wrappers, and the physics' share;
 * batched: ``BatchedRotorDropVecEnv`` with N envs of the damping env, with 1 numba thread (the
-  per-core figure) and with all threads; and with its default threads (chosen as it runs) over
-  one thread, N = 1 and N = ``--n-envs``, by the wall clock, runs interleaved.
+  per-core figure) and with all threads, next to the Amdahl bound of batching from the damping
+  env's split (``gym.make`` step over physics: nothing but the physics left; over the kernel
+  call: the Python part removed); and with its default threads (chosen as it runs) over one
+  thread, N = 1 and N = ``--n-envs``, by the wall clock, runs interleaved.
 """
 from __future__ import annotations
 
