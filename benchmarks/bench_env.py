@@ -12,12 +12,15 @@ a machine shared with other jobs) or by the wall clock (``--clock wall``).
   env (no action) and the damping env (uniform random actions, seeded), for the paper scene as
   it is (mu = 0.25: drop, bounces, no whirl) and at mu = 0.5, which whirls backward (run on
   through the whirl with ``terminate_on_failure=False``; the physics is costliest there);
-* cost split (passive env, same trajectory): physics alone (``integrate_segment`` over each
-  1 ms step, in one compiled loop), the step kernel (physics + sub-sampled monitors, reward,
-  observation), the Python ``step`` and Gymnasium's wrappers;
+* cost split (passive and damping env, each on one trajectory: the damping env's random actions
+  are replayed as the controls they set): physics alone (``integrate_segment`` over each 1 ms
+  step, in one compiled loop), the step kernel (physics + sub-sampled monitors, reward,
+  observation), the Python ``step`` and Gymnasium's wrappers, and the physics' share;
 * batched: ``BatchedRotorDropVecEnv`` with N envs of the damping env, with 1 numba thread (the
-  per-core figure) and with all threads; and with its default threads (chosen as it runs) over
-  one thread, N = 1 and N = ``--n-envs``, by the wall clock, runs interleaved.
+  per-core figure) and with all threads, next to the Amdahl bound of batching from the damping
+  env's split (``gym.make`` step over physics: nothing but the physics left; over the kernel
+  call: the Python part removed); and with its default threads (chosen as it runs) over one
+  thread, N = 1 and N = ``--n-envs``, by the wall clock, runs interleaved.
 """
 from __future__ import annotations
 
@@ -67,68 +70,82 @@ def single_env_rate(env_id: str, kwargs: dict, episodes: int, unwrapped: bool, s
     return run
 
 
-def passive_split(kwargs: dict, episodes: int):
-    """Per-step microseconds of physics, kernel, unwrapped step and wrapped step (passive env)."""
-    env = gym.make("RotorDrop-Passive-v0", **kwargs)
+def cost_split(env_id: str, kwargs: dict, episodes: int, seed: int = 0):
+    """Per-step microseconds of physics, kernel, unwrapped step and wrapped step of ``env_id``
+    on one trajectory (the passive env without action; others with seeded uniform random
+    actions, the same in every part). The physics replays the controls ``U`` each step of the
+    episode left in the kernel, so it integrates the very trajectory the env steps."""
+    env = gym.make(env_id, **kwargs)
     u = env.unwrapped
-    a = np.zeros(1, dtype=np.float32)
+    space = env.action_space
+    space.seed(seed)
+    passive = env_id == "RotorDrop-Passive-v0"
+    acts = [np.zeros(space.shape, dtype=space.dtype) if passive else space.sample()
+            for _ in range(4096)]
 
     def per_step(fn):
         def run():
             steps, total = 0, 0.0
             for _ in range(episodes):
-                env.reset(seed=0)
+                env.reset(seed=seed)
                 t0 = CLOCK()
                 done = False
                 while not done:
-                    done = fn()
+                    done = fn(acts[steps % len(acts)])
                     steps += 1
                 total += CLOCK() - t0
             return total / steps * 1e6
         return run
 
-    def kernel_step():
+    def kernel_step(a):
+        u._b.act[:] = a
         K.step_one(*u._args)
         return bool(u._b.out[K.O_TERM] or u._b.out[K.O_TRUNC])
 
-    def unwrapped_step():
+    def unwrapped_step(a):
         _, _, te, tr, _ = u.step(a)
         return te or tr
 
-    def wrapped_step():
+    def wrapped_step(a):
         _, _, te, tr, _ = env.step(a)
         return te or tr
 
-    env.reset(seed=0)
-    n_steps = 1
-    while not kernel_step():                # episode length (it may end at the stator)
-        n_steps += 1
+    env.reset(seed=seed)                    # the controls of each step of one episode
+    controls = []
+    while True:
+        done = kernel_step(acts[len(controls) % len(acts)])
+        controls.append(u._b.U.copy())
+        if done:
+            break
+    controls = np.array(controls)
 
     def physics():
-        env.reset(seed=0)
+        env.reset(seed=seed)
         b = u._b
-        y, U = b.y.copy(), b.U.copy()
+        y = b.y.copy()
         sv = u.scene.solver
         work = np.empty((9, y.size))
         t0 = CLOCK()
-        status = _physics_loop(y, b.M[K.M_T], u.dt, n_steps, b.P, b.I, U, sv.rtol, b.atol,
+        status = _physics_loop(y, b.M[K.M_T], u.dt, controls, b.P, b.I, sv.rtol, b.atol,
                                b.M[K.M_H], sv.max_step, sv.min_step, work)
         elapsed = CLOCK() - t0
         assert status == 0
-        return elapsed / n_steps * 1e6
+        return elapsed / len(controls) * 1e6
 
     return dict(physics=physics, kernel=per_step(kernel_step), unwrapped=per_step(unwrapped_step),
                 wrapped=per_step(wrapped_step))
 
 
 @njit
-def _physics_loop(y, t, dt, n, P, I, U, rtol, atol, h, h_max, h_min, work):
-    """The physics alone: n control steps of integrate_segment in one compiled call."""
+def _physics_loop(y, t, dt, controls, P, I, rtol, atol, h, h_max, h_min, work):
+    """The physics alone: a control step of integrate_segment per row of ``controls`` (the
+    U of each step), in one compiled call."""
     no_t = np.empty(0)
     no_Y = np.empty((0, y.shape[0]))
-    for _ in range(n):
-        status, _, h, _, _, _, _ = integrate_segment(y, t, t + dt, P, I, U, rtol, atol, h, h_max,
-                                                     h_min, False, 10**9, no_t, no_Y, 0, work)
+    for k in range(controls.shape[0]):
+        status, _, h, _, _, _, _ = integrate_segment(y, t, t + dt, P, I, controls[k], rtol, atol,
+                                                     h, h_max, h_min, False, 10**9, no_t, no_Y, 0,
+                                                     work)
         if status != 0:
             return status
         t += dt
@@ -167,6 +184,19 @@ def default_vs_one_thread(env_id: str, kwargs: dict, n_envs: int, steps: int, re
             statistics.median(o for _, o in pairs))
 
 
+def _print_split(env_id: str, split: dict) -> None:
+    print(f"  cost split of one {env_id} step [µs] (same trajectory):")
+    print(f"    physics (integrate_segment)        {split['physics']:8.1f}")
+    print(f"    + monitors, reward, obs (kernel)   {split['kernel'] - split['physics']:8.1f}"
+          f"   (kernel call {split['kernel']:.1f})")
+    print(f"    + Python step()                    {split['unwrapped'] - split['kernel']:8.1f}"
+          f"   (env.unwrapped.step {split['unwrapped']:.1f})")
+    print(f"    + Gymnasium wrappers               {split['wrapped'] - split['unwrapped']:8.1f}"
+          f"   (gym.make env.step {split['wrapped']:.1f})")
+    print(f"    physics share of env.step: {100 * split['physics'] / split['wrapped']:.0f} %, "
+          f"compiled kernel share {100 * split['kernel'] / split['wrapped']:.0f} %")
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--repeats", type=int, default=3)
@@ -199,22 +229,18 @@ def main(argv=None) -> int:
                 key = f"{label}: {env_id}{' unwrapped' if unwrapped else ''}"
                 res[key + " steps/s"] = rate
                 print(f"  {env_id + (' unwrapped' if unwrapped else ''):36s} {rate:10.0f} steps/s")
-        split = {k: _median(fn, R) for k, fn in passive_split(kw, E).items()}
-        res[f"{label}: passive per-step us"] = split
-        print("  cost split of one passive step [µs] (same trajectory):")
-        print(f"    physics (integrate_segment)        {split['physics']:8.1f}")
-        print(f"    + monitors, reward, obs (kernel)   {split['kernel'] - split['physics']:8.1f}"
-              f"   (kernel call {split['kernel']:.1f})")
-        print(f"    + Python step()                    {split['unwrapped'] - split['kernel']:8.1f}"
-              f"   (env.unwrapped.step {split['unwrapped']:.1f})")
-        print(f"    + Gymnasium wrappers               {split['wrapped'] - split['unwrapped']:8.1f}"
-              f"   (gym.make env.step {split['wrapped']:.1f})")
-        print(f"    physics share of env.step: {100 * split['physics'] / split['wrapped']:.0f} %")
+        for env_id in ("RotorDrop-Passive-v0", "RotorDrop-Damping-v0"):
+            split = {k: _median(fn, R) for k, fn in cost_split(env_id, kw, E).items()}
+            res[f"{label}: {env_id} per-step us"] = split
+            _print_split(env_id, split)
 
     n, steps = args.n_envs, 600
     single = res[f"{cases[0][0]}: RotorDrop-Damping-v0 steps/s"]
     print(f"batched VecEnv, N = {n}, RotorDrop-Damping-v0 (paper scene), random actions, "
           f"{steps} batch steps:")
+    split = res[f"{cases[0][0]}: RotorDrop-Damping-v0 per-step us"]
+    bound = dict(physics=split["wrapped"] / split["physics"], kernel=split["wrapped"] / split["kernel"])
+    res["batching bound per core (Amdahl)"] = bound
     for threads in sorted({1, numba.config.NUMBA_NUM_THREADS}):
         rate = _median(batched_rate("RotorDrop-Damping-v0", kwargs, n, steps, threads), R)
         per_core = rate if args.clock == "cpu" else rate / threads
@@ -222,6 +248,9 @@ def main(argv=None) -> int:
         print(f"  {threads} thread(s): {per_core:10.0f} env steps/s per core "
               f"({per_core / single:.2f}x the single env)"
               + ("" if args.clock == "cpu" else f", {rate:.0f} env steps/s in all"))
+    print(f"  bound per core (Amdahl, the damping env's split above, mu = 0.25): batching can "
+          f"remove at most the non-physics share of a step, {bound['physics']:.2f}x; it keeps the "
+          f"compiled monitors, reward and observation too, {bound['kernel']:.2f}x")
     print(f"batched VecEnv with default threads (chosen as it runs) over one thread, wall clock, "
           f"runs interleaved (median of {R}):")
     for n_b in sorted({1, n}):

@@ -1,6 +1,7 @@
 """Ensemble speed: `rotordrop study paper` against its floor, one drop's cost times its drops.
 
     python benchmarks/bench_study.py [--quick] [--repeats 5] [--sample 40] [--json out.json]
+    python benchmarks/bench_study.py --quick --cores 1,2 [--rounds 3]     # speed-up 1 -> 2 cores
 
 Study ratio = study wall time / (simulated seconds of all its drops x one drop's wall time per
 simulated second / cores), all measured in this run:
@@ -13,8 +14,13 @@ simulated second / cores), all measured in this run:
   the study itself (every k-th, run one at a time), which carries its mix of whirling drops
   (costlier per simulated second) and calm ones;
 * cores: the CPUs this process may use;
-* by CPU time: the study's CPU seconds (all threads) over its drops' integration CPU seconds
-  (the sample's mean per drop times the drops): the overhead alone, whatever the load.
+* by CPU time: the study's CPU seconds (all threads) over its drops' integration CPU seconds,
+  summed over every drop the study runs (:class:`IntegrationMeter`), and over the sample's mean
+  per drop times the drops: the overhead alone, whatever the load.
+
+``--cores 1,2``: instead, the study's wall time on 1 and on 2 threads (``--jobs``), the runs
+interleaved over ``--rounds`` rounds, medians and the speed-up (on a machine shared with other
+work the second core is only as free as the load average, printed before and after, says).
 
 Ratio 1 is the study at the cost of its drops' integration alone, perfectly parallel; what is
 above it is the output sampling, diagnostics, metrics, figures and threading. The CPU time per
@@ -24,10 +30,12 @@ with other work the ratio rises with the load (``uptime`` is printed).
 from __future__ import annotations
 
 import argparse
+import importlib
 import json
 import os
 import statistics
 import tempfile
+import threading
 import time
 
 from physics import load_scene, simulate
@@ -71,6 +79,55 @@ def sample_rate(runs, k: int) -> tuple[float, dict]:
     return statistics.fmean(rates), {k: statistics.fmean(v) for k, v in parts.items()}
 
 
+def core_scaling(quick: bool, cores: list[int], rounds: int) -> dict:
+    """Wall seconds of the whole study on each thread count of ``cores``, interleaved over
+    ``rounds`` (the order alternates); medians and the speed-up over the first count."""
+    walls: dict[int, list[float]] = {c: [] for c in cores}
+    used: dict[int, list[float]] = {c: [] for c in cores}     # CPU s / wall s: cores it got
+    print(f"{'quick' if quick else 'full'} paper study on {', '.join(map(str, cores))} threads, "
+          f"{rounds} interleaved rounds; {load()}")
+    for k in range(rounds):
+        for c in (cores if k % 2 == 0 else cores[::-1]):
+            t0, c0 = time.perf_counter(), time.process_time()
+            with tempfile.TemporaryDirectory() as out:
+                run_paper_study("paper", {}, out, quick=quick, jobs=c, progress=False)
+            walls[c].append(time.perf_counter() - t0)
+            used[c].append((time.process_time() - c0) / walls[c][-1])
+            print(f"  round {k + 1}, {c} thread(s): {walls[c][-1]:.1f} s, {used[c][-1]:.2f} cores "
+                  f"busy on average; {load()}", flush=True)
+    med = {c: statistics.median(w) for c, w in walls.items()}
+    base = cores[0]
+    for c in cores:
+        print(f"{c} thread(s): median {med[c]:.1f} s, speed-up over {base}: "
+              f"{med[base] / med[c]:.2f}x (runs: {', '.join(f'{w:.1f}' for w in walls[c])})")
+    return dict(walls=walls, cores_busy=used, median=med,
+                speedup={c: med[base] / med[c] for c in cores},
+                load_after=os.getloadavg())
+
+
+class IntegrationMeter:
+    """While active, sums the integration CPU time (``RunStats.cpu_time_s``) of every drop run in
+    this process, by wrapping :func:`physics.simulate.run_model` (what every drop of a study runs,
+    on any thread): the study's own integration, measured in the study itself."""
+
+    def __enter__(self) -> "IntegrationMeter":
+        self.module = importlib.import_module("physics.simulate")
+        self.original = self.module.run_model
+        self.cpu, self.drops, lock = 0.0, 0, threading.Lock()
+
+        def run_model(*args, **kwargs):
+            result = self.original(*args, **kwargs)
+            with lock:
+                self.cpu += result.stats.cpu_time_s
+                self.drops += 1
+            return result
+        self.module.run_model = run_model
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.module.run_model = self.original
+
+
 def load() -> str:
     return "load average " + ", ".join(f"{x:.2f}" for x in os.getloadavg())
 
@@ -81,9 +138,20 @@ def main() -> None:
     ap.add_argument("--repeats", type=int, default=5, help="paper drops before and after")
     ap.add_argument("--sample", type=int, default=40, help="study drops run one at a time")
     ap.add_argument("--json", default=None)
+    ap.add_argument("--keep", default=None, metavar="DIR",
+                    help="write the study there (study.json, report, drops) instead of a temporary folder")
+    ap.add_argument("--cores", default=None, help="e.g. 1,2: the study's speed-up from 1 to 2 "
+                    "threads instead of its ratio")
+    ap.add_argument("--rounds", type=int, default=3, help="interleaved rounds of --cores")
     args = ap.parse_args()
     paper = load_scene("paper")
     warm_up(build_model(paper))
+    if args.cores:
+        res = core_scaling(args.quick, [int(c) for c in args.cores.split(",")], args.rounds)
+        if args.json:
+            with open(args.json, "w") as f:
+                json.dump(res, f, indent=2)
+        return
     base = StudyInput("paper", {})
     runs = plan_runs(Plan.make(args.quick), base)
     sim_s = sum(r.to_scene().solver.t_end for r in runs)
@@ -93,8 +161,8 @@ def main() -> None:
 
     before = drop_rate(paper, args.repeats)
     t0, c0 = time.perf_counter(), time.process_time()
-    with tempfile.TemporaryDirectory() as out:
-        run_paper_study("paper", {}, out, quick=args.quick, progress=False)
+    with tempfile.TemporaryDirectory() as tmp, IntegrationMeter() as meter:
+        run_paper_study("paper", {}, args.keep or tmp, quick=args.quick, progress=False)
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     after = drop_rate(paper, args.repeats)
     mix, parts = sample_rate(runs, max(1, len(runs) // args.sample))
@@ -105,7 +173,8 @@ def main() -> None:
                ratio_paper_drop=wall / (sim_s * one / cores),
                ratio_study_mix=wall / (sim_s * mix / cores), cpu_per_drop_s=parts,
                study_cpu_s=cpu, ratio_cpu=cpu / (len(runs) * parts["integration"]),
-               load=os.getloadavg())
+               study_integration_cpu_s=meter.cpu, study_integrated_drops=meter.drops,
+               ratio_cpu_in_study=cpu / meter.cpu, load=os.getloadavg())
     print(f"study wall {wall:.1f} s; one paper drop {one * 1e3:.1f} ms per simulated s "
           f"(before {statistics.median(before) * 1e3:.1f}, after {statistics.median(after) * 1e3:.1f});"
           f" the study's own drops one at a time {mix * 1e3:.1f} ms per simulated s")
@@ -114,8 +183,9 @@ def main() -> None:
         f"{k} {v * 1e3:.1f} ms ({v / base:.2f})" for k, v in parts.items()))
     print(f"study ratio {res['ratio_paper_drop']:.2f} (vs the paper drop), "
           f"{res['ratio_study_mix']:.2f} (vs the study's own drops); by CPU time (all threads, "
-          f"robust to load): {res['ratio_cpu']:.2f} (study CPU {cpu:.0f} s over its drops' "
-          f"integration); {load()}")
+          f"robust to load): {res['ratio_cpu_in_study']:.2f} (study CPU {cpu:.0f} s over the "
+          f"integration CPU of the {meter.drops} drops it ran, {meter.cpu:.0f} s, summed in the "
+          f"study), {res['ratio_cpu']:.2f} (over the sample's mean per drop); {load()}")
     if args.json:
         with open(args.json, "w") as f:
             json.dump(res, f, indent=2)

@@ -52,17 +52,16 @@ def whirl(result: Result, plane: str, after: float) -> dict:
     WHIRL_MIN_REVOLUTIONS net backward revolutions; its frequency is the backward angular rate
     over the samples that counted. Also reports the mean orbit angular momentum sign.
     """
-    sel = result.t >= after
-    e = (result.orbit(plane) - result.sleeve(plane))[sel]
-    t = result.t[sel]
+    i = int(np.searchsorted(result.t, after, "left"))       # the samples t >= after (a suffix)
+    e = result.orbit_after(plane, after, relative=True)
+    t = result.t[i:]
     c = result.model.scene.contact.clearance
-    spin = np.sign(result.rotor_speed[sel].mean()) or 1.0
-    r = np.hypot(e[:, 0], e[:, 1])
+    spin = np.sign(result.rotor_speed[i:].mean()) or 1.0
+    r = result.radius_after(plane, after, relative=True)
     ang = np.arctan2(e[:, 1], e[:, 0])
     far = r > WHIRL_RADIUS_FRACTION * c
     both = far[1:] & far[:-1]
-    dang = (np.diff(ang) + np.pi) % (2 * np.pi) - np.pi
-    dang = dang[both]
+    dang = (np.diff(ang)[both] + np.pi) % (2 * np.pi) - np.pi
     backward_rad = -spin * dang.sum()
     revs = backward_rad / (2 * np.pi)
     dt = np.diff(t)[both]
@@ -364,10 +363,10 @@ def compute_metrics(result: Result) -> dict:
                rejected_steps=result.stats.rejected_steps, n_state=result.model.n_state, planes={})
     pre = pre_fault(result)
     for p in PLANES:
-        o = result.orbit(p)[post]
+        o = result.orbit_after(p, t_fault)
         force = result.contact_force(p)
         f, f_pre = force[post], force[pre]
-        disp = np.hypot(o[:, 0], o[:, 1]) if len(o) else np.zeros(1)
+        disp = result.radius_after(p, t_fault) if len(o) else np.zeros(1)
         entry = dict(max_displacement_um=float(disp.max() * 1e6),
                      max_y_displacement_um=float(np.abs(o[:, 1]).max() * 1e6) if len(o) else 0.0,
                      peak_contact_force_N=float(f.max()) if len(f) else 0.0,

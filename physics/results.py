@@ -34,7 +34,7 @@ class Result:
     # after the fault, per plane (RB1, RB2): the contact force, bearing load and largest ball load
     # at every accepted integrator step (physics.integrate.P_*), whatever the output rate
     step_peaks: np.ndarray | None = None
-    _axes: dict = field(default_factory=dict, init=False, repr=False, compare=False)
+    _derived: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     # -- rotor ----------------------------------------------------------------------------
     def state(self, name: str) -> np.ndarray:
@@ -57,13 +57,9 @@ class Result:
     def _axis(self, z: float, offset: int = 0) -> np.ndarray:
         """Rotor axis (x + z a, y + z b) at axial station z; offset 4: its velocity. Computed
         once per station (the metrics ask several times), read-only."""
-        key = (z, offset)
-        if key not in self._axes:
-            i = self.model.I[S_X] + offset
-            a = np.stack([self.Y[:, i] + z * self.Y[:, i + 2], self.Y[:, i + 1] + z * self.Y[:, i + 3]], 1)
-            a.flags.writeable = False
-            self._axes[key] = a
-        return self._axes[key]
+        i = self.model.I[S_X] + offset
+        return self._memo((z, offset), lambda: np.stack(
+            [self.Y[:, i] + z * self.Y[:, i + 2], self.Y[:, i + 1] + z * self.Y[:, i + 3]], 1))
 
     def orbit(self, plane: str) -> np.ndarray:
         """Rotor axis position (x, y) at a retainer plane, relative to the nominal centre [m]."""
@@ -73,6 +69,31 @@ class Result:
         """Rotor axis position (x, y) at AMB plane ``AMB1``/``AMB2`` [m], relative to the stator
         centre: what the environments check against the stator (``amb.air_gap``)."""
         return self._axis(self.model.P[P_Z_AMB1 + self._plane(plane, AMB_PLANES)])
+
+    def orbit_after(self, plane: str, t0: float, relative: bool = False) -> np.ndarray:
+        """:meth:`orbit` at the samples t >= ``t0`` (``relative``: minus :meth:`sleeve`, the
+        rotor in its sleeve's gap), computed once per result (the metrics and the study's
+        observables read the same pieces), read-only."""
+        def piece():                    # t is increasing: the samples t >= t0 are a suffix
+            i = int(np.searchsorted(self.t, t0, "left"))
+            o = self.orbit(plane)[i:]
+            return o - self.sleeve(plane)[i:] if relative else o
+        return self._memo(("orbit", plane, t0, relative), piece)
+
+    def radius_after(self, plane: str, t0: float, relative: bool = False) -> np.ndarray:
+        """The radius |(x, y)| of :meth:`orbit_after` (``np.hypot``), computed once per result."""
+        def radius():
+            o = self.orbit_after(plane, t0, relative)
+            return np.hypot(o[:, 0], o[:, 1])
+        return self._memo(("radius", plane, t0, relative), radius)
+
+    def _memo(self, key, compute) -> np.ndarray:
+        """``compute()`` once per result and ``key``, kept read-only (derived time series)."""
+        if key not in self._derived:
+            a = compute()
+            a.flags.writeable = False
+            self._derived[key] = a
+        return self._derived[key]
 
     def orbit_velocity(self, plane: str) -> np.ndarray:
         return self._axis(self.model.P[P_Z_RB1 + self._plane(plane)], offset=4)

@@ -115,7 +115,8 @@ def make_manifest(runs: Sequence[Run], evaluate: Evaluate | None, what: str) -> 
         if path.is_file():
             h.update(path.read_bytes())
     for r in runs:
-        h.update(json.dumps([r.scene, r.overrides, r.labels], default=str).encode())
+        key = [r.scene, r.overrides, r.labels] + ([] if r.observe else ["not observed"])
+        h.update(json.dumps(key, default=str).encode())
     return dict(format=FORMAT, what=what, runs=len(runs), scenes=scenes, evaluate=ev,
                 fingerprint=h.hexdigest())
 

@@ -32,14 +32,18 @@ from .results import Result
 
 @dataclass(frozen=True)
 class Run:
-    """One drop: scene source, dotted overrides and free-form labels used to group results."""
+    """One drop: scene source, dotted overrides and free-form labels used to group results;
+    ``observe = False``: the batch's ``evaluate`` hook is skipped for it (a drop whose extra
+    numbers nobody reads, e.g. the paper study's sensitivity drops: only metrics come back)."""
     scene: str = "paper"
     overrides: tuple[tuple[str, Any], ...] = ()
     labels: tuple[tuple[str, Any], ...] = ()
+    observe: bool = True
 
     @classmethod
-    def of(cls, scene: str = "paper", overrides: dict | None = None, **labels) -> "Run":
-        return cls(scene, tuple(sorted((overrides or {}).items())), tuple(labels.items()))
+    def of(cls, scene: str = "paper", overrides: dict | None = None, *, observe: bool = True,
+           **labels) -> "Run":
+        return cls(scene, tuple(sorted((overrides or {}).items())), tuple(labels.items()), observe)
 
     @property
     def settings(self) -> dict[str, Any]:
@@ -101,9 +105,10 @@ Evaluate = Callable[[Result], dict]
 
 def outcome_of(run: Run, result: Result, evaluate: Evaluate | None = None) -> Outcome:
     """The :class:`Outcome` of ``run`` from its simulated ``result`` (for a caller that also
-    keeps the full result, e.g. to draw it)."""
+    keeps the full result, e.g. to draw it); ``evaluate`` fills ``extra`` unless the run says
+    ``observe = False``."""
     metrics = compute_metrics(result)
-    extra = evaluate(result) if evaluate is not None else {}
+    extra = evaluate(result) if evaluate is not None and run.observe else {}
     return Outcome(run, True, metrics, extra)
 
 

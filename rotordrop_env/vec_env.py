@@ -182,6 +182,9 @@ class BatchedRotorDropVecEnv(VecEnv):
         one at most numba's current setting, e.g. a training run's ``--threads``)."""
         if self.n_threads is not None:
             n = self.n_threads
+        elif self.threads.most == 1:        # nothing to choose (N < 8, one core): the one-thread
+            K.step_rows(*self._args)        # step as is (numba.get_num_threads() costs ~3 µs)
+            return
         else:
             n = min(self.threads.next(), numba.get_num_threads())
         t0 = time.perf_counter()

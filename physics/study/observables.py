@@ -26,11 +26,11 @@ def drop_observables(result: Result) -> dict:
     late = t >= t_f + 0.5 * (t[-1] - t_f)
     out: dict = {"planes": {}}
     for p in PLANES:
-        o = result.orbit(p)[post]
-        r = np.hypot(o[:, 0], o[:, 1])
+        o = result.orbit_after(p, t_f)
+        r = result.radius_after(p, t_f)
         f = result.contact_force(p)
-        e = (result.orbit(p) - result.sleeve(p))[post]
-        v = np.gradient(np.hypot(e[:, 0], e[:, 1]), t[post]) if post.sum() > 2 else np.zeros(1)
+        v = (np.gradient(result.radius_after(p, t_f, relative=True), t[post]) if post.sum() > 2
+             else np.zeros(1))
         ws = result.sleeve_speed(p)
         spun = np.flatnonzero(post & (ws >= 0.5 * result.rotor_speed))
         out["planes"][p] = dict(

@@ -110,12 +110,14 @@ class StudyInput:
     def scene(self) -> Scene:
         return load_scene(self.source, self.overrides)
 
-    def run(self, extra: dict, **labels) -> Run:
-        return Run.of(self.source, {**self.overrides, **extra}, **labels)
+    def run(self, extra: dict, observe: bool = True, **labels) -> Run:
+        return Run.of(self.source, {**self.overrides, **extra}, observe=observe, **labels)
 
 
 def plan_runs(plan: Plan, base: StudyInput) -> list[Run]:
-    """Every drop of the study, labelled ``study`` = friction | stiffness | damping | sensitivity."""
+    """Every drop of the study, labelled ``study`` = friction | stiffness | damping | sensitivity.
+    The sensitivity drops are analysed by their metrics alone (:func:`_sensitivity`), so they skip
+    the observables (``Run.observe``)."""
     scene = base.scene
     members = perturbations(plan.members, scene.amb.off_time, plan.seed)
     runs: list[Run] = []
@@ -137,10 +139,10 @@ def plan_runs(plan: Plan, base: StudyInput) -> list[Run]:
     for factor, label, ov in sensitivity_settings(scene):
         for mu in plan.sens_frictions:
             for k, m in enumerate(sens):
-                runs.append(base.run({**ov, "contact.friction": mu, **m}, study="sensitivity",
+                runs.append(base.run({**ov, "contact.friction": mu, **m}, False, study="sensitivity",
                                      factor=factor, setting=label, friction=mu, member=k))
         for k, m in enumerate(soft):
-            runs.append(base.run({**ov, "support.stiffness": SOFT, **m}, study="sensitivity",
+            runs.append(base.run({**ov, "support.stiffness": SOFT, **m}, False, study="sensitivity",
                                  factor=factor, setting=label, friction="soft", member=k))
     return runs
 
