@@ -309,19 +309,11 @@ def latency_steps(latency_s: float, control_dt: float) -> int:
 def benchmark(out: str | Path, quick: bool = False, policies: list[str] | None = None,
               max_scenarios: int | None = None, episodes: int | None = None,
               progress: bool = True, plots: bool = True, power_return: float | None = None,
-              backend=None, suite: str = "nominal") -> dict:
+              backend=None) -> dict:
     """Run the suite and write benchmark.json, leaderboard.md and the plots into ``out``;
     ``power_return`` [s]: see :func:`scenario_suite`. On ``backend`` ray every friction of the
     threshold sweep and every controller is one Ray task (learned policies travel as their
-    paths and are loaded again on the node). ``suite="robust"``: the robust suite instead
-    (:func:`agents.robust.robust_benchmark`; ``episodes`` and ``power_return`` do not apply)."""
-    if check_suite(suite) == "robust":
-        for flag, value in (("--episodes", episodes), ("--power-return-ms", power_return)):
-            if value is not None:
-                raise ValueError(f"{flag} does not apply to --suite robust (its scenarios draw "
-                                 "the power return; one episode each)")
-        from .robust import robust_benchmark
-        return robust_benchmark(out, quick, policies, max_scenarios, progress, plots, backend)
+    paths and are loaded again on the node). The robust suite: :mod:`agents.robust`."""
     from physics.backend import Backend
     backend = backend if backend is not None else Backend()
     if power_return is not None:
@@ -425,15 +417,6 @@ class Validator:
                           self.phases)
         board = leaderboard(self.passive + rows, self.scenarios, None)
         return next(e["score"] for e in board if e["controller"] == "candidate"), rows
-
-
-def validator_for(env_id: str, env_kwargs: dict | None = None) -> Validator:
-    """The validation suite of a training run: the robust one (:mod:`agents.robust`) when its
-    environments have sensor noise or observation latency, else the nominal one."""
-    from .robust import is_robust, robust_validator
-    if is_robust(env_kwargs or {}):
-        return robust_validator(env_id)
-    return Validator(env_id)
 
 
 def _row(entry: Entry, sc: Scenario, eps) -> dict:

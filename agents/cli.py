@@ -126,12 +126,12 @@ def cmd_export_policy(args) -> int:
 
 def cmd_benchmark(args) -> int:
     from physics.backend import Backend
-    from .benchmark import benchmark
+    from .robust import run_suite
     try:
-        benchmark(args.out, quick=args.quick, policies=args.policy, max_scenarios=args.scenarios,
-                  episodes=args.episodes, progress=not args.quiet, plots=not args.no_plots,
-                  power_return=_power_return_s(args), backend=Backend.from_args(args),
-                  suite=args.suite)
+        run_suite(args.suite, args.out, quick=args.quick, policies=args.policy,
+                  max_scenarios=args.scenarios, episodes=args.episodes, progress=not args.quiet,
+                  plots=not args.no_plots, power_return=_power_return_s(args),
+                  backend=Backend.from_args(args))
     except ERRORS as exc:
         return _fail("benchmark", exc)
     return 0

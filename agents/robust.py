@@ -77,6 +77,14 @@ def robust_validator(env_id: str = ENV_ID) -> Validator:
     return Validator(env_id, robust_scenarios(VALIDATION_SCENARIOS, VALIDATION_SEED), (0.0,))
 
 
+def validator_for(env_id: str, env_kwargs: dict | None = None) -> Validator:
+    """The validation suite of a training run: the robust one when its environments have
+    sensor noise or observation latency, else the nominal one."""
+    if is_robust(env_kwargs or {}):
+        return robust_validator(env_id)
+    return Validator(env_id)
+
+
 def training_env_kwargs(control_dt: float = 0.005) -> dict:
     """The env kwargs that train on the robust distribution at control step ``control_dt``
     (the latency's steps as the suite rounds them: the suite's shortest latency, 1 ms, and
@@ -86,6 +94,24 @@ def training_env_kwargs(control_dt: float = 0.005) -> dict:
     return dict(randomize=True, randomization={k: list(v) for k, v in ROBUST_RANGES.items()},
                 sensor_noise=SENSOR_NOISE, obs_latency_steps=lo if lo == hi else [lo, hi],
                 control_dt=control_dt)
+
+
+def run_suite(suite: str, out, quick: bool = False, policies: list[str] | None = None,
+              max_scenarios: int | None = None, episodes: int | None = None,
+              progress: bool = True, plots: bool = True, power_return: float | None = None,
+              backend=None) -> dict:
+    """``rotordrop benchmark --suite SUITE``: the nominal suite (:func:`agents.benchmark.benchmark`)
+    or the robust one (:func:`robust_benchmark`, where ``episodes`` and ``power_return`` do not
+    apply: its scenarios draw the power return, one episode each)."""
+    from .benchmark import benchmark, check_suite
+    if check_suite(suite) == "nominal":
+        return benchmark(out, quick, policies, max_scenarios, episodes, progress, plots,
+                         power_return, backend)
+    for flag, value in (("--episodes", episodes), ("--power-return-ms", power_return)):
+        if value is not None:
+            raise ValueError(f"{flag} does not apply to --suite robust (its scenarios draw the "
+                             "power return; one episode each)")
+    return robust_benchmark(out, quick, policies, max_scenarios, progress, plots, backend)
 
 
 def robust_benchmark(out, quick: bool = False, policies: list[str] | None = None,

@@ -50,7 +50,7 @@ class ValidationCallback(BaseCallback):
         self.validator = None
 
     def _init_callback(self) -> None:
-        from .benchmark import validator_for
+        from .robust import validator_for
         spec = self.training_env.get_attr("spec", [0])[0]
         self.env_id, self.env_kwargs = spec.id, dict(spec.kwargs)
         self.validator = validator_for(self.env_id, self.env_kwargs)

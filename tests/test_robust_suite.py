@@ -6,9 +6,10 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from agents.benchmark import Entry, Scenario, benchmark, episode_kwargs, latency_steps
+from agents.benchmark import Entry, Scenario, episode_kwargs, latency_steps
 from agents.robust import (LATENCY_MS, ROBUST_RANGES, SENSOR_NOISE, SUITE_SEED, VALIDATION_SEED,
-                           draw_scenario, robust_benchmark, robust_scenarios, seed_groups, target,
+                           draw_scenario, robust_benchmark, robust_scenarios, run_suite,
+                           seed_groups, target,
                            training_env_kwargs)
 
 
@@ -80,9 +81,9 @@ def test_seed_groups_and_the_target():
 
 def test_bad_suite_and_nominal_only_options_raise():
     with pytest.raises(ValueError, match="--suite = 'robst' must be one of nominal, robust"):
-        benchmark("unused", suite="robst")
+        run_suite("robst", "unused")
     with pytest.raises(ValueError, match="--episodes does not apply to --suite robust"):
-        benchmark("unused", suite="robust", episodes=2)
+        run_suite("robust", "unused", episodes=2)
 
 
 def test_cli_refuses_a_bad_suite_in_one_line(capsys):
