@@ -26,6 +26,7 @@ leaderboard), ``leaderboard.md``, ``score.png``, ``whirl_map.png``, ``peak_force
 """
 from __future__ import annotations
 
+import math
 import os
 import time
 from dataclasses import dataclass, field
@@ -48,6 +49,14 @@ WHIRL_MARGINS = (0.05, 0.10, 0.15)
 TASKS = {"damping": "RotorDrop-Damping-v0", "relevitate": "RotorDrop-Relevitate-v0",
          "full": "RotorDrop-Full-v0"}
 RELEVITATION_ENVS = (TASKS["relevitate"], TASKS["full"])
+#: ``--suite``: the fixed nominal suite, or the robust one (:mod:`agents.robust`)
+SUITES = ("nominal", "robust")
+
+
+def check_suite(suite: str) -> str:
+    if suite not in SUITES:
+        raise ValueError(f"--suite = {suite!r} must be one of {', '.join(SUITES)}")
+    return suite
 
 
 def task_of(env_id: str) -> str:
@@ -75,6 +84,9 @@ class Scenario:
     group: str = "in-distribution"                      # in the re-levitation tasks (_group)
     env_kwargs: dict = field(default_factory=dict)      # relevitation envs only
     tasks: tuple[str, ...] = tuple(TASKS)
+    sensor_noise: float = 0.0       # std of the displacement sensors' noise [m]
+    latency_s: float = 0.0          # observation latency [s], in whole control steps (rounded up)
+    seed: int = 0                   # episode seed (the noise's draws)
 
     def scene_overrides(self, phase: float) -> dict:
         return {"contact.friction": self.friction, "unbalance.angle_deg": phase, **self.overrides}
@@ -188,6 +200,18 @@ def _entries(policies: list[LearnedPolicy], controllers=()) -> list[Entry]:
     return out
 
 
+def robust_entries(policies: list[str] | None) -> tuple[list[Entry], dict]:
+    """The Full-task entries of the robust suite (every baseline with channels there, the
+    shipped Full policies, the ``--policy`` extras) and the learned ones by name."""
+    extra, custom = extras(policies or [])
+    loaded = [p for p in [load_shipped(n) for n in shipped_names()] + extra
+              if p.env_id == TASKS["full"]]
+    entries = check_unique_names([e for e in _entries(loaded, custom) if e.task == "full"])
+    for e in [e for e in entries if e.name in {c.name for c in custom}]:
+        check_actor(TASKS[e.task], e.make, e.env_kwargs)
+    return entries, {p.name: p for p in loaded}
+
+
 def controller_entry(cls, env_id: str) -> Entry:
     """The benchmark entry of a controller class in the task of ``env_id``."""
     return Entry(cls.name, task_of(env_id), lambda plant: make_controller(cls, plant),
@@ -258,15 +282,28 @@ def monitor_kwargs(kw: dict) -> dict:
 
 
 def episode_kwargs(entry: Entry, scenario: Scenario, phase: float) -> dict:
+    """The env kwargs of one episode: the entry's (its command, control step...) without its
+    training distribution and sensing, the scenario's scene values, power return and sensing
+    (the latency as whole control steps of the entry's, rounded up: the newest measurement
+    that has arrived)."""
     kw = {k: v for k, v in entry.env_kwargs.items()
           if k not in ("randomize", "randomization", "overrides", "terminate_on_failure",
-                       "episode_time", "samples_per_step")}
+                       "episode_time", "samples_per_step", "sensor_noise", "obs_latency_steps")}
     kw.update(EVAL_KWARGS)
     kw.update(monitor_kwargs(kw))
     kw["overrides"] = {**(entry.env_kwargs.get("overrides") or {}), **scenario.scene_overrides(phase)}
     if entry.task != "damping":
         kw.update(scenario.env_kwargs)
+    if scenario.sensor_noise:
+        kw["sensor_noise"] = scenario.sensor_noise
+    if scenario.latency_s:
+        kw["obs_latency_steps"] = latency_steps(scenario.latency_s, kw.get("control_dt", 1e-3))
     return kw
+
+
+def latency_steps(latency_s: float, control_dt: float) -> int:
+    """A latency [s] in whole control steps, rounded up (at least one step for any latency)."""
+    return int(math.ceil(latency_s / control_dt - 1e-9))
 
 
 def benchmark(out: str | Path, quick: bool = False, policies: list[str] | None = None,
@@ -276,7 +313,7 @@ def benchmark(out: str | Path, quick: bool = False, policies: list[str] | None =
     """Run the suite and write benchmark.json, leaderboard.md and the plots into ``out``;
     ``power_return`` [s]: see :func:`scenario_suite`. On ``backend`` ray every friction of the
     threshold sweep and every controller is one Ray task (learned policies travel as their
-    paths and are loaded again on the node)."""
+    paths and are loaded again on the node). The robust suite: :mod:`agents.robust`."""
     from physics.backend import Backend
     backend = backend if backend is not None else Backend()
     if power_return is not None:
@@ -349,7 +386,7 @@ def suite_rows(entry: Entry, scenarios: list[Scenario], phases, progress=None) -
     for sc in [s for s in scenarios if entry.task in s.tasks]:
         eps = []
         for ph in phases:
-            eps += run_episodes(TASKS[entry.task], entry.make, [0], episode_kwargs(entry, sc, ph))
+            eps += run_episodes(TASKS[entry.task], entry.make, [sc.seed], episode_kwargs(entry, sc, ph))
             if progress is not None:
                 progress.update(1)
         rows.append(_row(entry, sc, eps))
@@ -364,17 +401,20 @@ VALIDATION_PHASES = (45.0, 225.0)
 
 class Validator:
     """The benchmark score of one policy on the validation suite (``VALIDATION_*``) of a task,
-    against the passive drop on the same suite (computed once)."""
+    against the passive drop on the same suite (computed once); or on given ``scenarios``
+    and ``phases`` (the robust validation set, :func:`agents.robust.robust_validator`)."""
 
-    def __init__(self, env_id: str):
+    def __init__(self, env_id: str, scenarios: list[Scenario] | None = None,
+                 phases=VALIDATION_PHASES):
         self.task = task_of(env_id)
-        self.scenarios = [Scenario(f"mu={m:g}", m) for m in VALIDATION_FRICTIONS]
+        self.scenarios = scenarios or [Scenario(f"mu={m:g}", m) for m in VALIDATION_FRICTIONS]
+        self.phases = tuple(phases)
         self.passive = suite_rows(Entry("passive", self.task, Passive, {}), self.scenarios,
-                                  VALIDATION_PHASES)
+                                  self.phases)
 
     def score(self, make_actor, env_kwargs: dict) -> tuple[float, list[dict]]:
         rows = suite_rows(Entry("candidate", self.task, make_actor, env_kwargs), self.scenarios,
-                          VALIDATION_PHASES)
+                          self.phases)
         board = leaderboard(self.passive + rows, self.scenarios, None)
         return next(e["score"] for e in board if e["controller"] == "candidate"), rows
 
@@ -397,8 +437,12 @@ def _row(entry: Entry, sc: Scenario, eps) -> dict:
                 episodes=len(eps))
 
 
-def leaderboard(rows: list[dict], scenarios: list[Scenario], threshold) -> list[dict]:
-    """Per task and controller: overall score, whirl and force criteria (see agents.score)."""
+def leaderboard(rows: list[dict], scenarios: list[Scenario], threshold,
+                any_friction: bool = False) -> list[dict]:
+    """Per task and controller: overall score, whirl and force criteria (see agents.score).
+    The whirl rate "where passive whirls" counts the scenarios where the passive drop whirls
+    at μ* + 0.05 or above (``threshold`` = μ*), or at any friction with ``any_friction``
+    (the robust suite's drawn scenarios)."""
     board = []
     for task in dict.fromkeys(r["task"] for r in rows):
         passive = {r["scenario"]: r for r in rows if r["task"] == task and r["controller"] == "passive"}
@@ -411,7 +455,8 @@ def leaderboard(rows: list[dict], scenarios: list[Scenario], threshold) -> list[
             for r in mine:
                 r["cost"] = costs[r["scenario"]]
             whirl_sc = [r for r in mine if passive[r["scenario"]]["backward_whirl"] >= 0.5
-                        and threshold is not None and r["friction"] >= threshold + 0.05 - 1e-9]
+                        and (any_friction or threshold is not None
+                             and r["friction"] >= threshold + 0.05 - 1e-9)]
             entry = dict(task=task, controller=name,
                          score=overall_score(list(costs.values()), [p_costs[n] for n in costs]),
                          in_distribution_score=_group_score(mine, costs, p_costs, "in-distribution"),
@@ -454,6 +499,12 @@ def leaderboard_markdown(report: dict) -> str:
              f"tasks: power back {1e3 * report['power_return_s']:g} ms after the fault unless "
              f"the scenario says otherwise). "
              f"Score: 100 (1 - sum J / sum J_passive), see docs/agents.md.", ""]
+    return "\n".join(lines + leaderboard_tables(report))
+
+
+def leaderboard_tables(report: dict, scenario_rows: bool = True) -> list[str]:
+    """The markdown leaderboard per task (and, with ``scenario_rows``, every row's KPIs)."""
+    lines = []
     for task in dict.fromkeys(e["task"] for e in report["leaderboard"]):
         lines += [f"## {task}", "",
                   "| rank | controller | score | in-dist. | out-of-dist. | whirl rate | whirl where "
@@ -468,6 +519,9 @@ def leaderboard_markdown(report: dict) -> str:
                          f"{e['force_ratio']:.2f}, {e['max_force_ratio']:.2f} | "
                          f"{e['displacement_ratio']:.2f} | {fmt_or_dash(e['relevitation_rate'], '.2f')} | "
                          f"{e['stator_contact_rate']:.2f} |")
+        if not scenario_rows:
+            lines.append("")
+            continue
         lines += ["", "| controller | scenario | mu | whirl | peak revs | peak F [N] | max disp [µm] | "
                       "stator | relevitated | t_relev [ms] | J |",
                   "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
@@ -479,5 +533,5 @@ def leaderboard_markdown(report: dict) -> str:
                          f"{r['stator_contact']:.2f} | {fmt_or_dash(r['relevitated'], '.2f')} | {fmt_or_dash(t * 1e3 if t is not None else None, '.0f')} | "
                          f"{r.get('cost', float('nan')):.2f} |")
         lines.append("")
-    return "\n".join(lines)
+    return lines
 

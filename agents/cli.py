@@ -126,11 +126,12 @@ def cmd_export_policy(args) -> int:
 
 def cmd_benchmark(args) -> int:
     from physics.backend import Backend
-    from .benchmark import benchmark
+    from .robust import run_suite
     try:
-        benchmark(args.out, quick=args.quick, policies=args.policy, max_scenarios=args.scenarios,
-                  episodes=args.episodes, progress=not args.quiet, plots=not args.no_plots,
-                  power_return=_power_return_s(args), backend=Backend.from_args(args))
+        run_suite(args.suite, args.out, quick=args.quick, policies=args.policy,
+                  max_scenarios=args.scenarios, episodes=args.episodes, progress=not args.quiet,
+                  plots=not args.no_plots, power_return=_power_return_s(args),
+                  backend=Backend.from_args(args))
     except ERRORS as exc:
         return _fail("benchmark", exc)
     return 0
@@ -161,7 +162,8 @@ def cmd_tune(args) -> int:
     try:
         r = tune(args.policy, args.env, args.gain, args.out, iterations=args.iterations,
                  population=args.population, elite=args.elite, seed=args.seed,
-                 progress=not args.quiet, plots=not args.no_plots, backend=Backend.from_args(args))
+                 progress=not args.quiet, plots=not args.no_plots, backend=Backend.from_args(args),
+                 suite=args.suite)
     except ERRORS as exc:
         return _fail("tune", exc)
     print(f"{r['controller']} on {r['env_id']}: validation score {r['start_validation_score']:.2f} "
@@ -253,7 +255,12 @@ def register(sub) -> None:
 
     p = sub.add_parser("benchmark", help="every baseline and shipped policy on a fixed scenario suite")
     p.add_argument("--quick", action="store_true",
-                   help="a reduced suite: 5 scenarios x 2 phases (about 15 s)")
+                   help="a reduced suite: 5 scenarios x 2 phases (about 15 s); with --suite "
+                        "robust its first 40 scenarios")
+    p.add_argument("--suite", default="nominal",
+                   help="nominal (default: the fixed scenario suite) or robust (200 drawn drops "
+                        "under sensor noise, latency, actuator spread and plant variation, Full "
+                        "task; docs/agents.md 'Robust suite')")
     p.add_argument("--policy", action="append", default=None,
                    help="extra policies or controllers to include (repeatable): a training "
                         "directory or model .zip (shown as name@run), or your own controller "
@@ -297,6 +304,9 @@ def register(sub) -> None:
     p.add_argument("--population", type=int, default=24, help="candidates per generation")
     p.add_argument("--elite", type=int, default=6, help="best candidates the next generation is fitted to")
     p.add_argument("--seed", type=_SEED, default=0)
+    p.add_argument("--suite", default="nominal",
+                   help="validation set: nominal (default) or robust (the robust suite's "
+                        "distribution, Full task: see docs/agents.md 'Robust suite')")
     add_backend_args(p, resume=False)
     _output_args(p, "out/tune")
     p.set_defaults(func=cmd_tune)

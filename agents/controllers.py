@@ -26,6 +26,8 @@ Baselines (spec §5-6):
     continuously inside the integrator, same ramp) on as soon as power is back.
 ``whirl-brake``
     Continuous currents: PD, gravity feed-forward and terms against backward whirl (class doc).
+``whirl-brake-robust``
+    ``whirl-brake`` with gains re-tuned on the robust suite's distribution (class doc).
 ``inner-loop``, ``whirl-brake-sup``
     ``command="supervisor"``: the built-in PID switched on at power return with C_max, alone
     (zero reference offsets) or with whirl-brake's whirl terms as reference offsets.
@@ -334,6 +336,17 @@ class WhirlBrake(Controller):
         return out
 
 
+class WhirlBrakeRobust(WhirlBrake):
+    """``whirl-brake`` with its gains re-tuned on the robust distribution (docs/agents.md
+    "Robust suite": 2 µm sensor noise, 1-3 ms latency, actuator spread, plant variation) by
+    ``rotordrop tune --policy whirl-brake --env RotorDrop-Full-v0 --suite robust`` (20
+    generations of 24, 25 min on one core). No gains in the searched ranges re-levitate under
+    1-3 ms of latency: the tuned law lowers the force and displacement peaks only."""
+
+    name = "whirl-brake-robust"
+    GAINS = dict(kp=0.408, kd=3.756, kc=2.431, kt=0.150, kr=0.107, ff=0.798, r_on=0.587)
+
+
 def whirl_terms(g: dict, pos: np.ndarray, vel: np.ndarray, spin: np.ndarray):
     """whirl-brake's terms against backward whirl, k_c s J v τ/c + [|x| > r_on c](k_t s J x̂ −
     k_r x̂), in normalised current per axis (x1, y1, x2, y2), and the unit radius vectors x̂;
@@ -403,7 +416,7 @@ def _rot90(v: np.ndarray) -> np.ndarray:
 
 BASELINES: dict[str, type[Controller]] = {c.name: c for c in (
     Passive, MaxDamping, WhirlSwitch, PidRelevitate, BuiltinRelevitate, WhirlBrake, InnerLoop,
-    WhirlBrakeSupervisor)}
+    WhirlBrakeSupervisor, WhirlBrakeRobust)}
 
 
 def command_for(cls: type[Controller]) -> str | None:

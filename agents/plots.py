@@ -256,3 +256,41 @@ def plot_tuning(report: dict, out: Path) -> Path:
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
+
+
+ROBUST_FRICTION_BINS = (0.3, 0.375, 0.45, 0.525, 0.6)
+
+
+def plot_robust(report: dict, out: Path) -> list[Path]:
+    """The robust suite: score per row (learned in green) and the backward-whirl rate per
+    friction bin of passive, the best designed row and the learned rows."""
+    plt = _plt()
+    board = report["leaderboard"]
+    names = [e["controller"] for e in board]
+    fig, axes = plt.subplots(1, 2, figsize=(13, 0.32 * len(names) + 2.5))
+    y = np.arange(len(names))[::-1]
+    axes[0].barh(y, [e["score"] for e in board],
+                 color=["C2" if e["kind"] == "learned" else "C0" for e in board])
+    axes[0].axvline(0.0, color="k", lw=0.8)
+    axes[0].set(yticks=y, yticklabels=names, xlabel="score (passive = 0)",
+                title=f"robust suite, {len(report['scenarios'])} drops")
+    edges = np.asarray(ROBUST_FRICTION_BINS)
+    mu = np.array([s["friction"] for s in report["scenarios"]])
+    which = np.clip(np.searchsorted(edges, mu, side="right") - 1, 0, len(edges) - 2)
+    mid = 0.5 * (edges[:-1] + edges[1:])
+    designed = [e["controller"] for e in board if e["kind"] == "designed" and e["controller"] != "passive"]
+    show = ["passive", *designed[:1], *[e["controller"] for e in board if e["kind"] == "learned"]]
+    for name in show:
+        w = {r["scenario"]: r["backward_whirl"] for r in report["rows"] if r["controller"] == name}
+        v = np.array([w[s["name"]] for s in report["scenarios"]])
+        axes[1].plot(mid, [v[which == b].mean() if np.any(which == b) else np.nan
+                           for b in range(len(mid))], "o-", label=name)
+    axes[1].set(xlabel="friction (bin centre)", ylabel="backward-whirl rate", ylim=(-0.02, 1.02),
+                title="drops per bin: " + ", ".join(str(int(np.sum(which == b))) for b in range(len(mid))))
+    axes[1].legend(fontsize=7)
+    axes[1].grid(alpha=0.3)
+    fig.tight_layout()
+    path = Path(out) / "robust.png"
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return [path]

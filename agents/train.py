@@ -162,8 +162,8 @@ def _callbacks():
         def __init__(self, env_id, algo, env_kwargs, meta, best_dir: Path, eval_cb,
                      best: float = -np.inf):
             super().__init__()
-            from .benchmark import Validator
-            self.validator = Validator(env_id)
+            from .robust import validator_for
+            self.validator = validator_for(env_id, env_kwargs)
             self.env_id, self.algo, self.env_kwargs, self.meta = env_id, algo, env_kwargs, meta
             self.best_dir, self.eval_cb = best_dir, eval_cb
             self.best = best                        # a continued run's best score so far

@@ -26,7 +26,7 @@ import numpy as np
 
 from physics.backend import Backend
 
-from .benchmark import TASKS, Validator, controller_env_kwargs
+from .benchmark import TASKS, Validator, check_suite, controller_env_kwargs
 from .controllers import BASELINES, Controller, controller_class, make_controller
 from .rollout import check_actor
 from .score import write_json
@@ -115,10 +115,12 @@ class GainObjective:
 
 def tune(spec: str, env_id: str, gains: list[str], out, iterations: int = 12,
          population: int = 24, elite: int = 6, seed: int = 0, progress: bool = True,
-         plots: bool = True, backend: Backend = Backend()) -> dict:
+         plots: bool = True, backend: Backend = Backend(), suite: str = "nominal") -> dict:
     """Run the search (module doc) and write ``tune.json`` / ``tune.png`` into ``out``; on
     ``--backend ray`` Ray Tune evaluates the candidates (:mod:`agents.ray_search`, its trials
-    under ``out/ray_tune``), with the same result."""
+    under ``out/ray_tune``), with the same result. ``suite="robust"``: on the robust
+    validation set (:func:`agents.robust.robust_validator`, Full task only) instead."""
+    check_suite(suite)
     if not gains:
         raise ValueError("--gain is required (NAME=LO:HI, repeatable)")
     ranges = [parse_gain(g) for g in gains]
@@ -137,7 +139,12 @@ def tune(spec: str, env_id: str, gains: list[str], out, iterations: int = 12,
     defaults = getattr(cls, "GAINS", {})
     start = np.clip([defaults.get(n, 0.5 * (lo + hi)) for n, lo, hi in ranges], low, high)
     env_kwargs = _check_gains(cls, env_id, dict(zip(names, start.tolist())))
-    objective = GainObjective(_portable(spec), env_id, env_kwargs, names, Validator(env_id))
+    if suite == "robust":
+        from .robust import robust_validator
+        validator = robust_validator(env_id)
+    else:
+        validator = Validator(env_id)
+    objective = GainObjective(_portable(spec), env_id, env_kwargs, names, validator)
     score = objective.score
 
     t0 = time.perf_counter()
@@ -147,7 +154,7 @@ def tune(spec: str, env_id: str, gains: list[str], out, iterations: int = 12,
         population=population, elite=elite, rng=np.random.default_rng(seed),
         min_std=0.01 * (high - low))
     final, rows = score(best)
-    report = dict(controller=cls.name, spec=spec, env_id=env_id, backend=backend.name,
+    report = dict(controller=cls.name, spec=spec, env_id=env_id, suite=suite, backend=backend.name,
                   ranges={n: [lo, hi] for n, lo, hi in ranges},
                   start=dict(zip(names, start.tolist())), start_validation_score=-history[0]["best_cost"],
                   gains=dict(zip(names, best.tolist())), validation_score=final, rows=rows,

@@ -50,10 +50,10 @@ class ValidationCallback(BaseCallback):
         self.validator = None
 
     def _init_callback(self) -> None:
-        from .benchmark import Validator
+        from .robust import validator_for
         spec = self.training_env.get_attr("spec", [0])[0]
         self.env_id, self.env_kwargs = spec.id, dict(spec.kwargs)
-        self.validator = Validator(self.env_id)
+        self.validator = validator_for(self.env_id, self.env_kwargs)
         self.algo = type(self.model).__name__.lower()
         if self.save_path is not None:
             self.save_path.mkdir(parents=True, exist_ok=True)

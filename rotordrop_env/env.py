@@ -21,8 +21,9 @@ from physics.simulate import IntegrationError, _explain
 from . import kernels as K
 from .buffers import Buffers
 from .layout import COMMANDS, action_layout, observation_layout
-from .scenario import (POWER_RETURN, POWER_RETURN_LIMITS, fault_state, resolve_ranges, sample,
-                       scenario_scene)
+from .scenario import (POWER_RETURN, POWER_RETURN_LIMITS, fault_state, layout_base, resolve_ranges,
+                       sample, scenario_scene)
+from .sensors import Sensing, check_latency, check_noise
 
 #: the kernel's re-levitation mode of each ``command``
 LEV_CODES = {"discrete": K.LEV_DISCRETE, "continuous": K.LEV_CONTINUOUS,
@@ -44,7 +45,8 @@ FIXED_SETTINGS = frozenset(("control_dt", "dt", "episode_time", "n_steps", "rand
                             "randomization", "ranges", "fixed_keys", "full_state", "command",
                             "power_return_time", "samples_per_step", "relevitation_hold",
                             "terminate_on_failure", "render_mode", "base_scene", "overrides",
-                            "obs_names", "obs_scale", "action_names", "weights"))
+                            "obs_names", "obs_scale", "action_names", "weights",
+                            "sensor_noise", "obs_latency_steps"))
 
 
 def _weight(name: str, doc: str) -> property:
@@ -76,6 +78,11 @@ class RotorDropEnv(gym.Env):
     randomization               None        {key: (low, high) | (law, low, high) | None};
                                             needs randomize=True, no range for a fixed key
     full_state                  False       observe the whole state vector (research)
+    sensor_noise                0.0         std of the displacement sensors' Gaussian noise [m]
+                                            (velocities: sqrt(2) x that / 1 ms), see
+                                            :mod:`rotordrop_env.sensors`
+    obs_latency_steps           0           k or (low, high): the agent sees the measurement of
+                                            k control steps ago, k drawn per episode
     command                     "discrete"  re-levitation envs: "discrete", "continuous" or
                                             "supervisor"
     power_return_time           0.05        re-levitation envs: power returns [s after fault]
@@ -119,7 +126,8 @@ class RotorDropEnv(gym.Env):
                  randomization: dict | None = None, full_state: bool = False,
                  command: str | None = None, power_return_time: float | None = None,
                  samples_per_step: int = 5, relevitation_hold: float = 0.02,
-                 terminate_on_failure: bool = True, w_whirl: float = 10.0,
+                 terminate_on_failure: bool = True, sensor_noise: float = 0.0,
+                 obs_latency_steps: int | tuple[int, int] = 0, w_whirl: float = 10.0,
                  w_contact: float = 0.1, w_displacement: float = 0.1, w_effort: float = 0.01,
                  w_success: float = 10.0, w_failure: float = 10.0, render_mode: str | None = None):
         self._check_options(command, power_return_time, render_mode)
@@ -146,9 +154,12 @@ class RotorDropEnv(gym.Env):
         self.full_state = _flag("full_state", full_state)
         self.render_mode = render_mode
         self.weights = weights
-        self.base_scene = self._make_scene(scene, overrides)
+        self.sensor_noise = check_noise(sensor_noise)
+        self.obs_latency_steps = check_latency(obs_latency_steps)
+        base = self._make_scene(scene, overrides)
         self.ranges, fixed = resolve_ranges(randomization, self._relevitate, type(self).__name__)
         _check_unused_ranges(randomization, self.randomize, overrides, power_return_time)
+        self.base_scene = layout_base(base, self.ranges, fixed) if self.randomize else base
         #: keys the user fixed: never randomised (still drawn, so the others' draws stay put)
         self.fixed_keys = fixed | frozenset(overrides or {}) | frozenset(
             [POWER_RETURN] if power_return_time is not None else [])
@@ -166,6 +177,8 @@ class RotorDropEnv(gym.Env):
         self._discrete = isinstance(self.action_space, gym.spaces.Discrete)
         self._act_shape = () if self._discrete else self.action_space.shape
         n_act = 1 if self._discrete else self.action_space.shape[0]
+        self._sensing = Sensing(self.sensor_noise, self.obs_latency_steps, self.obs_names,
+                                self.obs_scale, self.base_scene.contact.clearance)
         self._bind(Buffers(model.n_state, n_obs, n_act, int(samples_per_step)))
         self._configure_static(relevitation_hold, _flag("terminate_on_failure", terminate_on_failure))
         self._renderer = None
@@ -337,7 +350,12 @@ class RotorDropEnv(gym.Env):
         if self.render_mode is not None:            # record from the first step of the episode
             self._reset_view()
             self._record(step=False)
-        return b.obs.astype(np.float32), {"scenario": dict(self._scenario), "time_s": 0.0}
+        info = {"scenario": dict(self._scenario), "time_s": 0.0}
+        if not self._sensing.active:
+            return b.obs.astype(np.float32), info
+        obs = self._sensing.reset(b.obs, self.np_random)
+        info["obs_latency_steps"] = self._sensing.k
+        return obs, info
 
     def _scenario_report(self, values: dict, power: bool) -> dict:
         """The machine of this episode: the value of every randomisation key (drawn, fixed by
@@ -401,7 +419,15 @@ class RotorDropEnv(gym.Env):
         self._ended |= terminated or truncated
         info = self._step_info(terminated or truncated)
         self._show_step()
-        return b.obs.astype(np.float32), float(out[K.O_REWARD]), terminated, truncated, info
+        return self.observed(), float(out[K.O_REWARD]), terminated, truncated, info
+
+    def observed(self) -> np.ndarray:
+        """The float32 observation the agent gets after the step just taken: the kernel's, or
+        with ``sensor_noise`` / ``obs_latency_steps`` the sensed one (:mod:`.sensors`; call
+        once per step, it takes the measurement)."""
+        if not self._sensing.active:
+            return self._b.obs.astype(np.float32)
+        return self._sensing.step(self._b.obs, self.np_random)
 
     def _action_error(self, err: int, action) -> None:
         """Raise the ValueError of a refused action (``err``: the kernel's ERR_* code)."""

@@ -152,3 +152,24 @@ def scenario_scene(base: Scene, values: Mapping[str, Any]) -> Scene:
         return base.with_overrides(keys)
     except SceneError as exc:
         raise SceneError(f"scenario {keys}: {exc}") from None
+
+
+def layout_base(base: Scene, ranges: Mapping[str, tuple[str, float, float]],
+                fixed: frozenset = frozenset()) -> Scene:
+    """``base``, or with the low end of each range that would switch a state on in every draw
+    (``amb.coil_time_constant`` 0 in the scene, a range above 0: the coil-lag states), so that
+    the state layout is the same at every reset. A range that crosses the switch (low 0, high
+    > 0) raises SceneError."""
+    switch = {}
+    n_base = build_model(base).n_state
+    for key, (_, lo, hi) in sorted(ranges.items()):
+        if key == POWER_RETURN or key in fixed:
+            continue
+        n_lo = build_model(base.with_overrides({key: lo})).n_state
+        n_hi = build_model(base.with_overrides({key: hi})).n_state if hi != lo else n_lo
+        if n_lo != n_hi:
+            raise SceneError(f"randomization[{key!r}] = ({lo:g}, {hi:g}) changes the state layout "
+                             "within its range: keep it on one side of the switch (e.g. low > 0)")
+        if n_lo != n_base:
+            switch[key] = lo
+    return base.with_overrides(switch) if switch else base

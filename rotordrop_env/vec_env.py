@@ -114,6 +114,7 @@ class BatchedRotorDropVecEnv(VecEnv):
             env._bind(self.stack.row(e))
         self._args = self.stack.args()
         self._discrete = first._discrete
+        self._sensed = any(env._sensing.active for env in self.envs)
         if n_threads is not None and not 1 <= int(n_threads) <= numba.config.NUMBA_NUM_THREADS:
             raise ValueError(f"n_threads = {n_threads!r} must be in [1, "
                              f"{numba.config.NUMBA_NUM_THREADS}] (numba's NUMBA_NUM_THREADS)")
@@ -126,12 +127,13 @@ class BatchedRotorDropVecEnv(VecEnv):
 
     # ------------------------------------------------------------------ SB3 VecEnv API --
     def reset(self):
+        obs = np.empty((self.num_envs, *self.observation_space.shape), dtype=np.float32)
         for e, env in enumerate(self.envs):
             options = {"options": self._options[e]} if self._options[e] else {}
-            _, self.reset_infos[e] = env.reset(seed=self._seeds[e], **options)
+            obs[e], self.reset_infos[e] = env.reset(seed=self._seeds[e], **options)
         self._reset_seeds()
         self._reset_options()
-        return self.stack.obs.astype(np.float32)
+        return obs
 
     def step_async(self, actions: np.ndarray) -> None:
         self.actions = actions
@@ -161,6 +163,9 @@ class BatchedRotorDropVecEnv(VecEnv):
             e = failed[0]
             self.envs[e]._finish(a[e])
         obs = self.stack.obs.astype(np.float32)
+        if self._sensed:                          # noise / latency (rotordrop_env.sensors)
+            for e, env in enumerate(self.envs):
+                obs[e] = env.observed()
         rewards = out[:, K.O_REWARD].astype(np.float32)
         terminated = out[:, K.O_TERM] > 0.0
         truncated = out[:, K.O_TRUNC] > 0.0

@@ -1,0 +1,132 @@
+"""Imperfect sensing of the agent's observations: Gaussian sensor noise and observation latency
+(kwargs ``sensor_noise`` and ``obs_latency_steps``; docs/environments.md "Sensor noise and
+latency").
+
+Only what the agent (or a designed controller reading the observation) sees is affected. The
+physics step, its built-in position PID (the machine's fast inner loop) and the supervisor's
+orbit frame inside it run on the true state, as a real AMB's analogue or FPGA position loop
+does; the KPIs and rewards are those of the true motion.
+
+* **Noise**: the four displacements x1, y1, x2, y2 get independent Gaussian noise of standard
+  deviation σ = ``sensor_noise`` [m]; the four velocities, which a real machine estimates by
+  differencing the displacement signal, get σ_v = √2 σ / ``VELOCITY_ESTIMATE_DT`` (the noise of
+  a difference over 1 ms, the same for every control step). With ``command="supervisor"`` the
+  orbit radius and rate are computed from the noisy values (the same formula as the kernel's).
+  Spin speeds, damper states and coil currents are not noised.
+* **Latency**: the observation returned after control step n is the (noisy) measurement taken
+  after step n − k; k is drawn once per episode, uniformly from the integers of
+  ``obs_latency_steps = (low, high)``. Every entry is delayed except ``time``, the controller's
+  own clock. Before the episode has k measurements, the first one is repeated.
+
+All draws come from the environment's ``np_random``; with σ = 0 and k = 0 nothing is drawn and
+the observations are bit-identical to an environment without these kwargs.
+"""
+from __future__ import annotations
+
+import math
+import numbers
+
+import numpy as np
+
+from .kernels import SUP_MIN_RADIUS
+from .layout import SUPERVISOR_OBS
+
+#: interval of the velocity estimate that the velocity noise stands for [s]
+VELOCITY_ESTIMATE_DT = 1e-3
+NOISE_LIMITS = (0.0, 1e-4)          # sensor_noise [m]
+LATENCY_LIMITS = (0, 100)           # obs_latency_steps [control steps]
+POSITIONS = ("x1", "y1", "x2", "y2")
+VELOCITIES = ("vx1", "vy1", "vx2", "vy2")
+
+
+def check_noise(value) -> float:
+    """``sensor_noise`` as a float in ``NOISE_LIMITS`` (one-line ValueError otherwise)."""
+    lo, hi = NOISE_LIMITS
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real) \
+            or not (math.isfinite(value) and lo <= value <= hi):
+        raise ValueError(f"sensor_noise = {value!r} must be a standard deviation in metres in "
+                         f"[{lo:g}, {hi:g}] (e.g. 2e-6 for 2 µm)")
+    return float(value)
+
+
+def check_latency(value) -> tuple[int, int]:
+    """``obs_latency_steps`` (an integer k, or (low, high)) as (low, high) integers in
+    ``LATENCY_LIMITS`` (one-line ValueError otherwise)."""
+    lo_lim, hi_lim = LATENCY_LIMITS
+    pair = tuple(value) if isinstance(value, (list, tuple)) else (value, value)
+    ok = len(pair) == 2 and all(isinstance(v, numbers.Integral) and not isinstance(v, (bool, np.bool_))
+                                for v in pair)
+    if not ok or not lo_lim <= pair[0] <= pair[1] <= hi_lim:
+        raise ValueError(f"obs_latency_steps = {value!r} must be an integer or a pair (low, high) "
+                         f"of integers with {lo_lim} <= low <= high <= {hi_lim} [control steps]")
+    return int(pair[0]), int(pair[1])
+
+
+class Sensing:
+    """The noisy, delayed observation of one environment (module doc).
+
+    ``obs_names``/``obs_scale``: the environment's layout (normalised obs x scale = SI);
+    ``clearance`` [m] for the orbit's dead zone."""
+
+    def __init__(self, noise: float, latency: tuple[int, int], obs_names, obs_scale,
+                 clearance: float):
+        names = list(obs_names)
+        self.noise, self.latency = noise, latency
+        self.active = noise > 0.0 or latency[1] > 0
+        self.time_col = names.index("time")
+        if noise > 0.0:
+            missing = [n for n in POSITIONS + VELOCITIES if n not in names]
+            if missing:
+                raise ValueError("sensor_noise applies to the sensor observations (x1 ... vy2), "
+                                 "which a full_state=True environment does not have")
+            self.cols = np.array([names.index(n) for n in POSITIONS + VELOCITIES])
+            sigma = np.array([noise] * 4 + [math.sqrt(2.0) * noise / VELOCITY_ESTIMATE_DT] * 4)
+            self.sigma = sigma / np.asarray(obs_scale)[self.cols]       # in obs units
+            self.scale = np.asarray(obs_scale, dtype=np.float64)
+            self.orbit = [names.index(n) for n in SUPERVISOR_OBS] if SUPERVISOR_OBS[0] in names else None
+            self.speed_col = names.index("rotor_speed")
+            self.r_min = SUP_MIN_RADIUS * clearance
+        self.buffer = np.zeros((latency[1] + 1, len(names)))
+        self.k = 0
+        self.n = 0                      # measurements taken this episode
+
+    def reset(self, true_obs: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        """Start an episode: draw its latency k, take the first measurement."""
+        lo, hi = self.latency
+        self.k = int(rng.integers(lo, hi + 1)) if hi > lo else lo
+        self.n = 0
+        return self.step(true_obs, rng)
+
+    def step(self, true_obs: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        """Measure ``true_obs`` (normalised, as the kernel wrote it) and return the float32
+        observation the agent sees now."""
+        m = self._measure(true_obs, rng)
+        L = len(self.buffer)
+        self.buffer[self.n % L] = m
+        if self.n == 0:
+            self.buffer[:] = m
+        out = self.buffer[(self.n - min(self.k, self.n)) % L].astype(np.float32)
+        out[self.time_col] = true_obs[self.time_col]
+        self.n += 1
+        return out
+
+    def _measure(self, true_obs: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        m = np.array(true_obs, dtype=np.float64)
+        if self.noise > 0.0:
+            m[self.cols] += self.sigma * rng.standard_normal(len(self.cols))
+            if self.orbit is not None:
+                self._orbit(m)
+        return m
+
+    def _orbit(self, m: np.ndarray) -> None:
+        """Orbit radius and rate (supervisor entries) from the noisy displacements and
+        velocities, as :func:`rotordrop_env.kernels.orbit_frame` computes them from the state."""
+        phys = m[self.cols] * self.scale[self.cols]
+        spin = 1.0 if m[self.speed_col] >= 0.0 else -1.0
+        for k in range(2):
+            px, py = phys[2 * k], phys[2 * k + 1]
+            vx, vy = phys[4 + 2 * k], phys[5 + 2 * k]
+            r = math.hypot(px, py)
+            rate = spin * (px * vy - py * vx) / (r * r) if r > self.r_min else 0.0
+            m[self.orbit[k]] = r / self.scale[self.orbit[k]]
+            m[self.orbit[2 + k]] = rate / self.scale[self.orbit[2 + k]]
