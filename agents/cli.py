@@ -18,6 +18,7 @@ from physics.backend import add_backend_args
 from physics.cli import at_least
 
 from . import research
+from .hyperparams import ALGOS
 
 OPTIONAL_RL_MODULES = ("gymnasium", "stable_baselines3", "torch", "tensorboard", "yaml")
 
@@ -80,7 +81,7 @@ def cmd_train(args) -> int:
         common = dict(timesteps=args.timesteps, n_envs=args.n_envs, config=args.config,
                       verbose=args.verbose, command=command_line(), overwrite=args.overwrite,
                       eval_freq=args.eval_freq, n_eval_episodes=args.eval_episodes,
-                      checkpoint_freq=args.save_freq)
+                      checkpoint_freq=args.save_freq, time_limit=args.time_limit)
         if args.seeds is None and backend.name == "local":
             print(train(args.env, args.algo, args.out, seed=args.seed, resume=args.resume,
                         threads=args.threads, progress=not args.quiet, **common).summary())
@@ -187,7 +188,7 @@ def cmd_oracle(args) -> int:
 def register(sub) -> None:
     p = sub.add_parser("train", help="train an SB3 agent on a rotor-drop environment")
     p.add_argument("--env", required=True, help="environment id, e.g. RotorDrop-Damping-v0")
-    p.add_argument("--algo", required=True, choices=("ppo", "sac", "td3"))
+    p.add_argument("--algo", required=True, choices=ALGOS)
     p.add_argument("--timesteps", type=int, default=None, help="override n_timesteps of the config")
     p.add_argument("--n-envs", type=int, default=None, help="override n_envs of the config")
     p.add_argument("--config", default=None,
@@ -216,6 +217,9 @@ def register(sub) -> None:
     p.add_argument("--save-freq", type=at_least(0), default=None,
                    help="environment steps between checkpoints (0: none; default: the config's, "
                         "else 100000)")
+    p.add_argument("--time-limit", type=float, default=None, metavar="SECONDS",
+                   help="wall-clock budget of the training: stop once it has passed, then "
+                        "evaluate, keep best/ and save the model as at the end of a run")
     p.set_defaults(func=cmd_train)
 
     p = sub.add_parser("export-policy", help="a trained policy as one zip that plain SB3 "
