@@ -172,13 +172,28 @@ def cmd_tune(args) -> int:
     return 0
 
 
+def _number_list(sep: str, count: int | None):
+    """argparse type: ``count`` (any if None) numbers joined by ``sep``, e.g. ``0.3:0.6``."""
+    def parse(text: str) -> tuple[float, ...]:
+        try:
+            values = tuple(float(v) for v in text.split(sep))
+        except ValueError:
+            values = ()
+        if not values or (count is not None and len(values) != count):
+            shape = sep.join(["LO", "HI"] if count == 2 else ["E0", "E1", "..."])
+            raise argparse.ArgumentTypeError(f"expected {shape} (numbers), got {text!r}")
+        return values
+    return parse
+
+
 def cmd_oracle(args) -> int:
     from .oracle import oracle
     try:
         report = oracle(args.out, scenarios=args.scenarios, population=args.population,
                         iterations=args.iterations, seed=args.seed, policies=args.policy,
                         progress=not args.quiet, plots=not args.no_plots,
-                        search=not args.no_search, scenario_seed=args.scenario_seed)
+                        search=not args.no_search, scenario_seed=args.scenario_seed,
+                        friction=args.friction, friction_bins=args.friction_bins)
     except ERRORS as exc:
         return _fail("oracle", exc)
     _wrote(args.out, ["oracle.json", *report.get("figures", [])], report["wall_time_s"])
@@ -282,6 +297,13 @@ def register(sub) -> None:
                    help="seed of the first drawn scenario (default 10000; scenario i uses it + i)")
     p.add_argument("--no-search", action="store_true",
                    help="score the rows only (no oracle search), e.g. on 200 scenarios")
+    p.add_argument("--friction", type=_number_list(":", 2), default=None, metavar="LO:HI",
+                   help="friction range the scenarios are drawn from (default 0.38:0.6; "
+                        "0 <= LO < HI <= 1)")
+    p.add_argument("--friction-bins", type=_number_list(",", None), default=None,
+                   metavar="E0,E1,...", help="edges of the whirl-rate-per-friction table, from "
+                   "LO to HI (default: 0.38,0.44,0.5,0.55,0.6 on the default range, else "
+                   "0.05-wide bins)")
     p.add_argument("--policy", action="append", default=None,
                    help="extra rows: a training directory / model .zip or module:Class "
                         "(repeatable)")
