@@ -88,13 +88,19 @@ def _callbacks():
             return True
 
     class KpiEvalCallback(EvalCallback):
-        """EvalCallback that also records the episode KPIs (backward whirl, peak force...)."""
+        """EvalCallback that also records the episode KPIs (backward whirl, peak force...) and
+        the wall-clock time since this session's training started (``wall_time_s``)."""
 
         def __init__(self, *args, eval_seed: int = 0, **kwargs):
             super().__init__(*args, **kwargs)
             self.eval_seed = eval_seed
             self.kpi_history: list[dict] = []
             self._kpis: list[dict] = []
+            self.t0 = time.perf_counter()
+
+        def _on_training_start(self):
+            super()._on_training_start()
+            self.t0 = time.perf_counter()
 
         def _log_success_callback(self, locals_, globals_):
             super()._log_success_callback(locals_, globals_)
@@ -113,7 +119,8 @@ def _callbacks():
             if len(self.evaluations_timesteps) > n_before:
                 rewards = self.evaluations_results[-1]
                 entry = dict(timesteps=int(self.num_timesteps), mean_reward=float(np.mean(rewards)),
-                             std_reward=float(np.std(rewards)))
+                             std_reward=float(np.std(rewards)),
+                             wall_time_s=time.perf_counter() - self.t0)
                 for key in sorted({k for d in self._kpis for k in d}):
                     mean = mean_finite(d.get(key) for d in self._kpis)      # NaN (no value) skipped
                     if mean is not None:

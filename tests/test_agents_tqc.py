@@ -42,6 +42,8 @@ def test_tqc_trains_checkpoints_and_resumes_like_sac(tqc_run, tmp_path):
     assert info["algo"] == "tqc" and info["hyperparams"]["top_quantiles_to_drop_per_net"] == 1
     assert [h["timesteps"] for h in info["learning_curve"]] == [128, 256]
     assert all("mean_relevitated" in h for h in info["learning_curve"])
+    times = [h["wall_time_s"] for h in info["learning_curve"]]
+    assert 0.0 < times[0] <= times[1] <= info["wall_time_s"]
     more = train(ENV, "tqc", tmp_path / "more", timesteps=320, config=cfg, seed=1, resume=run,
                  progress=False)
     assert more.timesteps == 320
