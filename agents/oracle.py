@@ -22,7 +22,8 @@ sequence is the rollout of lowest J among all the search ran. Every row
 the benchmark's formula, score = 100 (1 - sum J / sum J_passive).
 
 Outputs in ``--out``: ``oracle.json`` (settings, scenarios, per-scenario KPIs and J of every row,
-the oracle's command sequence and search history, the summary table) and ``oracle.png``. The
+the oracle's command sequence and search history, the summary table), ``oracle.png``, and the
+whirl rate per friction bin as ``whirl_by_friction.png`` and ``whirl_by_friction.csv``. The
 search is written after every scenario; a rerun with the same settings continues where it
 stopped and re-scores the rows (add ``--policy`` runs without searching again). ``--no-search``
 scores the rows alone, e.g. on 200 scenarios from another ``--scenario-seed``. The whirl
@@ -305,6 +306,7 @@ def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iteration
         bar.update(1)
     bar.close()
     report["whirl_by_friction"] = whirl_by_friction(report, edges)
+    write_whirl_csv(report["whirl_by_friction"], out / "whirl_by_friction.csv")
     if plots:
         report["figures"] = [plot_oracle(report, out / "oracle.png").name,
                              plot_whirl_by_friction(report, out / "whirl_by_friction.png").name]
@@ -320,6 +322,21 @@ def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iteration
               f"{e['relevitation_rate']:.2f} |")
     print_whirl_by_friction(report["whirl_by_friction"])
     return report
+
+
+def write_whirl_csv(table: dict, path: Path) -> Path:
+    """The per-friction whirl table as CSV: one line per row and bin (controller, bin edges,
+    drops, whirling drops, whirl rate; empty where the bin has no drop)."""
+    import csv
+    edges = table["edges"]
+    with Path(path).open("w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["controller", "mu_lo", "mu_hi", "drops", "whirls", "whirl_rate"])
+        for name, rates in table["rates"].items():
+            for lo, hi, n, r in zip(edges[:-1], edges[1:], table["counts"], rates):
+                w.writerow([name, lo, hi, n, "" if r is None else round(r * n),
+                            "" if r is None else f"{r:.4f}"])
+    return Path(path)
 
 
 def print_whirl_by_friction(table: dict) -> None:

@@ -100,6 +100,9 @@ def test_a_friction_range_draws_there_and_bins_its_whirl_table(tmp_path, capsys)
     table = rep["whirl_by_friction"]
     assert table["edges"] == [0.3, 0.33, 0.36] and sum(table["counts"]) == 3
     assert "| drops |" in capsys.readouterr().out
+    lines = (tmp_path / "whirl_by_friction.csv").read_text().splitlines()
+    assert lines[0] == "controller,mu_lo,mu_hi,drops,whirls,whirl_rate"
+    assert len(lines) == 1 + 2 * len(table["rates"])               # a line per row and bin
     assert friction_edges((0.3, 0.6)) == (0.3, 0.35, 0.4, 0.45, 0.5, 0.55, 0.6)
     assert friction_edges((0.38, 0.6)) == (0.38, 0.44, 0.5, 0.55, 0.6)       # the default's bins
     with pytest.raises(ValueError, match=r"--friction must be LO:HI with 0 <= LO < HI <= 1, got 0.5:0.3"):
