@@ -438,7 +438,7 @@ def plot_whirl_by_friction(report: dict, path: Path) -> Path:
         ax.plot(mid, rates, "o-", label=name)
     ax.set(xlabel="friction coefficient (bin centre)", ylabel="backward-whirl rate",
            ylim=(-0.02, 1.02), title="drops per bin: " + ", ".join(str(c) for c in table["counts"]))
-    ax.axhline(0.05, color="k", lw=0.8, ls=":")
+    ax.axhline(0.05, color="k", lw=0.8, ls=":", label="goal: 5 %")
     ax.legend(fontsize=7)
     ax.grid(alpha=0.3)
     fig.tight_layout()
