@@ -14,6 +14,7 @@ from __future__ import annotations
 import argparse
 import csv
 import json
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -44,6 +45,14 @@ def aggregate(runs: list[str | Path], quantities=QUANTITIES) -> dict[str, np.nda
     return out
 
 
+def _nan_stats(values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Mean and std over runs (axis 0) of the entries they have; NaN where none has one (a
+    quantity a run does not record, e.g. validation_score without validation), silently."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return np.nanmean(values, axis=0), np.nanstd(values, axis=0)
+
+
 def write(groups: dict[str, list[str]], out: Path, quantities=QUANTITIES) -> list[Path]:
     """PNG and CSV of the labelled groups of runs (``quantities``: (key, axis title) pairs)."""
     import matplotlib.pyplot as plt
@@ -55,7 +64,7 @@ def write(groups: dict[str, list[str]], out: Path, quantities=QUANTITIES) -> lis
         data = aggregate(runs, quantities)
         steps = data["steps"]
         for ax, (key, title) in zip(axes, quantities):
-            mean, std = np.nanmean(data[key], axis=0), np.nanstd(data[key], axis=0)
+            mean, std = _nan_stats(data[key])
             ax.plot(steps, mean, color=f"C{i}", label=f"{label} ({len(runs)} run"
                     f"{'s' if len(runs) > 1 else ''})")
             if len(runs) > 1:
@@ -63,8 +72,8 @@ def write(groups: dict[str, list[str]], out: Path, quantities=QUANTITIES) -> lis
             ax.set_ylabel(title)
             ax.grid(alpha=0.3)
         for j, s in enumerate(steps):
-            rows.append([label, int(s), len(runs)] + [f"{f(data[k][:, j]):.6g}" for k, _ in
-                                                      quantities for f in (np.nanmean, np.nanstd)])
+            rows.append([label, int(s), len(runs)] + [f"{v[j]:.6g}" for k, _ in quantities
+                                                      for v in _nan_stats(data[k])])
     axes[0].legend(fontsize=8)
     axes[-1].set_xlabel("environment steps")
     fig.tight_layout()
