@@ -238,7 +238,7 @@ def register(sub) -> None:
     p.set_defaults(func=cmd_train)
 
     p = sub.add_parser("export-policy", help="a trained policy as one zip that plain SB3 "
-                                             "(PPO.load / SAC.load / TD3.load) runs as rotordrop does")
+                                             "(PPO.load / SAC.load / TD3.load / TQC.load) runs as rotordrop does")
     p.add_argument("source", help="run directory, its best/, a model or checkpoint zip, or a "
                                   "shipped policy name")
     where = p.add_mutually_exclusive_group(required=True)

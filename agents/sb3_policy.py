@@ -1,5 +1,5 @@
-"""Self-contained policy zips: plain ``PPO.load`` / ``SAC.load`` / ``TD3.load`` act like the
-project's loader.
+"""Self-contained policy zips: plain ``PPO.load`` / ``SAC.load`` / ``TD3.load`` (and
+sb3-contrib's ``TQC.load``) act like the project's loader.
 
 A policy trained by ``rotordrop train`` needs two things besides its network: the observation
 normalisation (``VecNormalize`` statistics) and, for a residual policy (config ``residual:``),
@@ -188,7 +188,7 @@ def _exported_class(policy) -> type:
 def export_self_contained(model, vecnormalize, out_path: str | Path, *, env_id: str | None = None,
                           env_kwargs: dict | None = None, residual: str | None = None,
                           residual_scale: float | None = None) -> Path:
-    """Write ``model`` (a PPO / SAC / TD3 with an ``MlpPolicy``) as a zip that plain SB3 loads
+    """Write ``model`` (a PPO / SAC / TD3 / TQC with an ``MlpPolicy``) as a zip that plain SB3 loads
     and runs like the project's loader: ``vecnormalize`` (a ``VecNormalize`` or None) and the
     ``residual`` baseline (name, ``residual_scale``) go inside the policy. ``env_id`` and
     ``env_kwargs`` name the training environment (the residual's plant); without ``env_id``
