@@ -18,6 +18,7 @@ from physics.backend import add_backend_args
 from physics.cli import at_least
 
 from . import research
+from .hyperparams import ALGOS
 
 OPTIONAL_RL_MODULES = ("gymnasium", "stable_baselines3", "torch", "tensorboard", "yaml")
 
@@ -80,7 +81,7 @@ def cmd_train(args) -> int:
         common = dict(timesteps=args.timesteps, n_envs=args.n_envs, config=args.config,
                       verbose=args.verbose, command=command_line(), overwrite=args.overwrite,
                       eval_freq=args.eval_freq, n_eval_episodes=args.eval_episodes,
-                      checkpoint_freq=args.save_freq)
+                      checkpoint_freq=args.save_freq, time_limit=args.time_limit)
         if args.seeds is None and backend.name == "local":
             print(train(args.env, args.algo, args.out, seed=args.seed, resume=args.resume,
                         threads=args.threads, progress=not args.quiet, **common).summary())
@@ -173,13 +174,28 @@ def cmd_tune(args) -> int:
     return 0
 
 
+def _number_list(sep: str, count: int | None):
+    """argparse type: ``count`` (any if None) numbers joined by ``sep``, e.g. ``0.3:0.6``."""
+    def parse(text: str) -> tuple[float, ...]:
+        try:
+            values = tuple(float(v) for v in text.split(sep))
+        except ValueError:
+            values = ()
+        if not values or (count is not None and len(values) != count):
+            shape = sep.join(["LO", "HI"] if count == 2 else ["E0", "E1", "..."])
+            raise argparse.ArgumentTypeError(f"expected {shape} (numbers), got {text!r}")
+        return values
+    return parse
+
+
 def cmd_oracle(args) -> int:
     from .oracle import oracle
     try:
         report = oracle(args.out, scenarios=args.scenarios, population=args.population,
                         iterations=args.iterations, seed=args.seed, policies=args.policy,
                         progress=not args.quiet, plots=not args.no_plots,
-                        search=not args.no_search, scenario_seed=args.scenario_seed)
+                        search=not args.no_search, scenario_seed=args.scenario_seed,
+                        friction=args.friction, friction_bins=args.friction_bins)
     except ERRORS as exc:
         return _fail("oracle", exc)
     _wrote(args.out, ["oracle.json", *report.get("figures", [])], report["wall_time_s"])
@@ -189,7 +205,7 @@ def cmd_oracle(args) -> int:
 def register(sub) -> None:
     p = sub.add_parser("train", help="train an SB3 agent on a rotor-drop environment")
     p.add_argument("--env", required=True, help="environment id, e.g. RotorDrop-Damping-v0")
-    p.add_argument("--algo", required=True, choices=("ppo", "sac", "td3"))
+    p.add_argument("--algo", required=True, choices=ALGOS)
     p.add_argument("--timesteps", type=int, default=None, help="override n_timesteps of the config")
     p.add_argument("--n-envs", type=int, default=None, help="override n_envs of the config")
     p.add_argument("--config", default=None,
@@ -218,10 +234,13 @@ def register(sub) -> None:
     p.add_argument("--save-freq", type=at_least(0), default=None,
                    help="environment steps between checkpoints (0: none; default: the config's, "
                         "else 100000)")
+    p.add_argument("--time-limit", type=float, default=None, metavar="SECONDS",
+                   help="wall-clock budget of the training: stop once it has passed, then "
+                        "evaluate, keep best/ and save the model as at the end of a run")
     p.set_defaults(func=cmd_train)
 
     p = sub.add_parser("export-policy", help="a trained policy as one zip that plain SB3 "
-                                             "(PPO.load / SAC.load / TD3.load) runs as rotordrop does")
+                                             "(PPO.load / SAC.load / TD3.load / TQC.load) runs as rotordrop does")
     p.add_argument("source", help="run directory, its best/, a model or checkpoint zip, or a "
                                   "shipped policy name")
     where = p.add_mutually_exclusive_group(required=True)
@@ -285,6 +304,13 @@ def register(sub) -> None:
                    help="seed of the first drawn scenario (default 10000; scenario i uses it + i)")
     p.add_argument("--no-search", action="store_true",
                    help="score the rows only (no oracle search), e.g. on 200 scenarios")
+    p.add_argument("--friction", type=_number_list(":", 2), default=None, metavar="LO:HI",
+                   help="friction range the scenarios are drawn from (default 0.38:0.6; "
+                        "0 <= LO < HI <= 1)")
+    p.add_argument("--friction-bins", type=_number_list(",", None), default=None,
+                   metavar="E0,E1,...", help="edges of the whirl-rate-per-friction table, from "
+                   "LO to HI (default: 0.38,0.44,0.5,0.55,0.6 on the default range, else "
+                   "0.05-wide bins)")
     p.add_argument("--policy", action="append", default=None,
                    help="extra rows: a training directory / model .zip or module:Class "
                         "(repeatable)")

@@ -64,7 +64,9 @@ from typing import Any
 
 from .config_checks import ConfigError, check_keys, is_finite_number
 
-ALGOS = ("ppo", "sac", "td3")
+ALGOS = ("ppo", "sac", "td3", "tqc")
+#: algorithms from sb3-contrib (the ``rl`` extra installs it)
+CONTRIB_ALGOS = ("tqc",)
 META_KEYS = ("n_timesteps", "n_envs", "policy", "policy_kwargs", "normalize", "env_kwargs",
              "eval_freq", "n_eval_episodes", "checkpoint_freq", "noise_type", "noise_std",
              "reward", "reward_kwargs", "residual", "residual_scale", "validation")
@@ -123,8 +125,14 @@ def load_yaml(text: str):
 
 
 def algo_class(algo: str):
-    """The Stable-Baselines3 class of ``algo``."""
+    """The Stable-Baselines3 (or sb3-contrib: TQC) class of ``algo``."""
     import stable_baselines3 as sb3
+    if algo in CONTRIB_ALGOS:
+        try:
+            import sb3_contrib
+        except ImportError as exc:   # pragma: no cover - the rl extra installs it
+            raise ConfigError(f"--algo {algo} needs sb3-contrib: pip install 'rotordrop[rl]'") from exc
+        return {"tqc": sb3_contrib.TQC}[algo]
     return {"ppo": sb3.PPO, "sac": sb3.SAC, "td3": sb3.TD3}[algo]
 
 

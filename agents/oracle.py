@@ -2,7 +2,7 @@
 scenario, as a bound for learned and designed controllers on the same scenarios.
 
 For each of ``--scenarios`` drops drawn where whirl is decided (``ORACLE_RANGES``: friction
-0.38-0.6, power back 30-70 ms rounded up to the 5 ms control grid, any unbalance phase, the
+0.38-0.6 unless ``--friction LO:HI`` says otherwise, power back 30-70 ms rounded up to the 5 ms control grid, any unbalance phase, the
 environments' default ranges for the rest; seeds from ``SCENARIO_SEED``, disjoint from training
 and evaluation seeds) a
 cross-entropy search (:mod:`agents.search`) optimises an open-loop command sequence of
@@ -22,10 +22,14 @@ sequence is the rollout of lowest J among all the search ran. Every row
 the benchmark's formula, score = 100 (1 - sum J / sum J_passive).
 
 Outputs in ``--out``: ``oracle.json`` (settings, scenarios, per-scenario KPIs and J of every row,
-the oracle's command sequence and search history, the summary table) and ``oracle.png``. The
+the oracle's command sequence and search history, the summary table), ``oracle.png``, and the
+whirl rate per friction bin as ``whirl_by_friction.png`` and ``whirl_by_friction.csv``. The
 search is written after every scenario; a rerun with the same settings continues where it
 stopped and re-scores the rows (add ``--policy`` runs without searching again). ``--no-search``
-scores the rows alone, e.g. on 200 scenarios from another ``--scenario-seed``.
+scores the rows alone, e.g. on 200 scenarios from another ``--scenario-seed``. The whirl
+rate per friction bin (``whirl_by_friction``, ``whirl_by_friction.png``) uses
+``--friction-bins`` edges, by default :data:`FRICTION_BINS` on the default range and 0.05-wide
+bins on any other (:func:`friction_edges`).
 """
 from __future__ import annotations
 
@@ -56,15 +60,55 @@ SHAPING = 0.25
 WHIRL_REVOLUTIONS = 3.0
 
 
-def draw_scenarios(n: int, seed: int = SCENARIO_SEED) -> list[dict]:
+def draw_scenarios(n: int, seed: int = SCENARIO_SEED,
+                   friction: tuple[float, float] | None = None) -> list[dict]:
     """``n`` scenario dicts (dotted scene keys and ``power_return_time``) drawn by the Full
-    environment's own sampler from ``ORACLE_RANGES`` and the default ranges."""
+    environment's own sampler from ``ORACLE_RANGES`` (friction from ``friction`` if given) and
+    the default ranges."""
     from .plant import make_env
-    env = make_env(ENV_ID, randomize=True, randomization=dict(ORACLE_RANGES), episode_time=0.01)
+    ranges = oracle_ranges(friction)
+    env = make_env(ENV_ID, randomize=True, randomization=ranges, episode_time=0.01)
     try:
         return [on_grid(env.reset(seed=seed + i)[1]["scenario"]) for i in range(n)]
     finally:
         env.close()
+
+
+def oracle_ranges(friction: tuple[float, float] | None = None) -> dict:
+    """``ORACLE_RANGES`` with the friction range ``friction`` (checked: 0 <= LO < HI <= 1)."""
+    ranges = dict(ORACLE_RANGES)
+    if friction is not None:
+        ranges["contact.friction"] = check_friction(friction)
+    return ranges
+
+
+def check_friction(friction) -> tuple[float, float]:
+    """``(lo, hi)`` as floats; ValueError unless 0 <= lo < hi <= 1 (the scene's range of mu)."""
+    try:
+        lo, hi = (float(v) for v in friction)
+    except (TypeError, ValueError):
+        raise ValueError(f"--friction must be LO:HI, got {friction!r}") from None
+    if not (0.0 <= lo < hi <= 1.0):
+        raise ValueError(f"--friction must be LO:HI with 0 <= LO < HI <= 1, got {lo:g}:{hi:g}")
+    return lo, hi
+
+
+def friction_edges(friction: tuple[float, float], edges=None) -> tuple[float, ...]:
+    """Bin edges of ``whirl_by_friction`` over the range ``friction``: ``edges`` (checked:
+    increasing, from LO to HI), else :data:`FRICTION_BINS` on the default range and bins on
+    the 0.05 grid (cut at LO and HI) on any other."""
+    lo, hi = friction
+    if edges is None:
+        if (lo, hi) == (FRICTION_BINS[0], FRICTION_BINS[-1]):
+            return FRICTION_BINS
+        inner = np.arange(np.floor(lo / 0.05 + 1e-9) + 1, np.ceil(hi / 0.05 - 1e-9)) * 0.05
+        return tuple(round(float(e), 6) for e in (lo, *inner, hi))
+    edges = tuple(float(e) for e in edges)
+    if len(edges) < 2 or any(b <= a for a, b in zip(edges, edges[1:])) \
+            or not (np.isclose(edges[0], lo) and np.isclose(edges[-1], hi)):
+        raise ValueError(f"--friction-bins must be increasing edges from {lo:g} to {hi:g} "
+                         f"(the --friction range), got {','.join(f'{e:g}' for e in edges)}")
+    return edges
 
 
 def as_benchmark(values: dict, name: str) -> tuple[Scenario, float]:
@@ -212,20 +256,25 @@ def score_rows(per_scenario: list[dict], names: list[str]) -> list[dict]:
 
 def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iterations: int = 10,
            seed: int = 0, policies: list[str] | None = None, progress: bool = True,
-           plots: bool = True, search: bool = True, scenario_seed: int = SCENARIO_SEED) -> dict:
+           plots: bool = True, search: bool = True, scenario_seed: int = SCENARIO_SEED,
+           friction: tuple[float, float] | None = None, friction_bins=None) -> dict:
     """Search the command sequence of each scenario, score every row on the same scenarios and
     write ``oracle.json`` (and ``oracle.png``) into ``out`` (module doc). ``search=False``
-    scores the rows only (no oracle row): the same comparison on many more scenarios."""
+    scores the rows only (no oracle row): the same comparison on many more scenarios.
+    ``friction``: the (LO, HI) range of mu the scenarios are drawn from (default 0.38-0.6);
+    ``friction_bins``: the edges of the per-friction whirl table (:func:`friction_edges`)."""
     from tqdm.auto import tqdm
     from .score import fmt_or_dash
     if scenarios < 1 or population < 2 or iterations < 0:
         raise ValueError(f"need --scenarios >= 1, --population >= 2, --iterations >= 0 (got "
                          f"{scenarios}, {population}, {iterations})")
+    ranges = oracle_ranges(friction)
+    edges = friction_edges(ranges["contact.friction"], friction_bins)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     settings = dict(env_id=ENV_ID, command=COMMAND, scenarios=scenarios, population=population,
                     iterations=iterations, seed=seed, scenario_seed=SCENARIO_SEED,
-                    ranges={k: list(v) for k, v in ORACLE_RANGES.items()},
+                    ranges={k: list(v) for k, v in ranges.items()},
                     segment_edges_ms=list(SEGMENT_EDGES_MS), segment_actions=list(SEGMENT_ACTIONS),
                     max_delay_s=MAX_DELAY, control_dt=CONTROL_DT, shaping=SHAPING,
                     episode_time_s=EPISODE_TIME)
@@ -234,7 +283,7 @@ def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iteration
     entries = row_entries(policies)
     t0 = time.perf_counter()
     per_scenario = []
-    drawn = draw_scenarios(scenarios, scenario_seed)
+    drawn = draw_scenarios(scenarios, scenario_seed, ranges["contact.friction"])
     if not search:
         done = {}
     bar = tqdm(total=scenarios, desc="oracle scenarios", unit="sc", disable=not progress)
@@ -256,20 +305,49 @@ def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iteration
         write_json(out / "oracle.json", report)              # after every scenario: resumable
         bar.update(1)
     bar.close()
-    report["whirl_by_friction"] = whirl_by_friction(report)
+    report["whirl_by_friction"] = whirl_by_friction(report, edges)
+    write_whirl_csv(report["whirl_by_friction"], out / "whirl_by_friction.csv")
     if plots:
         report["figures"] = [plot_oracle(report, out / "oracle.png").name,
                              plot_whirl_by_friction(report, out / "whirl_by_friction.png").name]
     write_json(out / "oracle.json", report)
+    lo, hi = ranges["contact.friction"]
     print(f"{'oracle bound' if search else 'rows'}, {ENV_ID}, {scenarios} scenarios "
-          f"(friction 0.38-0.6, power back 30-70 ms, seeds from {scenario_seed}):")
+          f"(friction {lo:g}-{hi:g}, power back 30-70 ms, seeds from {scenario_seed}):")
     print("| controller | score | whirl rate | whirl where passive whirls | re-levitated |")
     print("|---|---:|---:|---:|---:|")
     for e in report["summary"]:
         print(f"| {e['controller']} | {e['score']:.2f} | {e['whirl_rate']:.2f} | "
               f"{fmt_or_dash(e['whirl_rate_where_passive_whirls'], '.2f')} | "
               f"{e['relevitation_rate']:.2f} |")
+    print_whirl_by_friction(report["whirl_by_friction"])
     return report
+
+
+def write_whirl_csv(table: dict, path: Path) -> Path:
+    """The per-friction whirl table as CSV: one line per row and bin (controller, bin edges,
+    drops, whirling drops, whirl rate; empty where the bin has no drop)."""
+    import csv
+    edges = table["edges"]
+    with Path(path).open("w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["controller", "mu_lo", "mu_hi", "drops", "whirls", "whirl_rate"])
+        for name, rates in table["rates"].items():
+            for lo, hi, n, r in zip(edges[:-1], edges[1:], table["counts"], rates):
+                w.writerow([name, lo, hi, n, "" if r is None else round(r * n),
+                            "" if r is None else f"{r:.4f}"])
+    return Path(path)
+
+
+def print_whirl_by_friction(table: dict) -> None:
+    """The per-friction whirl table as markdown (rows: controllers; columns: bins)."""
+    edges = table["edges"]
+    bins = [f"{a:.2f}-{b:.2f}" for a, b in zip(edges[:-1], edges[1:])]
+    print("| whirl rate per friction bin | " + " | ".join(bins) + " |")
+    print("|---|" + "---:|" * len(bins))
+    print("| drops | " + " | ".join(str(c) for c in table["counts"]) + " |")
+    for name, rates in table["rates"].items():
+        print(f"| {name} | " + " | ".join("-" if r is None else f"{r:.2f}" for r in rates) + " |")
 
 
 def _report(settings: dict, per_scenario: list[dict], names: list[str], t0: float,
@@ -360,7 +438,7 @@ def plot_whirl_by_friction(report: dict, path: Path) -> Path:
         ax.plot(mid, rates, "o-", label=name)
     ax.set(xlabel="friction coefficient (bin centre)", ylabel="backward-whirl rate",
            ylim=(-0.02, 1.02), title="drops per bin: " + ", ".join(str(c) for c in table["counts"]))
-    ax.axhline(0.05, color="k", lw=0.8, ls=":")
+    ax.axhline(0.05, color="k", lw=0.8, ls=":", label="goal: 5 %")
     ax.legend(fontsize=7)
     ax.grid(alpha=0.3)
     fig.tight_layout()

@@ -116,13 +116,15 @@ class LearnedPolicy:
             raise FileNotFoundError(f"no model at {model_path}" + (
                 " (nor best_model.zip: a run's best/)" if path.is_dir() else ""))
         algo = meta.get("algo") or _algo_from_zip(model_path)
-        env_id = meta.get("env_id")
+        model = algo_class(algo).load(str(model_path), device="cpu")
+        inside = model.policy.rotordrop if is_self_contained(model) else {}
+        env_id = meta.get("env_id") or inside.get("env_id")
         if env_id is None:
             raise FileNotFoundError(f"cannot tell which environment {model_path} was trained on: "
                                     f"no config.yaml or .json next to it")
         hp = meta.get("hyperparams", {})
-        env_kwargs = dict(meta.get("env_kwargs") or hp.get("env_kwargs") or {})
-        model = algo_class(algo).load(str(model_path), device="cpu")
+        env_kwargs = dict(meta.get("env_kwargs") or hp.get("env_kwargs")
+                          or inside.get("env_kwargs") or {})
         task = env_id.split("-")[1].lower() if env_id.count("-") >= 2 else "policy"
         if is_self_contained(model):        # normalisation and residual are inside the zip
             vn, settings = None, model.policy.rotordrop
@@ -176,6 +178,11 @@ def _read_meta(path: Path) -> dict:
 
 
 def _algo_from_zip(path: Path) -> str:
+    """The algorithm from the zip's policy class, else from its name (``<algo>-...``)."""
+    from .sb3_policy import zip_algo
+    found = zip_algo(path)
+    if found is not None:
+        return found
     for a in ALGO_NAMES:
         if a in path.stem.lower():
             return a

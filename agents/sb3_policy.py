@@ -1,5 +1,5 @@
-"""Self-contained policy zips: plain ``PPO.load`` / ``SAC.load`` / ``TD3.load`` act like the
-project's loader.
+"""Self-contained policy zips: plain ``PPO.load`` / ``SAC.load`` / ``TD3.load`` (and
+sb3-contrib's ``TQC.load``) act like the project's loader.
 
 A policy trained by ``rotordrop train`` needs two things besides its network: the observation
 normalisation (``VecNormalize`` statistics) and, for a residual policy (config ``residual:``),
@@ -22,7 +22,11 @@ checkpoints (``rotordrop train --resume``).
 """
 from __future__ import annotations
 
+import base64
 import copy
+import json
+import pickletools
+import zipfile
 from pathlib import Path
 from typing import Any
 
@@ -31,6 +35,11 @@ import torch as th
 from stable_baselines3.common.policies import ActorCriticPolicy
 from stable_baselines3.sac.policies import SACPolicy
 from stable_baselines3.td3.policies import TD3Policy
+
+try:                                    # TQC is sb3-contrib's (the rl extra installs it)
+    from sb3_contrib.tqc.policies import TQCPolicy
+except ImportError:                     # pragma: no cover
+    TQCPolicy = None
 
 #: the ``policy_kwargs`` entry that carries the environment, normalisation and residual
 KEY = "rotordrop"
@@ -129,19 +138,57 @@ class RotorDropTD3Policy(SelfContained, TD3Policy):
 POLICY_CLASSES = {ActorCriticPolicy: RotorDropActorCriticPolicy, SACPolicy: RotorDropSACPolicy,
                   TD3Policy: RotorDropTD3Policy}
 
+if TQCPolicy is not None:
+    class RotorDropTQCPolicy(SelfContained, TQCPolicy):
+        """TQC's (sb3-contrib) ``MlpPolicy`` with the normalisation and residual inside."""
+
+        def __init__(self, *args, rotordrop: dict | None = None, **kwargs):
+            super().__init__(*args, **kwargs)
+            self._setup_rotordrop(rotordrop)
+
+    POLICY_CLASSES[TQCPolicy] = RotorDropTQCPolicy
+
+
+#: the module of a plain SB3 model's policy class -> its algorithm
+PLAIN_MODULES = {"stable_baselines3.common.policies": "ppo", "stable_baselines3.sac.policies": "sac",
+                 "stable_baselines3.td3.policies": "td3", "sb3_contrib.tqc.policies": "tqc"}
+#: the self-contained policy classes -> their algorithm
+EXPORTED_ALGOS = {"RotorDropActorCriticPolicy": "ppo", "RotorDropSACPolicy": "sac",
+                  "RotorDropTD3Policy": "td3", "RotorDropTQCPolicy": "tqc"}
+
+
+def zip_algo(path: str | Path) -> str | None:
+    """The algorithm of an SB3 model zip (plain or self-contained) from its saved policy class,
+    read without loading the model; None for a policy class of no supported algorithm.
+    ValueError if ``path`` is not an SB3 model zip."""
+    try:
+        with zipfile.ZipFile(path) as z:
+            cls = json.loads(z.read("data")).get("policy_class", {})
+    except (OSError, KeyError, ValueError, zipfile.BadZipFile) as exc:
+        raise ValueError(f"{path} is not a Stable-Baselines3 model zip ({exc})") from exc
+    module = cls.get("__module__")
+    if module != __name__:
+        return PLAIN_MODULES.get(module)
+    try:                          # the pickled reference names the class: read it, import nothing
+        ops = pickletools.genops(base64.b64decode(cls.get(":serialized:", "")))
+        names = {arg for _, arg, _ in ops if isinstance(arg, str)}
+    except ValueError:
+        return None
+    return next((EXPORTED_ALGOS[n] for n in names if n in EXPORTED_ALGOS), None)
+
 
 def _exported_class(policy) -> type:
     for base, cls in POLICY_CLASSES.items():
         if type(policy) in (base, cls):
             return cls
-    raise ValueError(f"cannot export a {type(policy).__name__}: only the MlpPolicy of PPO, SAC "
-                     "and TD3 is supported")
+    raise ValueError(f"cannot export a {type(policy).__name__}: only the MlpPolicy of PPO, SAC, "
+                     "TD3 and TQC is supported")
 
 
 def export_self_contained(model, vecnormalize, out_path: str | Path, *, env_id: str | None = None,
                           env_kwargs: dict | None = None, residual: str | None = None,
                           residual_scale: float | None = None) -> Path:
-    """Write ``model`` (a PPO / SAC / TD3 with an ``MlpPolicy``) as a zip that plain SB3 loads
+    """Write ``model`` (a PPO / SAC / TD3 / TQC with an ``MlpPolicy``) as a zip that plain SB3 loads
     and runs like the project's loader: ``vecnormalize`` (a ``VecNormalize`` or None) and the
     ``residual`` baseline (name, ``residual_scale``) go inside the policy. ``env_id`` and
     ``env_kwargs`` name the training environment (the residual's plant); without ``env_id``

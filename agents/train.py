@@ -35,7 +35,6 @@ import shlex
 import shutil
 import sys
 import time
-import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -44,10 +43,7 @@ import numpy as np
 from .hyperparams import (ALGOS, ConfigError, algo_class, check_sb3, dump_yaml, load_hyperparams,
                           read_yaml, split)
 
-OFF_POLICY = ("sac", "td3")
-#: the module of a saved model's policy class -> its algorithm
-POLICY_MODULES = {"stable_baselines3.common.policies": "ppo", "stable_baselines3.sac.policies": "sac",
-                  "stable_baselines3.td3.policies": "td3"}
+OFF_POLICY = ("sac", "td3", "tqc")
 #: what a run writes into --out (a directory holding one of them holds a run)
 RUN_FILES = ("model.zip", "vecnormalize.pkl", "config.yaml", "training.json", "learning_curve.png",
              "monitor.csv", "best", "checkpoints", "eval", "tb")
@@ -92,13 +88,19 @@ def _callbacks():
             return True
 
     class KpiEvalCallback(EvalCallback):
-        """EvalCallback that also records the episode KPIs (backward whirl, peak force...)."""
+        """EvalCallback that also records the episode KPIs (backward whirl, peak force...) and
+        the wall-clock time since this session's training started (``wall_time_s``)."""
 
         def __init__(self, *args, eval_seed: int = 0, **kwargs):
             super().__init__(*args, **kwargs)
             self.eval_seed = eval_seed
             self.kpi_history: list[dict] = []
             self._kpis: list[dict] = []
+            self.t0 = time.perf_counter()
+
+        def _on_training_start(self):
+            super()._on_training_start()
+            self.t0 = time.perf_counter()
 
         def _log_success_callback(self, locals_, globals_):
             super()._log_success_callback(locals_, globals_)
@@ -117,7 +119,8 @@ def _callbacks():
             if len(self.evaluations_timesteps) > n_before:
                 rewards = self.evaluations_results[-1]
                 entry = dict(timesteps=int(self.num_timesteps), mean_reward=float(np.mean(rewards)),
-                             std_reward=float(np.std(rewards)))
+                             std_reward=float(np.std(rewards)),
+                             wall_time_s=time.perf_counter() - self.t0)
                 for key in sorted({k for d in self._kpis for k in d}):
                     mean = mean_finite(d.get(key) for d in self._kpis)      # NaN (no value) skipped
                     if mean is not None:
@@ -227,8 +230,27 @@ def _callbacks():
             write_json(self.path, summary)                # strict JSON, as every report
             return wall
 
+    class WallClockLimit(BaseCallback):
+        """Ends training once ``limit`` seconds of wall-clock time have passed since it started
+        (checked every step; SB3 then ends ``learn`` as at its last step, so the final
+        evaluation, ``best/`` and the model are written as usual). Marks ``record``."""
+
+        def __init__(self, limit: float, record: dict):
+            super().__init__()
+            self.limit, self.record, self.t0 = float(limit), record, time.perf_counter()
+
+        def _on_training_start(self):
+            self.t0 = time.perf_counter()
+            self.record["stopped_by_time_limit"] = False
+
+        def _on_step(self) -> bool:
+            if time.perf_counter() - self.t0 < self.limit:
+                return True
+            self.record["stopped_by_time_limit"] = True
+            return False
+
     return (SaveBest, KpiEvalCallback, TqdmCallback, ValidationCallback, FinalCheckpoint,
-            RecordCallback)
+            RecordCallback, WallClockLimit)
 
 
 def save_policy(model, path: Path, env_id: str, meta: dict) -> None:
@@ -298,11 +320,15 @@ def train(env_id: str, algo: str, out: str | Path, timesteps: int | None = None,
           resume: str | Path | None = None, threads: int = 1, progress: bool = True,
           verbose: int = 0, command: str | None = None, overwrite: bool = False,
           eval_freq: int | None = None, n_eval_episodes: int | None = None,
-          checkpoint_freq: int | None = None) -> TrainResult:
+          checkpoint_freq: int | None = None, time_limit: float | None = None) -> TrainResult:
     """Train ``algo`` on ``env_id`` and save model, statistics, config and learning curve
-    (module docstring: resuming, an existing ``out``, the final evaluation)."""
+    (module docstring: resuming, an existing ``out``, the final evaluation). ``time_limit``
+    [s of wall-clock time]: stop training once it has passed (the run then ends as at its last
+    step: final evaluation, ``best/``, model, ``training.json`` with ``stopped_by_time_limit``)."""
     if algo not in ALGOS:
         raise ConfigError(f"--algo must be one of {', '.join(ALGOS)}, got {algo!r}")
+    if time_limit is not None and not (np.isfinite(time_limit) and time_limit > 0):
+        raise ConfigError(f"--time-limit must be a number of seconds > 0, got {time_limit}")
     if int(threads) < 1:
         raise ConfigError(f"--threads must be >= 1, got {threads}")
     from stable_baselines3.common.callbacks import CallbackList
@@ -330,14 +356,15 @@ def train(env_id: str, algo: str, out: str | Path, timesteps: int | None = None,
     _remove(out, held)
     out.mkdir(parents=True, exist_ok=True)
     _log_episodes(monitor, out / "monitor.csv", env_id, append=continuing)
-    record = dict(algo=algo, env_id=env_id, seed=seed, threads=threads,
+    record = dict(algo=algo, env_id=env_id, seed=seed, threads=threads, time_limit_s=time_limit,
                   command=command or f"rotordrop train --env {env_id} --algo {algo} --seed {seed}",
                   resumed_from=str(ckpt[0]) if ckpt else None, hyperparams=hp,
                   versions=_versions())
     dump_yaml(record, out / "config.yaml")
 
     eval_cb, record_cb, cbs = _training_callbacks(env_id, algo, meta, seed, out, eval_venv, record,
-                                                  curve, eval_log, total if progress else None)
+                                                  curve, eval_log, total if progress else None,
+                                                  time_limit)
     model.learn(total_timesteps=remaining, callback=CallbackList(cbs), tb_log_name=algo,
                 reset_num_timesteps=ckpt is None, progress_bar=False)
     model_path = out / "model.zip"
@@ -372,11 +399,13 @@ def _build(env_id: str, algo: str, meta: dict, algo_kwargs: dict, seed: int, ckp
 
 
 def _training_callbacks(env_id: str, algo: str, meta: dict, seed: int, out: Path, eval_venv,
-                        record: dict, curve: list[dict], eval_log: dict, progress_total: int | None):
+                        record: dict, curve: list[dict], eval_log: dict, progress_total: int | None,
+                        time_limit: float | None = None):
     """(evaluation, record, all callbacks): evaluation with KPIs continuing ``curve`` and
-    ``eval_log`` from their best score, validation, checkpoints, progress bar, training.json."""
+    ``eval_log`` from their best score, validation, checkpoints, progress bar, training.json,
+    the wall-clock limit."""
     SaveBest, KpiEvalCallback, TqdmCallback, ValidationCallback, FinalCheckpoint, \
-        RecordCallback = _callbacks()
+        RecordCallback, WallClockLimit = _callbacks()
     n = meta.get("n_envs", 1)
     eval_freq = max(meta.get("eval_freq", 10_000) // n, 1) if meta.get("eval_freq", 1) else -1
     keep_best = eval_freq > 0 and not meta["validation"]      # else ValidationCallback keeps it
@@ -401,7 +430,8 @@ def _training_callbacks(env_id: str, algo: str, meta: dict, seed: int, out: Path
     if progress_total is not None:
         cbs.append(TqdmCallback(progress_total, eval_cb))
     record_cb = RecordCallback(out / "training.json", record, eval_cb)
-    return eval_cb, record_cb, cbs + [record_cb]
+    limit = [WallClockLimit(time_limit, record)] if time_limit is not None else []
+    return eval_cb, record_cb, limit + cbs + [record_cb]
 
 
 def _train_env(venv, norm):
@@ -502,13 +532,12 @@ def _check_resumed_run(checkpoint: Path, algo: str, env_id: str) -> None:
 
 
 def _checkpoint_algo(path: Path) -> str | None:
-    """The algorithm of an SB3 model zip, from the module of its policy class (None: unknown)."""
+    """The algorithm of an SB3 model zip, from its policy class (None: unknown)."""
+    from .sb3_policy import zip_algo
     try:
-        with zipfile.ZipFile(path) as z:
-            data = json.loads(z.read("data"))
-    except (OSError, KeyError, ValueError, zipfile.BadZipFile) as exc:
-        raise ConfigError(f"--resume {path} is not a Stable-Baselines3 model zip ({exc})") from exc
-    return POLICY_MODULES.get(data.get("policy_class", {}).get("__module__"))
+        return zip_algo(path)
+    except ValueError as exc:
+        raise ConfigError(f"--resume {exc.args[0]}") from exc
 
 
 def _held_run(out: Path, continuing: bool, overwrite: bool) -> list[str]:

@@ -354,3 +354,21 @@ def test_a_shipped_policy_trained_on_randomised_scenes_evaluates_fixed(tmp_path)
     r = _strict((out / "kpis.json").read_text())
     assert "randomization" not in r["env_kwargs"] and not r["env_kwargs"]["randomize"]
     assert r["episodes"][0]["scenario"]["contact.friction"] == 0.3
+
+
+
+def test_a_friction_range_that_is_not_two_numbers_is_a_flag_error(capsys, tmp_path):
+    err = _flag_error(["oracle", "--friction", "0.3", "--out", str(tmp_path / "x")], capsys)
+    assert err.endswith("argument --friction: expected LO:HI (numbers), got '0.3'")
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["oracle", "--friction", "0.6:0.3", "--no-search"],
+     "--friction must be LO:HI with 0 <= LO < HI <= 1, got 0.6:0.3"),
+    (["train", "--env", "RotorDrop-Relevitate-v0", "--algo", "tqc", "--time-limit", "0"],
+     "--time-limit must be a number of seconds > 0, got 0.0")])
+def test_a_bad_friction_range_or_time_limit_fails_before_anything_is_written(argv, message, capsys,
+                                                                           tmp_path):
+    assert main([*argv, "--out", str(tmp_path / "x")]) == 2
+    assert capsys.readouterr().err.strip().splitlines()[-1].endswith(message)
+    assert not (tmp_path / "x").exists()

@@ -82,7 +82,7 @@ def _trained_run(tmp_path, algo, residual=None):
     return model, venv, env_id, env_kwargs
 
 
-@pytest.mark.parametrize("algo", ["ppo", "sac", "td3"])
+@pytest.mark.parametrize("algo", ["ppo", "sac", "td3", "tqc"])
 def test_an_exported_model_acts_as_model_plus_vecnormalize_plus_residual(tmp_path, algo):
     model, vn, env_id, env_kwargs = _trained_run(tmp_path, algo)
     out = export_self_contained(model, vn, tmp_path / "policy.zip", env_id=env_id,

@@ -11,7 +11,7 @@ from helpers import phys
 ENV_IDS = ("RotorDrop-Damping-v0", "RotorDrop-Relevitate-v0", "RotorDrop-Full-v0")
 
 
-@pytest.mark.parametrize("algo", ["ppo", "sac", "td3"])
+@pytest.mark.parametrize("algo", ["ppo", "sac", "td3", "tqc"])
 def test_shipped_configs_parse(algo):
     from gymnasium.spaces import Box
     from agents.plant import make_env
@@ -20,7 +20,7 @@ def test_shipped_configs_parse(algo):
         assert meta["n_timesteps"] > 0 and meta["n_envs"] >= 1
         assert isinstance(kwargs["policy_kwargs"], dict)
         env = make_env(env_id, **meta["env_kwargs"])          # the env the config trains on
-        if algo != "ppo":       # SAC/TD3 need continuous actions
+        if algo != "ppo":       # SAC/TD3/TQC need continuous actions
             assert isinstance(env.action_space, Box), (algo, env_id)
 
 

@@ -30,3 +30,15 @@ def test_mean_and_std_over_seeds_on_shared_steps(tmp_path):
     assert float(first["validation_score_std"]) == 10.0
     assert [r["label"] for r in rows].count("sac") == 3
     assert (tmp_path / "lc.png").stat().st_size > 0
+
+
+def test_other_quantities_of_the_curve(tmp_path):
+    """--quantity picks learning-curve entries (a run without one gives NaN, not an error)."""
+    a = fake_run(tmp_path / "a", [10, 20], [1.0, 0.5])
+    assert main(["--group", f"tqc={a}", "--quantity", "mean_backward_whirl",
+                 "--quantity", "mean_relevitated", "--out", str(tmp_path / "q.png")]) == 0
+    rows = list(csv.DictReader((tmp_path / "q.csv").open()))
+    assert list(rows[0]) == ["label", "timesteps", "runs", "mean_backward_whirl_mean",
+                             "mean_backward_whirl_std", "mean_relevitated_mean", "mean_relevitated_std"]
+    assert [float(r["mean_backward_whirl_mean"]) for r in rows] == [1.0, 0.5]
+    assert rows[0]["mean_relevitated_mean"] == "nan"

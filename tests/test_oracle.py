@@ -85,3 +85,29 @@ def test_whirl_by_friction_bins_the_scenarios():
     t = whirl_by_friction(dict(per_scenario=per, summary=[{"controller": "a"}]))
     assert t["counts"] == [2, 0, 1, 1]                  # 0.60 falls in the last bin
     assert t["rates"]["a"] == [0.5, None, 1.0, 1.0]
+
+
+def test_a_friction_range_draws_there_and_bins_its_whirl_table(tmp_path, capsys):
+    """--friction 0.3:0.36: every scenario's mu in the range (the other draws as before), the
+    per-friction table on the given edges, printed; a bad range or bad edges fail at once."""
+    from agents.oracle import friction_edges
+    wide, low = draw_scenarios(8, 20_000), draw_scenarios(8, 20_000, (0.3, 0.36))
+    assert all(0.3 <= s["contact.friction"] <= 0.36 for s in low)
+    assert [s["power_return_time"] for s in low] == [s["power_return_time"] for s in wide]
+    rep = oracle(tmp_path, scenarios=3, search=False, scenario_seed=20_000, progress=False,
+                 plots=False, friction=(0.3, 0.36), friction_bins=(0.3, 0.33, 0.36))
+    assert rep["settings"]["ranges"]["contact.friction"] == [0.3, 0.36]
+    table = rep["whirl_by_friction"]
+    assert table["edges"] == [0.3, 0.33, 0.36] and sum(table["counts"]) == 3
+    assert "| drops |" in capsys.readouterr().out
+    lines = (tmp_path / "whirl_by_friction.csv").read_text().splitlines()
+    assert lines[0] == "controller,mu_lo,mu_hi,drops,whirls,whirl_rate"
+    assert len(lines) == 1 + 2 * len(table["rates"])               # a line per row and bin
+    assert friction_edges((0.3, 0.6)) == (0.3, 0.35, 0.4, 0.45, 0.5, 0.55, 0.6)
+    assert friction_edges((0.38, 0.6)) == (0.38, 0.44, 0.5, 0.55, 0.6)       # the default's bins
+    with pytest.raises(ValueError, match=r"--friction must be LO:HI with 0 <= LO < HI <= 1, got 0.5:0.3"):
+        oracle(tmp_path / "bad", scenarios=1, search=False, friction=(0.5, 0.3))
+    with pytest.raises(ValueError, match="--friction-bins must be increasing edges from 0.3 to 0.6"):
+        oracle(tmp_path / "bad", scenarios=1, search=False, friction=(0.3, 0.6),
+               friction_bins=(0.3, 0.5, 0.4, 0.6))
+    assert not (tmp_path / "bad").exists()                    # nothing written
