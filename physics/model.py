@@ -311,9 +311,15 @@ def sleeve_motion(y, I, k):
 
 @njit
 def rhs(t, y, P, I, U, dy, aux):
-    """dy/dt of the drop-down model (spec §1, §3-6). Fills ``aux`` with per-plane diagnostics."""
-    for i in range(dy.shape[0]):
-        dy[i] = 0.0
+    """dy/dt of the drop-down model (spec §1, §3-6). Fills ``aux`` with per-plane diagnostics.
+
+    ``dy = None``: the diagnostics alone (the output samples', :func:`diagnostics`), the same
+    values bit for bit; numba compiles that variant without the blocks under ``dy is not None``
+    (unbalance, AMBs, the bodies' and heat derivatives, the rotor's equations of motion), and
+    the sums that only feed them (forces, moments, powers) go unused."""
+    if dy is not None:
+        for i in range(dy.shape[0]):
+            dy[i] = 0.0
     m = P[P_M]
     g = P[P_G]
     vx, vy, va, vb = y[I[S_VX]], y[I[S_VY]], y[I[S_VA]], y[I[S_VB]]
@@ -327,7 +333,7 @@ def rhs(t, y, P, I, U, dy, aux):
     p_ext = 0.0         # power of external and non-potential forces (unbalance, AMB, film, cage)
 
     # unbalance
-    if I[F_UNB]:
+    if dy is not None and I[F_UNB]:
         iphi = I[S_PHI]
         ux, uy = unbalance_force(P[P_MUE], W, y[iphi] + P[P_UB_PHASE])
         z = P[P_Z_UB]
@@ -340,7 +346,7 @@ def rhs(t, y, P, I, U, dy, aux):
 
     # AMBs (hold the rotor until the fault)
     amb = I[F_AMB]
-    if amb == AMB_ACTUATOR or (amb == AMB_LINEAR and U[U_AMB_POWER] > 0.0):
+    if dy is not None and (amb == AMB_ACTUATOR or (amb == AMB_LINEAR and U[U_AMB_POWER] > 0.0)):
         # actuator (spec §5): the PID states evolve only under the built-in controller; the
         # magnets pull while powered or driven directly. The per-axis law takes scalars so that
         # it compiles inline here (as an array-taking call it cost ~90 ns per axis)
@@ -491,7 +497,8 @@ def rhs(t, y, P, I, U, dy, aux):
             load = math.sqrt(qx * qx + qy * qy)
             p_diss += P[P_CB] * (uvx * uvx + uvy * uvy)
             p_ext += dV * P[P_CAGE] * ws          # cage rotation under load (no torque in the model)
-            dy[i_th] = ws
+            if dy is not None:
+                dy[i_th] = ws
         elif I[F_RB] == RB_LINEAR:
             bfx = -P[P_KLIN] * ux - P[P_CB] * uvx
             bfy = -P[P_KLIN] * uy - P[P_CB] * uvy
@@ -505,21 +512,22 @@ def rhs(t, y, P, I, U, dy, aux):
                 drag_t = drag_torque_magnitude(ws, load, P[P_M0_LOW], P[P_M0_COEF], P[P_M1_COEF],
                                                P[P_MSEAL]) * smooth_sign(ws, P[P_WL])
                 p_diss += drag_t * ws
-            dws = (P[P_RS] * f_mu - drag_t) / P[P_JS]
-            dy[i_ws] = dws
-            if I[F_RB] == RB_SM and I[F_FILM]:
-                # film growth changes the ball potential without a force doing work
-                p_ext += qsum * dh_dw * dws
+            if dy is not None:
+                dws = (P[P_RS] * f_mu - drag_t) / P[P_JS]
+                dy[i_ws] = dws
+                if I[F_RB] == RB_SM and I[F_FILM]:
+                    # film growth changes the ball potential without a force doing work
+                    p_ext += qsum * dh_dw * dws
 
         # --- sleeve translation ---
-        if i_sx >= 0:
+        if dy is not None and i_sx >= 0:
             ms = P[P_MS]
             dy[i_sx] = svx
             dy[I[base + J_SY]] = svy
             dy[I[base + J_SVX]] = (cfx + bfx) / ms
             dy[I[base + J_SVY]] = (cfy + bfy) / ms - g
         # --- housing ---
-        if i_hx >= 0:
+        if dy is not None and i_hx >= 0:
             cs = U[U_CS1 + k]
             if I[I_CS] >= 0:                     # semi-active damper lags its command (spec §6)
                 # the clamp is needed: U is a public input, and even the env's command
@@ -551,7 +559,7 @@ def rhs(t, y, P, I, U, dy, aux):
         aux[o + A_QMAX] = qmax
 
     i_heat = I[I_THERM]
-    if i_heat >= 0:                              # effects.thermal: sleeve heating, heat audit
+    if dy is not None and i_heat >= 0:           # effects.thermal: sleeve heating, heat audit
         q_lost = 0.0
         w_fric = 0.0
         for k in range(2):
@@ -586,6 +594,8 @@ def rhs(t, y, P, I, U, dy, aux):
         aux[A_STATOR] = 0.0
         aux[A_STATOR + 1] = 0.0
 
+    if dy is None:
+        return
     # rotor equations of motion
     dy[I[S_X]] = vx
     dy[I[S_Y]] = vy
@@ -714,9 +724,8 @@ def mechanical_energy(y, P, I):
 @njit
 def diagnostics(T, Y, P, I, U, AUX):
     """Fill AUX[k] with the per-plane diagnostics at each output sample (post-processing)."""
-    dy = np.empty(Y.shape[1])
     for k in range(Y.shape[0]):
-        rhs(T[k], Y[k], P, I, U, dy, AUX[k])
+        rhs(T[k], Y[k], P, I, U, None, AUX[k])
 
 
 @njit
