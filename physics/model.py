@@ -316,7 +316,9 @@ def rhs(t, y, P, I, U, dy, aux):
     ``dy = None``: the diagnostics alone (the output samples', :func:`diagnostics`), the same
     values bit for bit; numba compiles that variant without the blocks under ``dy is not None``
     (unbalance, AMBs, the bodies' and heat derivatives, the rotor's equations of motion), and
-    the sums that only feed them (forces, moments, powers) go unused."""
+    the sums that only feed them (forces, moments, powers) go unused, and the second retainer
+    plane copies the first one's diagnostics when its inputs are the first one's bit for bit
+    (:func:`twin_planes`: a symmetric drop), which is what computing them again would give."""
     if dy is not None:
         for i in range(dy.shape[0]):
             dy[i] = 0.0
@@ -394,7 +396,14 @@ def rhs(t, y, P, I, U, dy, aux):
             p_ext += fx * ddx + fy * ddy
 
     # retainer planes: rotor-sleeve contact, sleeve on ball bearing, housing
+    twin = False
+    if dy is None:
+        twin = twin_planes(y, P, I)
     for k in range(2):
+        if twin and k == 1:
+            for j in range(N_AUX_PLANE):
+                aux[N_AUX_PLANE + j] = aux[j]
+            continue
         base = I_PLANES + k * N_PLANE_IDX
         z = P[P_Z_RB1 + k]
         px, py, pvx, pvy = axis_motion(y, I, z)
@@ -610,6 +619,29 @@ def rhs(t, y, P, I, U, dy, aux):
     if I[F_AUDIT]:
         dy[I[S_EDISS]] = p_diss
         dy[I[S_WEXT]] = p_ext
+
+
+@njit
+def _same(a, b):
+    """a and b are the same float bit for bit (0.0 and -0.0 differ, NaN never matches)."""
+    return a == b and math.copysign(1.0, a) == math.copysign(1.0, b)
+
+
+@njit
+def twin_planes(y, P, I):
+    """The second retainer plane's inputs to :func:`rhs` (rotor axis, sleeve and housing motion,
+    sleeve speed, cage angle, sleeve temperature) are the first one's bit for bit, so are its
+    diagnostics: what a symmetric rotor on symmetric supports keeps through a drop."""
+    px, py, vx, vy = axis_motion(y, I, P[P_Z_RB1])
+    qx, qy, wx, wy = axis_motion(y, I, P[P_Z_RB2])
+    if not (_same(px, qx) and _same(py, qy) and _same(vx, wx) and _same(vy, wy)):
+        return False
+    for j in range(N_PLANE_IDX):                 # the plane's bodies: every state or none
+        i = I[I_PLANES + j]
+        if i >= 0 and not _same(y[i], y[I[I_PLANES + N_PLANE_IDX + j]]):
+            return False
+    i = I[I_THERM]
+    return i < 0 or _same(y[i], y[i + 1])
 
 
 @njit

@@ -43,12 +43,14 @@ def test_step_collapse_and_step_budget_raise_clear_errors():
     {"effects.stator_contact": True, "effects.amb": "actuator", "contact.friction": 0.5},
     {"effects.retainer_bearing": "linear", "effects.friction": "kinematic",
      "contact.law": "hertz_line"},
+    {"positions.rb2": 0.3, "contact.friction": 0.5},                  # asymmetric: no twin planes
 ])
 def test_output_sample_diagnostics_equal_the_full_right_hand_sides_bit_for_bit(overrides):
     """The output samples' diagnostics come from the right-hand side without its derivative
     assembly (``dy = None``): every column equals what the full right-hand side (the one the
-    integrator calls) fills in at the same state, time and controls, bit for bit."""
-    from physics.model import N_AUX, diagnostics, rhs
+    integrator calls) fills in at the same state, time and controls, bit for bit, also where the
+    second retainer plane copies the first one's (a symmetric drop, ``twin_planes``)."""
+    from physics.model import N_AUX, diagnostics, rhs, twin_planes
     from physics.simulate import segments
     r = simulate(load_scene("paper", overrides), t_end=0.13)
     m = r.model
@@ -66,3 +68,5 @@ def test_output_sample_diagnostics_equal_the_full_right_hand_sides_bit_for_bit(o
         if not powered:      # the samples the metrics read after the fault (sample_diagnostics)
             assert np.array_equal(full[sel], r.aux[sel])
     assert (r.aux[:, 0] > 0.0).any()            # the samples include contact
+    twins = [twin_planes(y, m.P, m.I) for y in Y[r.t > 0.11]]
+    assert all(twins) != ("positions.rb2" in overrides)        # a symmetric drop stays symmetric
