@@ -3,6 +3,7 @@ the checks that say when they do not describe a clean drop (contact before the f
 contact, no fault in the run, output samples too coarse), listed as ``warnings``."""
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -28,10 +29,20 @@ STEP_PEAK_KEYS = {"peak_contact_force_N": P_FR, "peak_bearing_load_N": P_LOAD,
                   "max_ball_load_N": P_QMAX}      # metrics key -> physics.integrate peak column
 
 
+def per_plane(result: Result, compute) -> dict:
+    """{plane: compute(plane)} over the retainer planes (``compute`` returns a flat dict);
+    computed once and copied when both planes' time series are the same bit for bit
+    (:meth:`Result.twin_planes`, a symmetric drop), which gives the same numbers."""
+    first = compute(PLANES[0])
+    twin = result.twin_planes()
+    return {p: first if k == 0 else dict(first) if twin else compute(p)
+            for k, p in enumerate(PLANES)}
+
+
 def first_contact_time(result: Result) -> float | None:
     """Earliest time either plane's gap closes, interpolated between samples [s]."""
     best = None
-    for p in PLANES:
+    for p in PLANES[:1] if result.twin_planes() else PLANES:
         d = result.penetration(p)
         hit = np.flatnonzero(d > 0.0)
         if hit.size == 0:
@@ -82,6 +93,7 @@ def friction_heat(result: Result, plane: str, post: np.ndarray) -> np.ndarray:
     return np.concatenate(([0.0], np.cumsum(0.5 * (p[1:] + p[:-1]) * np.diff(t))))[:len(t)]
 
 
+@functools.lru_cache(maxsize=64)
 def rating_pressure(bearing) -> float:
     """Worst ball-race Hertz pressure [Pa] at s_0 = 1: the bearing statically carrying its load
     rating C_0 (``bearing.static_load_rating``) with a ball under the load
@@ -226,13 +238,14 @@ def contact_validity(result: Result) -> dict:
     model's calibration)."""
     scene = result.model.scene
     film = bool(result.model.I[F_FILM])
-    planes = {}
-    for p in PLANES:
+
+    def plane(p: str) -> dict:
         pen = result.penetration(p)
         ws = np.abs(result.sleeve_speed(p))
         h = film_thickness(float(ws.max()), result.model.P[P_FILM])[0] if film and len(ws) else None
-        planes[p] = dict(max_penetration_um=max(float(pen.max()), 0.0) * 1e6 if len(pen) else 0.0,
-                         max_film_thickness_um=h * 1e6 if h is not None else None)
+        return dict(max_penetration_um=max(float(pen.max()), 0.0) * 1e6 if len(pen) else 0.0,
+                    max_film_thickness_um=h * 1e6 if h is not None else None)
+    planes = per_plane(result, plane)
     bound = line_validity(scene.contact.clearance) * 1e6
     play = scene.bearing.clearance / 2.0 * 1e6
     return dict(planes=planes, penetration_validity_um=bound, bearing_radial_play_um=play,
@@ -362,27 +375,33 @@ def compute_metrics(result: Result) -> dict:
                rhs_evaluations=result.stats.rhs_evaluations, steps=result.stats.steps,
                rejected_steps=result.stats.rejected_steps, n_state=result.model.n_state, planes={})
     pre = pre_fault(result)
-    for p in PLANES:
-        o = result.orbit_after(p, t_fault)
-        force = result.contact_force(p)
-        f, f_pre = force[post], force[pre]
-        disp = result.radius_after(p, t_fault) if len(o) else np.zeros(1)
-        entry = dict(max_displacement_um=float(disp.max() * 1e6),
-                     max_y_displacement_um=float(np.abs(o[:, 1]).max() * 1e6) if len(o) else 0.0,
-                     peak_contact_force_N=float(f.max()) if len(f) else 0.0,
-                     pre_fault_peak_contact_force_N=float(f_pre.max()) if len(f_pre) else 0.0,
-                     final_sleeve_speed_rpm=float(result.sleeve_speed(p)[-1] * RPM))
-        entry.update(retainer_loading(result, p, post))
-        if result.has_thermal:
-            entry.update(sleeve_heating(result, p))
-        entry.update(whirl(result, p, t_fault))
-        out["planes"][p] = entry
+    out["planes"] = per_plane(result, lambda p: plane_metrics(result, p, t_fault, post, pre))
     out["backward_whirl"] = any(out["planes"][p]["backward_whirl"] for p in PLANES)
     balls = result.model.I[F_RB] == RB_SM
     out["rating_pressure_MPa"] = rating_pressure(result.model.scene.bearing) * 1e-6 if balls else None
     out.update(check_metrics(result, out))
     out["warnings"] = warnings_of(out, result.model.scene)
     return out
+
+
+def plane_metrics(result: Result, p: str, t_fault: float, post: np.ndarray,
+                  pre: np.ndarray) -> dict:
+    """The per-plane numbers of :func:`compute_metrics` at retainer plane ``p`` (``post``, ``pre``:
+    the samples after and before the fault at ``t_fault``)."""
+    o = result.orbit_after(p, t_fault)
+    force = result.contact_force(p)
+    f, f_pre = force[post], force[pre]
+    disp = result.radius_after(p, t_fault) if len(o) else np.zeros(1)
+    entry = dict(max_displacement_um=float(disp.max() * 1e6),
+                 max_y_displacement_um=float(np.abs(o[:, 1]).max() * 1e6) if len(o) else 0.0,
+                 peak_contact_force_N=float(f.max()) if len(f) else 0.0,
+                 pre_fault_peak_contact_force_N=float(f_pre.max()) if len(f_pre) else 0.0,
+                 final_sleeve_speed_rpm=float(result.sleeve_speed(p)[-1] * RPM))
+    entry.update(retainer_loading(result, p, post))
+    if result.has_thermal:
+        entry.update(sleeve_heating(result, p))
+    entry.update(whirl(result, p, t_fault))
+    return entry
 
 
 def worst_plane(metrics: dict, key: str) -> float | None:

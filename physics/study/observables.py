@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..metrics import RPM, first_contact_time
+from ..metrics import RPM, first_contact_time, per_plane
 from ..model import PLANES
 from ..results import Result
 
@@ -24,8 +24,8 @@ def drop_observables(result: Result) -> dict:
     post = t >= t_f
     t_fc = first_contact_time(result)
     late = t >= t_f + 0.5 * (t[-1] - t_f)
-    out: dict = {"planes": {}}
-    for p in PLANES:
+
+    def plane(p: str) -> dict:
         o = result.orbit_after(p, t_f)
         r = result.radius_after(p, t_f)
         f = result.contact_force(p)
@@ -33,7 +33,7 @@ def drop_observables(result: Result) -> dict:
              else np.zeros(1))
         ws = result.sleeve_speed(p)
         spun = np.flatnonzero(post & (ws >= 0.5 * result.rotor_speed))
-        out["planes"][p] = dict(
+        return dict(
             max_x_um=float(np.abs(o[:, 0]).max() * 1e6) if r.size else 0.0,
             t_max_response_s=float(t[post][np.argmax(r)] - t_f) if r.size else None,
             mean_late_force_N=float(f[late].mean()),
@@ -46,6 +46,7 @@ def drop_observables(result: Result) -> dict:
             sleeve_spin_up_s=float(t[spun[0]] - t_f) if spun.size else None,
             sleeve_speed_at_0p1s_rpm=float(np.interp(t_f + 0.1, t, ws) * RPM),
         )
+    out: dict = {"planes": per_plane(result, plane)}
     pl = out["planes"]
     out["t_max_response_s"] = max((pl[p]["t_max_response_s"] for p in PLANES),
                                   key=lambda x: -1 if x is None else x)
