@@ -138,11 +138,17 @@ def sleeve_heating(result: Result, plane: str) -> dict:
                 min_friction_coefficient=float(mu.min()), max_friction_coefficient=float(mu.max()))
 
 
-def pre_fault(result: Result) -> np.ndarray:
-    """Samples while the AMBs still carry the rotor (every sample when the run ends first)."""
+def pre_fault(result: Result) -> slice:
+    """Samples while the AMBs still carry the rotor, t < t_fault: a prefix of the run (every
+    sample when the run ends first). A slice indexes the samples a mask would, without a copy."""
     if result.t_fault is None:
-        return np.ones(len(result.t), dtype=bool)
-    return result.t < result.t_fault
+        return slice(0, len(result.t))
+    return slice(0, int(np.searchsorted(result.t, result.t_fault, "left")))
+
+
+def after(result: Result, t0: float) -> slice:
+    """The samples t >= ``t0``: a suffix of the run (t increases)."""
+    return slice(int(np.searchsorted(result.t, t0, "left")), None)
 
 
 def contact_period(scene, plane: str, load: float) -> float | None:
@@ -365,7 +371,7 @@ def _per_plane(m: dict, planes: list[str], key: str, spec: str) -> str:
 def compute_metrics(result: Result) -> dict:
     """The numbers written to metrics.json (SI, with µm and rpm at the edges)."""
     t_fault = result.t_fault if result.t_fault is not None else result.t[-1]
-    post = result.t >= t_fault
+    post = after(result, t_fault)
     t_fc = first_contact_time(result)
     out = dict(scene=result.model.scene.name, t_end=float(result.t[-1]), t_fault_s=result.t_fault,
                first_contact_time_s=t_fc,
@@ -384,8 +390,7 @@ def compute_metrics(result: Result) -> dict:
     return out
 
 
-def plane_metrics(result: Result, p: str, t_fault: float, post: np.ndarray,
-                  pre: np.ndarray) -> dict:
+def plane_metrics(result: Result, p: str, t_fault: float, post: slice, pre: slice) -> dict:
     """The per-plane numbers of :func:`compute_metrics` at retainer plane ``p`` (``post``, ``pre``:
     the samples after and before the fault at ``t_fault``)."""
     o = result.orbit_after(p, t_fault)
