@@ -3,6 +3,7 @@ the checks that say when they do not describe a clean drop (contact before the f
 contact, no fault in the run, output samples too coarse), listed as ``warnings``."""
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -28,10 +29,20 @@ STEP_PEAK_KEYS = {"peak_contact_force_N": P_FR, "peak_bearing_load_N": P_LOAD,
                   "max_ball_load_N": P_QMAX}      # metrics key -> physics.integrate peak column
 
 
+def per_plane(result: Result, compute) -> dict:
+    """{plane: compute(plane)} over the retainer planes (``compute`` returns a flat dict);
+    computed once and copied when both planes' time series are the same bit for bit
+    (:meth:`Result.twin_planes`, a symmetric drop), which gives the same numbers."""
+    first = compute(PLANES[0])
+    twin = result.twin_planes()
+    return {p: first if k == 0 else dict(first) if twin else compute(p)
+            for k, p in enumerate(PLANES)}
+
+
 def first_contact_time(result: Result) -> float | None:
     """Earliest time either plane's gap closes, interpolated between samples [s]."""
     best = None
-    for p in PLANES:
+    for p in PLANES[:1] if result.twin_planes() else PLANES:
         d = result.penetration(p)
         hit = np.flatnonzero(d > 0.0)
         if hit.size == 0:
@@ -82,6 +93,7 @@ def friction_heat(result: Result, plane: str, post: np.ndarray) -> np.ndarray:
     return np.concatenate(([0.0], np.cumsum(0.5 * (p[1:] + p[:-1]) * np.diff(t))))[:len(t)]
 
 
+@functools.lru_cache(maxsize=64)
 def rating_pressure(bearing) -> float:
     """Worst ball-race Hertz pressure [Pa] at s_0 = 1: the bearing statically carrying its load
     rating C_0 (``bearing.static_load_rating``) with a ball under the load
@@ -126,11 +138,17 @@ def sleeve_heating(result: Result, plane: str) -> dict:
                 min_friction_coefficient=float(mu.min()), max_friction_coefficient=float(mu.max()))
 
 
-def pre_fault(result: Result) -> np.ndarray:
-    """Samples while the AMBs still carry the rotor (every sample when the run ends first)."""
+def pre_fault(result: Result) -> slice:
+    """Samples while the AMBs still carry the rotor, t < t_fault: a prefix of the run (every
+    sample when the run ends first). A slice indexes the samples a mask would, without a copy."""
     if result.t_fault is None:
-        return np.ones(len(result.t), dtype=bool)
-    return result.t < result.t_fault
+        return slice(0, len(result.t))
+    return slice(0, int(np.searchsorted(result.t, result.t_fault, "left")))
+
+
+def after(result: Result, t0: float) -> slice:
+    """The samples t >= ``t0``: a suffix of the run (t increases)."""
+    return slice(int(np.searchsorted(result.t, t0, "left")), None)
 
 
 def contact_period(scene, plane: str, load: float) -> float | None:
@@ -226,13 +244,14 @@ def contact_validity(result: Result) -> dict:
     model's calibration)."""
     scene = result.model.scene
     film = bool(result.model.I[F_FILM])
-    planes = {}
-    for p in PLANES:
+
+    def plane(p: str) -> dict:
         pen = result.penetration(p)
         ws = np.abs(result.sleeve_speed(p))
         h = film_thickness(float(ws.max()), result.model.P[P_FILM])[0] if film and len(ws) else None
-        planes[p] = dict(max_penetration_um=max(float(pen.max()), 0.0) * 1e6 if len(pen) else 0.0,
-                         max_film_thickness_um=h * 1e6 if h is not None else None)
+        return dict(max_penetration_um=max(float(pen.max()), 0.0) * 1e6 if len(pen) else 0.0,
+                    max_film_thickness_um=h * 1e6 if h is not None else None)
+    planes = per_plane(result, plane)
     bound = line_validity(scene.contact.clearance) * 1e6
     play = scene.bearing.clearance / 2.0 * 1e6
     return dict(planes=planes, penetration_validity_um=bound, bearing_radial_play_um=play,
@@ -352,7 +371,7 @@ def _per_plane(m: dict, planes: list[str], key: str, spec: str) -> str:
 def compute_metrics(result: Result) -> dict:
     """The numbers written to metrics.json (SI, with µm and rpm at the edges)."""
     t_fault = result.t_fault if result.t_fault is not None else result.t[-1]
-    post = result.t >= t_fault
+    post = after(result, t_fault)
     t_fc = first_contact_time(result)
     out = dict(scene=result.model.scene.name, t_end=float(result.t[-1]), t_fault_s=result.t_fault,
                first_contact_time_s=t_fc,
@@ -362,27 +381,32 @@ def compute_metrics(result: Result) -> dict:
                rhs_evaluations=result.stats.rhs_evaluations, steps=result.stats.steps,
                rejected_steps=result.stats.rejected_steps, n_state=result.model.n_state, planes={})
     pre = pre_fault(result)
-    for p in PLANES:
-        o = result.orbit_after(p, t_fault)
-        force = result.contact_force(p)
-        f, f_pre = force[post], force[pre]
-        disp = result.radius_after(p, t_fault) if len(o) else np.zeros(1)
-        entry = dict(max_displacement_um=float(disp.max() * 1e6),
-                     max_y_displacement_um=float(np.abs(o[:, 1]).max() * 1e6) if len(o) else 0.0,
-                     peak_contact_force_N=float(f.max()) if len(f) else 0.0,
-                     pre_fault_peak_contact_force_N=float(f_pre.max()) if len(f_pre) else 0.0,
-                     final_sleeve_speed_rpm=float(result.sleeve_speed(p)[-1] * RPM))
-        entry.update(retainer_loading(result, p, post))
-        if result.has_thermal:
-            entry.update(sleeve_heating(result, p))
-        entry.update(whirl(result, p, t_fault))
-        out["planes"][p] = entry
+    out["planes"] = per_plane(result, lambda p: plane_metrics(result, p, t_fault, post, pre))
     out["backward_whirl"] = any(out["planes"][p]["backward_whirl"] for p in PLANES)
     balls = result.model.I[F_RB] == RB_SM
     out["rating_pressure_MPa"] = rating_pressure(result.model.scene.bearing) * 1e-6 if balls else None
     out.update(check_metrics(result, out))
     out["warnings"] = warnings_of(out, result.model.scene)
     return out
+
+
+def plane_metrics(result: Result, p: str, t_fault: float, post: slice, pre: slice) -> dict:
+    """The per-plane numbers of :func:`compute_metrics` at retainer plane ``p`` (``post``, ``pre``:
+    the samples after and before the fault at ``t_fault``)."""
+    o = result.orbit_after(p, t_fault)
+    force = result.contact_force(p)
+    f, f_pre = force[post], force[pre]
+    disp = result.radius_after(p, t_fault) if len(o) else np.zeros(1)
+    entry = dict(max_displacement_um=float(disp.max() * 1e6),
+                 max_y_displacement_um=float(np.abs(o[:, 1]).max() * 1e6) if len(o) else 0.0,
+                 peak_contact_force_N=float(f.max()) if len(f) else 0.0,
+                 pre_fault_peak_contact_force_N=float(f_pre.max()) if len(f_pre) else 0.0,
+                 final_sleeve_speed_rpm=float(result.sleeve_speed(p)[-1] * RPM))
+    entry.update(retainer_loading(result, p, post))
+    if result.has_thermal:
+        entry.update(sleeve_heating(result, p))
+    entry.update(whirl(result, p, t_fault))
+    return entry
 
 
 def worst_plane(metrics: dict, key: str) -> float | None:

@@ -311,9 +311,17 @@ def sleeve_motion(y, I, k):
 
 @njit
 def rhs(t, y, P, I, U, dy, aux):
-    """dy/dt of the drop-down model (spec §1, §3-6). Fills ``aux`` with per-plane diagnostics."""
-    for i in range(dy.shape[0]):
-        dy[i] = 0.0
+    """dy/dt of the drop-down model (spec §1, §3-6). Fills ``aux`` with per-plane diagnostics.
+
+    ``dy = None``: the diagnostics alone (the output samples', :func:`diagnostics`), the same
+    values bit for bit; numba compiles that variant without the blocks under ``dy is not None``
+    (unbalance, AMBs, the bodies' and heat derivatives, the rotor's equations of motion), and
+    the sums that only feed them (forces, moments, powers) go unused, and the second retainer
+    plane copies the first one's diagnostics when its inputs are the first one's bit for bit
+    (:func:`twin_planes`: a symmetric drop), which is what computing them again would give."""
+    if dy is not None:
+        for i in range(dy.shape[0]):
+            dy[i] = 0.0
     m = P[P_M]
     g = P[P_G]
     vx, vy, va, vb = y[I[S_VX]], y[I[S_VY]], y[I[S_VA]], y[I[S_VB]]
@@ -327,7 +335,7 @@ def rhs(t, y, P, I, U, dy, aux):
     p_ext = 0.0         # power of external and non-potential forces (unbalance, AMB, film, cage)
 
     # unbalance
-    if I[F_UNB]:
+    if dy is not None and I[F_UNB]:
         iphi = I[S_PHI]
         ux, uy = unbalance_force(P[P_MUE], W, y[iphi] + P[P_UB_PHASE])
         z = P[P_Z_UB]
@@ -340,7 +348,7 @@ def rhs(t, y, P, I, U, dy, aux):
 
     # AMBs (hold the rotor until the fault)
     amb = I[F_AMB]
-    if amb == AMB_ACTUATOR or (amb == AMB_LINEAR and U[U_AMB_POWER] > 0.0):
+    if dy is not None and (amb == AMB_ACTUATOR or (amb == AMB_LINEAR and U[U_AMB_POWER] > 0.0)):
         # actuator (spec §5): the PID states evolve only under the built-in controller; the
         # magnets pull while powered or driven directly. The per-axis law takes scalars so that
         # it compiles inline here (as an array-taking call it cost ~90 ns per axis)
@@ -388,7 +396,14 @@ def rhs(t, y, P, I, U, dy, aux):
             p_ext += fx * ddx + fy * ddy
 
     # retainer planes: rotor-sleeve contact, sleeve on ball bearing, housing
+    twin = False
+    if dy is None:
+        twin = twin_planes(y, P, I)
     for k in range(2):
+        if twin and k == 1:
+            for j in range(N_AUX_PLANE):
+                aux[N_AUX_PLANE + j] = aux[j]
+            continue
         base = I_PLANES + k * N_PLANE_IDX
         z = P[P_Z_RB1 + k]
         px, py, pvx, pvy = axis_motion(y, I, z)
@@ -491,7 +506,8 @@ def rhs(t, y, P, I, U, dy, aux):
             load = math.sqrt(qx * qx + qy * qy)
             p_diss += P[P_CB] * (uvx * uvx + uvy * uvy)
             p_ext += dV * P[P_CAGE] * ws          # cage rotation under load (no torque in the model)
-            dy[i_th] = ws
+            if dy is not None:
+                dy[i_th] = ws
         elif I[F_RB] == RB_LINEAR:
             bfx = -P[P_KLIN] * ux - P[P_CB] * uvx
             bfy = -P[P_KLIN] * uy - P[P_CB] * uvy
@@ -505,21 +521,22 @@ def rhs(t, y, P, I, U, dy, aux):
                 drag_t = drag_torque_magnitude(ws, load, P[P_M0_LOW], P[P_M0_COEF], P[P_M1_COEF],
                                                P[P_MSEAL]) * smooth_sign(ws, P[P_WL])
                 p_diss += drag_t * ws
-            dws = (P[P_RS] * f_mu - drag_t) / P[P_JS]
-            dy[i_ws] = dws
-            if I[F_RB] == RB_SM and I[F_FILM]:
-                # film growth changes the ball potential without a force doing work
-                p_ext += qsum * dh_dw * dws
+            if dy is not None:
+                dws = (P[P_RS] * f_mu - drag_t) / P[P_JS]
+                dy[i_ws] = dws
+                if I[F_RB] == RB_SM and I[F_FILM]:
+                    # film growth changes the ball potential without a force doing work
+                    p_ext += qsum * dh_dw * dws
 
         # --- sleeve translation ---
-        if i_sx >= 0:
+        if dy is not None and i_sx >= 0:
             ms = P[P_MS]
             dy[i_sx] = svx
             dy[I[base + J_SY]] = svy
             dy[I[base + J_SVX]] = (cfx + bfx) / ms
             dy[I[base + J_SVY]] = (cfy + bfy) / ms - g
         # --- housing ---
-        if i_hx >= 0:
+        if dy is not None and i_hx >= 0:
             cs = U[U_CS1 + k]
             if I[I_CS] >= 0:                     # semi-active damper lags its command (spec §6)
                 # the clamp is needed: U is a public input, and even the env's command
@@ -551,7 +568,7 @@ def rhs(t, y, P, I, U, dy, aux):
         aux[o + A_QMAX] = qmax
 
     i_heat = I[I_THERM]
-    if i_heat >= 0:                              # effects.thermal: sleeve heating, heat audit
+    if dy is not None and i_heat >= 0:           # effects.thermal: sleeve heating, heat audit
         q_lost = 0.0
         w_fric = 0.0
         for k in range(2):
@@ -586,6 +603,8 @@ def rhs(t, y, P, I, U, dy, aux):
         aux[A_STATOR] = 0.0
         aux[A_STATOR + 1] = 0.0
 
+    if dy is None:
+        return
     # rotor equations of motion
     dy[I[S_X]] = vx
     dy[I[S_Y]] = vy
@@ -600,6 +619,29 @@ def rhs(t, y, P, I, U, dy, aux):
     if I[F_AUDIT]:
         dy[I[S_EDISS]] = p_diss
         dy[I[S_WEXT]] = p_ext
+
+
+@njit
+def _same(a, b):
+    """a and b are the same float bit for bit (0.0 and -0.0 differ, NaN never matches)."""
+    return a == b and math.copysign(1.0, a) == math.copysign(1.0, b)
+
+
+@njit
+def twin_planes(y, P, I):
+    """The second retainer plane's inputs to :func:`rhs` (rotor axis, sleeve and housing motion,
+    sleeve speed, cage angle, sleeve temperature) are the first one's bit for bit, so are its
+    diagnostics: what a symmetric rotor on symmetric supports keeps through a drop."""
+    px, py, vx, vy = axis_motion(y, I, P[P_Z_RB1])
+    qx, qy, wx, wy = axis_motion(y, I, P[P_Z_RB2])
+    if not (_same(px, qx) and _same(py, qy) and _same(vx, wx) and _same(vy, wy)):
+        return False
+    for j in range(N_PLANE_IDX):                 # the plane's bodies: every state or none
+        i = I[I_PLANES + j]
+        if i >= 0 and not _same(y[i], y[I[I_PLANES + N_PLANE_IDX + j]]):
+            return False
+    i = I[I_THERM]
+    return i < 0 or _same(y[i], y[i + 1])
 
 
 @njit
@@ -714,9 +756,8 @@ def mechanical_energy(y, P, I):
 @njit
 def diagnostics(T, Y, P, I, U, AUX):
     """Fill AUX[k] with the per-plane diagnostics at each output sample (post-processing)."""
-    dy = np.empty(Y.shape[1])
     for k in range(Y.shape[0]):
-        rhs(T[k], Y[k], P, I, U, dy, AUX[k])
+        rhs(T[k], Y[k], P, I, U, None, AUX[k])
 
 
 @njit

@@ -13,6 +13,21 @@ from .model import (A_DELTA, A_DRAG, A_FMU, A_FR, A_LOAD, A_PFRIC, A_QMAX, A_STA
 AMB_PLANES = ("AMB1", "AMB2")
 
 
+def _axis_series(Y: np.ndarray, i: int, z: float) -> np.ndarray:
+    """(Y[:, i] + z Y[:, i + 2], Y[:, i + 1] + z Y[:, i + 3]) as an (N, 2) array, computed in
+    place (the same sums: IEEE addition is commutative)."""
+    out = np.empty((len(Y), 2))
+    for c in range(2):
+        np.multiply(Y[:, i + 2 + c], z, out=out[:, c])
+        out[:, c] += Y[:, i + c]
+    return out
+
+
+def _same_bits(a: np.ndarray, b: np.ndarray) -> bool:
+    """The float64 arrays ``a`` and ``b`` hold the same bits (signed zeros apart)."""
+    return bool(np.array_equal(a.view(np.int64), b.view(np.int64)))
+
+
 @dataclass
 class RunStats:
     rhs_evaluations: int = 0
@@ -58,8 +73,7 @@ class Result:
         """Rotor axis (x + z a, y + z b) at axial station z; offset 4: its velocity. Computed
         once per station (the metrics ask several times), read-only."""
         i = self.model.I[S_X] + offset
-        return self._memo((z, offset), lambda: np.stack(
-            [self.Y[:, i] + z * self.Y[:, i + 2], self.Y[:, i + 1] + z * self.Y[:, i + 3]], 1))
+        return self._memo((z, offset), lambda: _axis_series(self.Y, i, z))
 
     def orbit(self, plane: str) -> np.ndarray:
         """Rotor axis position (x, y) at a retainer plane, relative to the nominal centre [m]."""
@@ -86,6 +100,19 @@ class Result:
             o = self.orbit_after(plane, t0, relative)
             return np.hypot(o[:, 0], o[:, 1])
         return self._memo(("radius", plane, t0, relative), radius)
+
+    def twin_planes(self) -> bool:
+        """Both retainer planes' time series (rotor orbit, sleeve, the per-plane diagnostics,
+        sleeve temperature) are the same bit for bit, as in a symmetric drop: every per-plane
+        number is then the same too, and the metrics compute it once (``physics.metrics.per_plane``)."""
+        if "twin" not in self._derived:
+            a, b = PLANES
+            n = N_AUX_PLANE
+            self._derived["twin"] = (
+                _same_bits(self.orbit(a), self.orbit(b)) and _same_bits(self.sleeve(a), self.sleeve(b))
+                and _same_bits(self.aux[:, :n], self.aux[:, n:2 * n])
+                and _same_bits(self.temperature_rise(a), self.temperature_rise(b)))
+        return self._derived["twin"]
 
     def _memo(self, key, compute) -> np.ndarray:
         """``compute()`` once per result and ``key``, kept read-only (derived time series)."""

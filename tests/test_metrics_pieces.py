@@ -88,3 +88,20 @@ def test_the_bisection_stops_early_with_the_result_of_all_its_iterations():
             # it stopped early (a root at 0 moves on through the denormals for all 200)
             assert len(calls) < 100 or target == 0.0
             assert root == all_iterations(f, target, -10.0, 10.0)
+
+
+def test_twin_planes_computed_once_give_the_numbers_of_both_computed(whirling):
+    """A symmetric drop's planes have the same time series bit for bit (Result.twin_planes); the
+    metrics and observables computed once for both equal those computed plane by plane, and a
+    drop with the retainers placed asymmetrically is not a twin."""
+    import dataclasses
+    r = whirling
+    assert r.twin_planes()
+    twin = (compute_metrics(r), drop_observables(r))
+    plain = dataclasses.replace(r)              # a fresh result: nothing memoised
+    plain._derived["twin"] = False
+    assert (compute_metrics(plain), drop_observables(plain)) == twin
+    assert twin[0]["planes"]["RB1"] is not twin[0]["planes"]["RB2"]
+    lopsided = simulate(load_scene("paper", {"positions.rb2": 0.3, "contact.friction": 0.5,
+                                             "solver.t_end": 0.15}))
+    assert not lopsided.twin_planes()

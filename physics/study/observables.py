@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..metrics import RPM, first_contact_time
+from ..metrics import RPM, after, first_contact_time, per_plane
 from ..model import PLANES
 from ..results import Result
 
@@ -21,31 +21,34 @@ def drop_observables(result: Result) -> dict:
     """Per-plane and worst-plane observables of one drop (see module docstring)."""
     t = result.t
     t_f = result.t_fault if result.t_fault is not None else 0.0
-    post = t >= t_f
+    post = after(result, t_f)               # the samples t >= t_f, a suffix (as slices)
     t_fc = first_contact_time(result)
-    late = t >= t_f + 0.5 * (t[-1] - t_f)
-    out: dict = {"planes": {}}
-    for p in PLANES:
+    late = after(result, t_f + 0.5 * (t[-1] - t_f))
+    t_post = t[post]
+
+    def plane(p: str) -> dict:
         o = result.orbit_after(p, t_f)
         r = result.radius_after(p, t_f)
         f = result.contact_force(p)
-        v = (np.gradient(result.radius_after(p, t_f, relative=True), t[post]) if post.sum() > 2
+        v = (np.gradient(result.radius_after(p, t_f, relative=True), t_post) if t_post.size > 2
              else np.zeros(1))
         ws = result.sleeve_speed(p)
-        spun = np.flatnonzero(post & (ws >= 0.5 * result.rotor_speed))
-        out["planes"][p] = dict(
+        spun = post.start + np.flatnonzero(ws[post] >= 0.5 * result.rotor_speed[post])
+        late_force = float(f[late].mean())
+        return dict(
             max_x_um=float(np.abs(o[:, 0]).max() * 1e6) if r.size else 0.0,
-            t_max_response_s=float(t[post][np.argmax(r)] - t_f) if r.size else None,
-            mean_late_force_N=float(f[late].mean()),
-            force_settling_s=_settling(t, f, t_f, float(f[late].mean())),
+            t_max_response_s=float(t_post[np.argmax(r)] - t_f) if r.size else None,
+            mean_late_force_N=late_force,
+            force_settling_s=_settling(t, f, t_f, late_force),
             separations=_separations(f[post]),
             bounces_after_drop=(_separations(f[(t >= t_fc) & (t <= t_fc + BOUNCE_WINDOW_S)])
                                 if t_fc is not None else 0),
-            radial_speed_rms_mm_s=float(np.sqrt(np.mean(v[t[post] >= t_f + 0.1] ** 2)) * 1e3)
+            radial_speed_rms_mm_s=float(np.sqrt(np.mean(v[t_post >= t_f + 0.1] ** 2)) * 1e3)
             if v.size > 1 else 0.0,
             sleeve_spin_up_s=float(t[spun[0]] - t_f) if spun.size else None,
             sleeve_speed_at_0p1s_rpm=float(np.interp(t_f + 0.1, t, ws) * RPM),
         )
+    out: dict = {"planes": per_plane(result, plane)}
     pl = out["planes"]
     out["t_max_response_s"] = max((pl[p]["t_max_response_s"] for p in PLANES),
                                   key=lambda x: -1 if x is None else x)
