@@ -118,7 +118,7 @@ def main(argv=None) -> None:
     if args.steps:
         ckpts = [p for p in checkpoints(args.run)
                  if int(re.search(r"_(\d+)_steps", p.name)[1]) in {int(s) for s in args.steps.split(",")}]
-    if not args.steps and (args.run / "best" / "best_model.zip").is_file():
+    if (args.run / "best" / "best_model.zip").is_file():
         ckpts.append(args.run / "best" / "best_model.zip")
     first = LearnedPolicy.load(ckpts[0])
     env_kwargs = first.env_kwargs
