@@ -46,7 +46,7 @@ FIXED_SETTINGS = frozenset(("control_dt", "dt", "episode_time", "n_steps", "rand
                             "power_return_time", "samples_per_step", "relevitation_hold",
                             "terminate_on_failure", "render_mode", "base_scene", "overrides",
                             "obs_names", "obs_scale", "action_names", "weights",
-                            "sensor_noise", "obs_latency_steps"))
+                            "sensor_noise", "obs_latency_steps", "supervisor_authority"))
 
 
 def _weight(name: str, doc: str) -> property:
@@ -85,6 +85,9 @@ class RotorDropEnv(gym.Env):
                                             k control steps ago, k drawn per episode
     command                     "discrete"  re-levitation envs: "discrete", "continuous" or
                                             "supervisor"
+    supervisor_authority        1.0         command="supervisor": a in (0, 1] scales the offset
+                                            range (a x clearance) and the gain-scale range
+                                            (2^-a ... 2^a); 1 is the full range
     power_return_time           0.05        re-levitation envs: power returns [s after fault]
     samples_per_step            5           monitor samples per control step (dense output)
     relevitation_hold           0.02        re-levitated after this long in the success region [s]
@@ -129,8 +132,10 @@ class RotorDropEnv(gym.Env):
                  terminate_on_failure: bool = True, sensor_noise: float = 0.0,
                  obs_latency_steps: int | tuple[int, int] = 0, w_whirl: float = 10.0,
                  w_contact: float = 0.1, w_displacement: float = 0.1, w_effort: float = 0.01,
-                 w_success: float = 10.0, w_failure: float = 10.0, render_mode: str | None = None):
+                 w_success: float = 10.0, w_failure: float = 10.0, render_mode: str | None = None,
+                 supervisor_authority: float = 1.0):
         self._check_options(command, power_return_time, render_mode)
+        self.supervisor_authority = _check_authority(supervisor_authority, command)
         _positive("control_dt", control_dt, 1e-6, 0.1)
         _positive("episode_time", episode_time, control_dt, 100.0)
         _positive("relevitation_hold", relevitation_hold, 0.0, 100.0)
@@ -274,7 +279,8 @@ class RotorDropEnv(gym.Env):
         C[K.C_DT] = self.dt
         C[K.C_DAMP] = 1.0 if self._damping else 0.0
         C[K.C_LEV] = LEV_CODES[self.command] if self._relevitate else K.LEV_NONE
-        C[K.C_SUP_OFFSET], C[K.C_SUP_OCTAVES] = supervisor_scales(self.base_scene)
+        C[K.C_SUP_OFFSET], C[K.C_SUP_OCTAVES] = supervisor_scales(self.base_scene,
+                                                                  self.supervisor_authority)
         C[K.C_WHIRL_RADIUS], C[K.C_WHIRL_REVS] = WHIRL_RADIUS_FRACTION, WHIRL_MIN_REVOLUTIONS
         w = self.weights
         C[K.C_W_WHIRL], C[K.C_W_CONTACT], C[K.C_W_DISP] = w["w_whirl"], w["w_contact"], w["w_displacement"]
@@ -572,9 +578,22 @@ def real_action(action, space: gym.Space, names) -> np.ndarray:
     return a
 
 
-def supervisor_scales(scene: Scene) -> tuple[float, float]:
-    """(largest reference offset [m], gain-scale octaves) of ``command="supervisor"``."""
-    return SUPERVISOR_OFFSET * scene.contact.clearance, SUPERVISOR_OCTAVES
+def supervisor_scales(scene: Scene, authority: float = 1.0) -> tuple[float, float]:
+    """(largest reference offset [m], gain-scale octaves) of ``command="supervisor"`` with the
+    ``supervisor_authority`` ``authority`` (1: the full ranges)."""
+    return authority * SUPERVISOR_OFFSET * scene.contact.clearance, authority * SUPERVISOR_OCTAVES
+
+
+def _check_authority(value, command) -> float:
+    """``supervisor_authority``: a real number in (0, 1], other than 1 only with the supervisor
+    command (elsewhere it would silently change nothing)."""
+    if (isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real)
+            or not (math.isfinite(value) and 0.0 < value <= 1.0)):
+        raise ValueError(f"supervisor_authority = {value!r} must be a real number in (0, 1]")
+    if value != 1.0 and command != "supervisor":
+        raise ValueError(f"supervisor_authority = {value!r} applies to command='supervisor' only, "
+                         f"not command={command!r}")
+    return float(value)
 
 
 def _positive(name: str, value, lo: float, hi: float) -> None:

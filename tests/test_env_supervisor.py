@@ -134,3 +134,36 @@ def test_tangential_offset_drives_a_forward_orbit():
         obs, *_ = env.step(np.asarray(sup(tangential=0.1 if i >= 150 else 0.0, full=False),
                                       dtype=np.float32))
     assert obs[j] * u.obs_scale[j] > 50.0                 # rad/s, along the spin
+
+
+@pytest.mark.parametrize("bad", [0.0, -0.5, 1.5, math.nan, math.inf, "half", True])
+def test_supervisor_authority_out_of_range_names_the_range(bad):
+    with pytest.raises(ValueError, match=r"supervisor_authority = .* must be a real number in \(0, 1\]"):
+        gym.make("RotorDrop-Full-v0", command="supervisor", supervisor_authority=bad)
+
+
+def test_supervisor_authority_needs_the_supervisor_command():
+    with pytest.raises(ValueError, match="supervisor_authority = 0.5 applies to command='supervisor'"):
+        gym.make("RotorDrop-Full-v0", command="discrete", supervisor_authority=0.5)
+
+
+def trajectory(action, steps: int = 120, **kw):
+    env = gym.make("RotorDrop-Full-v0", command="supervisor", episode_time=0.12,
+                   terminate_on_failure=False, **kw)
+    env.reset(seed=3)
+    traj = []
+    for _ in range(steps):
+        env.step(np.asarray(action, dtype=np.float32))
+        traj.append(env.unwrapped.state)
+    return np.array(traj)
+
+
+def test_supervisor_authority_scales_the_commands_exactly():
+    """Authority a with command x moves the rotor exactly as full authority with a x (a = 1/2:
+    the scaling is exact in binary), for the offsets and the gain scale; the default is the
+    full range, bit for bit."""
+    x = sup(gain=0.6, radial=-0.8, tangential=0.5, damping=0.2)
+    half = sup(gain=0.3, radial=-0.4, tangential=0.25, damping=0.2)
+    assert np.array_equal(trajectory(x, supervisor_authority=0.5), trajectory(half))
+    assert np.array_equal(trajectory(x, supervisor_authority=1.0), trajectory(x))
+    assert not np.array_equal(trajectory(x, supervisor_authority=0.5), trajectory(x))
