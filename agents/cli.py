@@ -195,7 +195,8 @@ def cmd_oracle(args) -> int:
                         iterations=args.iterations, seed=args.seed, policies=args.policy,
                         progress=not args.quiet, plots=not args.no_plots,
                         search=not args.no_search, scenario_seed=args.scenario_seed,
-                        friction=args.friction, friction_bins=args.friction_bins)
+                        friction=args.friction, friction_bins=args.friction_bins,
+                        suite=args.suite)
     except ERRORS as exc:
         return _fail("oracle", exc)
     _wrote(args.out, ["oracle.json", *report.get("figures", [])], report["wall_time_s"])
@@ -300,8 +301,13 @@ def register(sub) -> None:
                    help="command sequences per generation (one batched rollout)")
     p.add_argument("--iterations", type=at_least(0), default=10, help="generations (default 10)")
     p.add_argument("--seed", type=_SEED, default=0, help="search seed")
-    p.add_argument("--scenario-seed", type=_SEED, default=10_000,
-                   help="seed of the first drawn scenario (default 10000; scenario i uses it + i)")
+    p.add_argument("--suite", default="full",
+                   help="full (default: drops drawn from friction 0.38-0.6, power back 30-70 ms) "
+                        "or robust (the first --scenarios drops of `rotordrop benchmark --suite "
+                        "robust`: sensor noise, latency, actuator spread, plant variation)")
+    p.add_argument("--scenario-seed", type=_SEED, default=None,
+                   help="seed of the first drawn scenario (default 10000, with --suite robust "
+                        "the suite's 30000; scenario i uses it + i)")
     p.add_argument("--no-search", action="store_true",
                    help="score the rows only (no oracle search), e.g. on 200 scenarios")
     p.add_argument("--friction", type=_number_list(":", 2), default=None, metavar="LO:HI",
