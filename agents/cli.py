@@ -196,7 +196,7 @@ def cmd_oracle(args) -> int:
                         progress=not args.quiet, plots=not args.no_plots,
                         search=not args.no_search, scenario_seed=args.scenario_seed,
                         friction=args.friction, friction_bins=args.friction_bins,
-                        suite=args.suite)
+                        suite=args.suite, constants=args.constant)
     except ERRORS as exc:
         return _fail("oracle", exc)
     _wrote(args.out, ["oracle.json", *report.get("figures", [])], report["wall_time_s"])
@@ -320,6 +320,11 @@ def register(sub) -> None:
     p.add_argument("--policy", action="append", default=None,
                    help="extra rows: a training directory / model .zip or module:Class "
                         "(repeatable)")
+    p.add_argument("--constant", type=_number_list(":", 2), action="append", default=None,
+                   metavar="GAIN:OFFSET_R",
+                   help="extra designed row (repeatable): the inner-loop commands with a constant "
+                        "PID gain scale and radial reference offset on both planes (supervisor "
+                        "actions in [-1, 1]), named 'constant g=GAIN r=OFFSET_R'")
     _output_args(p, "out/oracle")
     p.set_defaults(func=cmd_oracle)
 

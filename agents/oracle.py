@@ -29,7 +29,9 @@ stopped and re-scores the rows (add ``--policy`` runs without searching again). 
 scores the rows alone, e.g. on 200 scenarios from another ``--scenario-seed``. The whirl
 rate per friction bin (``whirl_by_friction``, ``whirl_by_friction.png``) uses
 ``--friction-bins`` edges, by default :data:`FRICTION_BINS` on the default range and 0.05-wide
-bins on any other (:func:`friction_edges`).
+bins on any other (:func:`friction_edges`). ``--constant GAIN:OFFSET_R`` adds designed rows
+that need no knowledge of the scenario: the inner loop with a constant gain scale and radial
+reference offset (:func:`constant_theta`), run as the oracle's rollouts.
 
 ``--suite robust`` runs the same search and rows on the robust suite's scenarios instead
 (:mod:`agents.robust`: the first ``--scenarios`` drops of ``rotordrop benchmark --suite robust``,
@@ -175,6 +177,50 @@ def inner_loop_theta() -> np.ndarray:
     return np.concatenate([seg.ravel(), [-1.0]])
 
 
+def constant_theta(gain: float, offset_r: float) -> np.ndarray:
+    """The ``inner-loop`` sequence with a constant PID gain scale ``gain`` and radial reference
+    offset ``offset_r`` on both planes (actions in [-1, 1]): a causal law that does not know the
+    scenario (the commands act once the PID is on, at the power return)."""
+    seg = inner_loop_theta()[:-1].reshape(len(SEGMENT_EDGES_MS) - 1, len(SEGMENT_ACTIONS))
+    for name, value in (("gain", gain), ("offset_r1", offset_r), ("offset_r2", offset_r)):
+        seg[:, SEGMENT_ACTIONS.index(name)] = value
+    return np.concatenate([seg.ravel(), [-1.0]])
+
+
+def check_constants(constants) -> list[tuple[float, float]]:
+    """``--constant GAIN:OFFSET_R`` pairs as floats; ValueError unless both are in [-1, 1]."""
+    out = []
+    for pair in constants or []:
+        g, r = (float(v) for v in pair)
+        if not (-1.0 <= g <= 1.0 and -1.0 <= r <= 1.0):
+            raise ValueError(f"--constant GAIN:OFFSET_R must have both in [-1, 1] (supervisor "
+                             f"actions), got {g:g}:{r:g}")
+        out.append((g, r))
+    return out
+
+
+def constant_name(gain: float, offset_r: float) -> str:
+    return f"constant g={gain:g} r={offset_r:g}"
+
+
+def constant_rows(sc: Scenario, phase: float, passive: dict,
+                  constants: list[tuple[float, float]]) -> dict[str, dict]:
+    """The rows of the ``constants`` laws (:func:`constant_theta`) on one scenario, run as the
+    oracle's rollouts (one batch) and scored against its passive row."""
+    from rotordrop_env import BatchedRotorDropVecEnv
+    thetas = np.array([constant_theta(g, r) for g, r in constants])
+    venv = BatchedRotorDropVecEnv(ENV_ID, len(thetas), seed=0, **search_kwargs(sc, phase))
+    try:
+        kpis = rollout(venv, thetas, sc.env_kwargs["power_return_time"])
+    finally:
+        venv.close()
+    rows = {}
+    for (g, r), k in zip(constants, kpis):
+        row = kpi_row(k)
+        rows[constant_name(g, r)] = dict(row, J=episode_cost(row, passive))
+    return rows
+
+
 def sequence_actions(thetas: np.ndarray, t: float, power_return: float,
                      action_names: list[str]) -> np.ndarray:
     """(n, n_actions) actions at time ``t`` after the fault for the command sequences
@@ -304,19 +350,21 @@ def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iteration
            seed: int = 0, policies: list[str] | None = None, progress: bool = True,
            plots: bool = True, search: bool = True, scenario_seed: int | None = None,
            friction: tuple[float, float] | None = None, friction_bins=None,
-           suite: str = "full") -> dict:
+           suite: str = "full", constants=None) -> dict:
     """Search the command sequence of each scenario, score every row on the same scenarios and
     write ``oracle.json`` (and ``oracle.png``) into ``out`` (module doc). ``search=False``
     scores the rows only (no oracle row): the same comparison on many more scenarios.
     ``friction``: the (LO, HI) range of mu the scenarios are drawn from (default 0.38-0.6);
     ``friction_bins``: the edges of the per-friction whirl table (:func:`friction_edges`);
     ``suite``: ``full`` (the drops above) or ``robust`` (the robust suite's, module doc;
-    ``scenario_seed`` defaults to its ``SUITE_SEED``)."""
+    ``scenario_seed`` defaults to its ``SUITE_SEED``); ``constants``: (gain, radial offset)
+    pairs scored as extra designed rows (:func:`constant_theta`, ``--constant``)."""
     from tqdm.auto import tqdm
     from .score import fmt_or_dash
     if scenarios < 1 or population < 2 or iterations < 0:
         raise ValueError(f"need --scenarios >= 1, --population >= 2, --iterations >= 0 (got "
                          f"{scenarios}, {population}, {iterations})")
+    constants = check_constants(constants)
     settings, ranges = suite_settings(suite, friction, scenario_seed)
     edges = friction_edges(ranges["contact.friction"], friction_bins)
     settings.update(scenarios=scenarios, population=population, iterations=iterations, seed=seed)
@@ -339,13 +387,16 @@ def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iteration
             rows[entry.name] = kpi_row(kpis)
         for row in rows.values():
             row["J"] = episode_cost(row, rows["passive"])
+        if constants:
+            rows.update(constant_rows(sc, phase, rows["passive"], constants))
         found = None
         if search:
             found = done.get(i) or search_scenario(sc, phase, rows["passive"], population,
                                                    iterations, seed + i, progress)
             rows["oracle"] = dict(found["kpis"], J=found["J"])
         per_scenario.append(dict(index=i, scenario=values, rows=rows, search=found))
-        report = _report(settings, per_scenario, [e.name for e in entries], t0, search)
+        report = _report(settings, per_scenario, [e.name for e in entries], t0, search,
+                         [constant_name(g, r) for g, r in constants])
         write_json(out / "oracle.json", report)              # after every scenario: resumable
         bar.update(1)
     bar.close()
@@ -426,14 +477,17 @@ def print_whirl_by_friction(table: dict) -> None:
 
 
 def _report(settings: dict, per_scenario: list[dict], names: list[str], t0: float,
-            search: bool = True) -> dict:
-    summary = score_rows(per_scenario, names + (["oracle"] if search else []))
+            search: bool = True, constants: list[str] = ()) -> dict:
+    """The summary of the rows so far; ``best_designed`` and the oracle's gain over it count
+    the baselines only, the ``constants`` rows are listed beside them (``constant_rows``)."""
+    summary = score_rows(per_scenario, names + list(constants) + (["oracle"] if search else []))
     learned = {n for n in names if n not in BASELINES}
     designed = [e for e in summary if e["controller"] in BASELINES and e["controller"] != "passive"]
     best = designed[0] if designed else None
     orc = next((e for e in summary if e["controller"] == "oracle"), None)
     return dict(settings=settings, per_scenario=per_scenario, summary=summary,
-                learned=sorted(learned), best_designed=best["controller"] if best else None,
+                learned=sorted(learned), constant_rows=list(constants),
+                best_designed=best["controller"] if best else None,
                 oracle_gain_over_best_designed=(orc["score"] - best["score"]
                                                 if best and orc else None),
                 wall_time_s=time.perf_counter() - t0)
@@ -472,7 +526,7 @@ def plot_oracle(report: dict, path: Path) -> Path:
     axes[1].set(yticks=y, yticklabels=[], xlabel="backward-whirl rate", xlim=(0, 1))
     idx = np.arange(len(report["per_scenario"]))
     show = ["passive", report["best_designed"], *(["oracle"] if "oracle" in names else []),
-            *report["learned"]]
+            *report.get("constant_rows", []), *report["learned"]]
     for name in dict.fromkeys(n for n in show if n):
         axes[2].plot(idx, [s["rows"][name]["J"] for s in report["per_scenario"]], "o-", ms=3,
                      label=name)

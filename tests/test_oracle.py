@@ -136,7 +136,7 @@ def test_robust_suite_searches_the_robust_scenario_with_its_sensing(tmp_path):
     venv.close()
 
     rep = oracle(tmp_path, scenarios=1, population=4, iterations=1, progress=False, plots=False,
-                 suite="robust")
+                 suite="robust", constants=[(0.0, 0.0), (0.0, -0.75)])
     assert rep["settings"]["suite"] == "robust" and rep["settings"]["scenario_seed"] == SUITE_SEED
     s = rep["per_scenario"][0]
     assert s["scenario"] == record
@@ -145,6 +145,10 @@ def test_robust_suite_searches_the_robust_scenario_with_its_sensing(tmp_path):
     score = {e["controller"]: e["score"] for e in rep["summary"]}
     assert score["oracle"] >= score["inner-loop"] - 0.1
     assert {"whirl-brake-robust", "sac-robust-full-scratch"} <= set(score)
+    # the constant law g = 0, r = 0 is the inner-loop sequence the search starts from
+    assert rows["constant g=0 r=0"]["J"] == s["search"]["inner_loop_J"]
+    assert rep["constant_rows"] == ["constant g=0 r=0", "constant g=0 r=-0.75"]
+    assert "constant g=0 r=-0.75" not in rep["learned"]
     # the rows are the robust benchmark's own episodes of the scenario
     bench = suite_rows(Entry("passive", "full", Passive, {}), [sc], (0.0,)) + suite_rows(
         Entry("inner-loop", "full", InnerLoop, {"command": "supervisor"}), [sc], (0.0,))
@@ -152,3 +156,6 @@ def test_robust_suite_searches_the_robust_scenario_with_its_sensing(tmp_path):
     assert bench[1]["cost"] == pytest.approx(rows["inner-loop"]["J"], rel=1e-9)
     with pytest.raises(ValueError, match="--suite = 'nominal' must be one of full, robust"):
         oracle(tmp_path / "bad", scenarios=1, suite="nominal")
+    with pytest.raises(ValueError, match=r"--constant GAIN:OFFSET_R must have both in \[-1, 1\]"):
+        oracle(tmp_path / "bad", scenarios=1, suite="robust", constants=[(0.0, -1.5)])
+    assert not (tmp_path / "bad").exists()
