@@ -196,7 +196,8 @@ def cmd_oracle(args) -> int:
                         progress=not args.quiet, plots=not args.no_plots,
                         search=not args.no_search, scenario_seed=args.scenario_seed,
                         friction=args.friction, friction_bins=args.friction_bins,
-                        suite=args.suite, constants=args.constant)
+                        suite=args.suite, constants=args.constant,
+                        start_from_constants=args.start_from_constants)
     except ERRORS as exc:
         return _fail("oracle", exc)
     _wrote(args.out, ["oracle.json", *report.get("figures", [])], report["wall_time_s"])
@@ -325,6 +326,9 @@ def register(sub) -> None:
                    help="extra designed row (repeatable): the inner-loop commands with a constant "
                         "PID gain scale and radial reference offset on both planes (supervisor "
                         "actions in [-1, 1]), named 'constant g=GAIN r=OFFSET_R'")
+    p.add_argument("--start-from-constants", action="store_true",
+                   help="start each scenario's search from the best of inner-loop and the "
+                        "--constant rows there (default: from inner-loop)")
     _output_args(p, "out/oracle")
     p.set_defaults(func=cmd_oracle)
 

@@ -276,9 +276,10 @@ def search_kwargs(sc: Scenario, phase: float) -> dict:
 
 
 def search_scenario(sc: Scenario, phase: float, passive: dict, population: int, iterations: int,
-                    seed: int, progress: bool) -> dict:
-    """Cross-entropy search of the command sequence of one scenario (module doc); each
-    generation is one batched rollout of ``population`` identical environments."""
+                    seed: int, progress: bool, start: np.ndarray | None = None) -> dict:
+    """Cross-entropy search of the command sequence of one scenario (module doc), from the
+    ``inner-loop`` sequence or ``start``; each generation is one batched rollout of
+    ``population`` identical environments."""
     from rotordrop_env import BatchedRotorDropVecEnv
     from .search import cross_entropy
     kw = search_kwargs(sc, phase)
@@ -298,7 +299,7 @@ def search_scenario(sc: Scenario, phase: float, passive: dict, population: int, 
             out.append(j + SHAPING * min(row["peak_whirl_revolutions"] / WHIRL_REVOLUTIONS, 1.0))
         return out
 
-    mean = inner_loop_theta()
+    mean = inner_loop_theta() if start is None else np.asarray(start, dtype=float)
     t0 = time.perf_counter()
     best, theta, history = cross_entropy(
         costs, mean, np.full(mean.shape, 0.5), -1.0, 1.0, iterations, population,
@@ -310,7 +311,8 @@ def search_scenario(sc: Scenario, phase: float, passive: dict, population: int, 
     j, row = seen[key]
     theta = np.frombuffer(key, dtype=float)
     return dict(theta=theta.tolist(), search_cost=best, J=j, kpis=row,
-                inner_loop_J=seen[mean.tobytes()][0],
+                start_J=seen[mean.tobytes()][0], start=mean.tolist(),
+                **({"inner_loop_J": seen[mean.tobytes()][0]} if start is None else {}),
                 rollouts=1 + iterations * population, wall_time_s=time.perf_counter() - t0,
                 history=[dict(iteration=h["iteration"], best_cost=h["best_cost"],
                               generation_best=h["generation_best"]) for h in history])
@@ -350,7 +352,7 @@ def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iteration
            seed: int = 0, policies: list[str] | None = None, progress: bool = True,
            plots: bool = True, search: bool = True, scenario_seed: int | None = None,
            friction: tuple[float, float] | None = None, friction_bins=None,
-           suite: str = "full", constants=None) -> dict:
+           suite: str = "full", constants=None, start_from_constants: bool = False) -> dict:
     """Search the command sequence of each scenario, score every row on the same scenarios and
     write ``oracle.json`` (and ``oracle.png``) into ``out`` (module doc). ``search=False``
     scores the rows only (no oracle row): the same comparison on many more scenarios.
@@ -358,7 +360,9 @@ def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iteration
     ``friction_bins``: the edges of the per-friction whirl table (:func:`friction_edges`);
     ``suite``: ``full`` (the drops above) or ``robust`` (the robust suite's, module doc;
     ``scenario_seed`` defaults to its ``SUITE_SEED``); ``constants``: (gain, radial offset)
-    pairs scored as extra designed rows (:func:`constant_theta`, ``--constant``)."""
+    pairs scored as extra designed rows (:func:`constant_theta`, ``--constant``); with
+    ``start_from_constants`` each scenario's search starts from the best of ``inner-loop`` and
+    these rows there (so that the oracle is never worse than any of them)."""
     from tqdm.auto import tqdm
     from .score import fmt_or_dash
     if scenarios < 1 or population < 2 or iterations < 0:
@@ -368,6 +372,10 @@ def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iteration
     settings, ranges = suite_settings(suite, friction, scenario_seed)
     edges = friction_edges(ranges["contact.friction"], friction_bins)
     settings.update(scenarios=scenarios, population=population, iterations=iterations, seed=seed)
+    if start_from_constants:
+        if not constants:
+            raise ValueError("--start-from-constants needs at least one --constant GAIN:OFFSET_R")
+        settings["search_start"] = ["inner-loop", *(list(c) for c in constants)]
     settings = {k: settings[k] for k in SETTINGS_ORDER if k in settings}
     drawn = suite_scenarios(suite, scenarios, settings["scenario_seed"], ranges["contact.friction"])
     out = Path(out)
@@ -391,8 +399,9 @@ def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iteration
             rows.update(constant_rows(sc, phase, rows["passive"], constants))
         found = None
         if search:
-            found = done.get(i) or search_scenario(sc, phase, rows["passive"], population,
-                                                   iterations, seed + i, progress)
+            found = done.get(i) or search_scenario(
+                sc, phase, rows["passive"], population, iterations, seed + i, progress,
+                best_start(rows, constants) if start_from_constants else None)
             rows["oracle"] = dict(found["kpis"], J=found["J"])
         per_scenario.append(dict(index=i, scenario=values, rows=rows, search=found))
         report = _report(settings, per_scenario, [e.name for e in entries], t0, search,
@@ -425,7 +434,15 @@ def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iteration
 #: so that the full suite's settings, and the runs they resume, are as before)
 SETTINGS_ORDER = ("env_id", "command", "suite", "scenarios", "population", "iterations", "seed",
                   "scenario_seed", "ranges", "sensor_noise_m", "latency_ms", "segment_edges_ms",
-                  "segment_actions", "max_delay_s", "control_dt", "shaping", "episode_time_s")
+                  "segment_actions", "max_delay_s", "control_dt", "shaping", "episode_time_s",
+                  "search_start")
+
+
+def best_start(rows: dict, constants: list[tuple[float, float]]) -> np.ndarray:
+    """The sequence of lowest J on this scenario among ``inner-loop`` and the constant laws."""
+    options = [(rows["inner-loop"]["J"], inner_loop_theta())]
+    options += [(rows[constant_name(g, r)]["J"], constant_theta(g, r)) for g, r in constants]
+    return min(options, key=lambda o: o[0])[1]
 
 
 def suite_settings(suite: str, friction, scenario_seed: int | None) -> tuple[dict, dict]:

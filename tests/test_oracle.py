@@ -136,7 +136,7 @@ def test_robust_suite_searches_the_robust_scenario_with_its_sensing(tmp_path):
     venv.close()
 
     rep = oracle(tmp_path, scenarios=1, population=4, iterations=1, progress=False, plots=False,
-                 suite="robust", constants=[(0.0, 0.0), (0.0, -0.75)])
+                 suite="robust", constants=[(0.0, 0.0), (0.0, -0.75)], start_from_constants=True)
     assert rep["settings"]["suite"] == "robust" and rep["settings"]["scenario_seed"] == SUITE_SEED
     s = rep["per_scenario"][0]
     assert s["scenario"] == record
@@ -145,8 +145,12 @@ def test_robust_suite_searches_the_robust_scenario_with_its_sensing(tmp_path):
     score = {e["controller"]: e["score"] for e in rep["summary"]}
     assert score["oracle"] >= score["inner-loop"] - 0.1
     assert {"whirl-brake-robust", "sac-robust-full-scratch"} <= set(score)
-    # the constant law g = 0, r = 0 is the inner-loop sequence the search starts from
-    assert rows["constant g=0 r=0"]["J"] == s["search"]["inner_loop_J"]
+    # the constant law g = 0, r = 0 is the inner-loop sequence (here at a 5 ms control step);
+    # started from the best constant law, the oracle is never worse than any of them
+    assert rows["constant g=0 r=0"]["J"] == pytest.approx(rows["inner-loop"]["J"], rel=1e-3)
+    assert rows["oracle"]["J"] <= min(rows["constant g=0 r=0"]["J"],
+                                      rows["constant g=0 r=-0.75"]["J"])
+    assert rep["settings"]["search_start"] == ["inner-loop", [0.0, 0.0], [0.0, -0.75]]
     assert rep["constant_rows"] == ["constant g=0 r=0", "constant g=0 r=-0.75"]
     assert "constant g=0 r=-0.75" not in rep["learned"]
     # the rows are the robust benchmark's own episodes of the scenario
@@ -158,4 +162,6 @@ def test_robust_suite_searches_the_robust_scenario_with_its_sensing(tmp_path):
         oracle(tmp_path / "bad", scenarios=1, suite="nominal")
     with pytest.raises(ValueError, match=r"--constant GAIN:OFFSET_R must have both in \[-1, 1\]"):
         oracle(tmp_path / "bad", scenarios=1, suite="robust", constants=[(0.0, -1.5)])
+    with pytest.raises(ValueError, match="--start-from-constants needs at least one --constant"):
+        oracle(tmp_path / "bad", scenarios=1, suite="robust", start_from_constants=True)
     assert not (tmp_path / "bad").exists()
