@@ -31,7 +31,9 @@ rate per friction bin (``whirl_by_friction``, ``whirl_by_friction.png``) uses
 ``--friction-bins`` edges, by default :data:`FRICTION_BINS` on the default range and 0.05-wide
 bins on any other (:func:`friction_edges`). ``--constant GAIN:OFFSET_R`` adds designed rows
 that need no knowledge of the scenario: the inner loop with a constant gain scale and radial
-reference offset (:func:`constant_theta`), run as the oracle's rollouts.
+reference offset (:func:`constant_theta`), run as the oracle's rollouts;
+``--start-from-constants`` starts each scenario's search from the best of ``inner-loop`` and
+those rows there.
 
 ``--suite robust`` runs the same search and rows on the robust suite's scenarios instead
 (:mod:`agents.robust`: the first ``--scenarios`` drops of ``rotordrop benchmark --suite robust``,
