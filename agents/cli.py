@@ -195,7 +195,9 @@ def cmd_oracle(args) -> int:
                         iterations=args.iterations, seed=args.seed, policies=args.policy,
                         progress=not args.quiet, plots=not args.no_plots,
                         search=not args.no_search, scenario_seed=args.scenario_seed,
-                        friction=args.friction, friction_bins=args.friction_bins)
+                        friction=args.friction, friction_bins=args.friction_bins,
+                        suite=args.suite, constants=args.constant,
+                        start_from_constants=args.start_from_constants)
     except ERRORS as exc:
         return _fail("oracle", exc)
     _wrote(args.out, ["oracle.json", *report.get("figures", [])], report["wall_time_s"])
@@ -300,8 +302,13 @@ def register(sub) -> None:
                    help="command sequences per generation (one batched rollout)")
     p.add_argument("--iterations", type=at_least(0), default=10, help="generations (default 10)")
     p.add_argument("--seed", type=_SEED, default=0, help="search seed")
-    p.add_argument("--scenario-seed", type=_SEED, default=10_000,
-                   help="seed of the first drawn scenario (default 10000; scenario i uses it + i)")
+    p.add_argument("--suite", default="full",
+                   help="full (default: drops drawn from friction 0.38-0.6, power back 30-70 ms) "
+                        "or robust (the first --scenarios drops of `rotordrop benchmark --suite "
+                        "robust`: sensor noise, latency, actuator spread, plant variation)")
+    p.add_argument("--scenario-seed", type=_SEED, default=None,
+                   help="seed of the first drawn scenario (default 10000, with --suite robust "
+                        "the suite's 30000; scenario i uses it + i)")
     p.add_argument("--no-search", action="store_true",
                    help="score the rows only (no oracle search), e.g. on 200 scenarios")
     p.add_argument("--friction", type=_number_list(":", 2), default=None, metavar="LO:HI",
@@ -314,6 +321,14 @@ def register(sub) -> None:
     p.add_argument("--policy", action="append", default=None,
                    help="extra rows: a training directory / model .zip or module:Class "
                         "(repeatable)")
+    p.add_argument("--constant", type=_number_list(":", 2), action="append", default=None,
+                   metavar="GAIN:OFFSET_R",
+                   help="extra designed row (repeatable): the inner-loop commands with a constant "
+                        "PID gain scale and radial reference offset on both planes (supervisor "
+                        "actions in [-1, 1]), named 'constant g=GAIN r=OFFSET_R'")
+    p.add_argument("--start-from-constants", action="store_true",
+                   help="start each scenario's search from the best of inner-loop and the "
+                        "--constant rows there (default: from inner-loop)")
     _output_args(p, "out/oracle")
     p.set_defaults(func=cmd_oracle)
 

@@ -29,7 +29,19 @@ stopped and re-scores the rows (add ``--policy`` runs without searching again). 
 scores the rows alone, e.g. on 200 scenarios from another ``--scenario-seed``. The whirl
 rate per friction bin (``whirl_by_friction``, ``whirl_by_friction.png``) uses
 ``--friction-bins`` edges, by default :data:`FRICTION_BINS` on the default range and 0.05-wide
-bins on any other (:func:`friction_edges`).
+bins on any other (:func:`friction_edges`). ``--constant GAIN:OFFSET_R`` adds designed rows
+that need no knowledge of the scenario: the inner loop with a constant gain scale and radial
+reference offset (:func:`constant_theta`), run as the oracle's rollouts;
+``--start-from-constants`` starts each scenario's search from the best of ``inner-loop`` and
+those rows there.
+
+``--suite robust`` runs the same search and rows on the robust suite's scenarios instead
+(:mod:`agents.robust`: the first ``--scenarios`` drops of ``rotordrop benchmark --suite robust``,
+seeds from ``SUITE_SEED``, the robust plant spread, sensor noise and observation latency), each
+built by the benchmark's own :func:`agents.benchmark.episode_kwargs` from the robust
+:class:`Scenario` and scored as that suite scores it. Noise and latency act on the
+observations only (:mod:`rotordrop_env.sensors`), so they change the rows that read the sensors
+and not the oracle's open-loop sequence over the built-in PID, which knows the plant in advance.
 """
 from __future__ import annotations
 
@@ -58,6 +70,34 @@ MAX_DELAY = 0.04            # switch-on delay after the power return: (theta + 1
 CONTROL_DT = 0.005          # the commands are piecewise constant over >= 10 ms segments
 SHAPING = 0.25
 WHIRL_REVOLUTIONS = 3.0
+#: ``--suite``: drops drawn from ``ORACLE_RANGES`` (full) or the robust suite's (robust)
+SUITES = ("full", "robust")
+
+
+def check_suite(suite: str) -> str:
+    if suite not in SUITES:
+        raise ValueError(f"--suite = {suite!r} must be one of {', '.join(SUITES)}")
+    return suite
+
+
+def suite_scenarios(suite: str, n: int, seed: int,
+                    friction: tuple[float, float] | None = None) -> list[tuple[Scenario, float, dict]]:
+    """The first ``n`` scenarios of ``suite`` from ``seed``: (benchmark :class:`Scenario`,
+    unbalance phase, the record written to oracle.json). ``robust``: the robust suite's own
+    scenarios (:func:`agents.robust.robust_scenarios`; their unbalance phase is in the scene
+    overrides, the phase argument is the benchmark's 0)."""
+    if check_suite(suite) == "robust":
+        from .robust import robust_scenarios
+        return [(sc, 0.0, robust_record(sc)) for sc in robust_scenarios(n, seed)]
+    return [(*as_benchmark(v, f"#{i}"), v) for i, v in enumerate(draw_scenarios(n, seed, friction))]
+
+
+def robust_record(sc: Scenario) -> dict:
+    """A robust scenario as the flat dict of the oracle's records (scene keys, power return)
+    with its sensing and episode seed."""
+    return {"contact.friction": sc.friction, **sc.overrides, **sc.env_kwargs,
+            "sensor_noise": sc.sensor_noise, "latency_ms": round(1e3 * sc.latency_s, 9),
+            "seed": sc.seed}
 
 
 def draw_scenarios(n: int, seed: int = SCENARIO_SEED,
@@ -139,6 +179,50 @@ def inner_loop_theta() -> np.ndarray:
     return np.concatenate([seg.ravel(), [-1.0]])
 
 
+def constant_theta(gain: float, offset_r: float) -> np.ndarray:
+    """The ``inner-loop`` sequence with a constant PID gain scale ``gain`` and radial reference
+    offset ``offset_r`` on both planes (actions in [-1, 1]): a causal law that does not know the
+    scenario (the commands act once the PID is on, at the power return)."""
+    seg = inner_loop_theta()[:-1].reshape(len(SEGMENT_EDGES_MS) - 1, len(SEGMENT_ACTIONS))
+    for name, value in (("gain", gain), ("offset_r1", offset_r), ("offset_r2", offset_r)):
+        seg[:, SEGMENT_ACTIONS.index(name)] = value
+    return np.concatenate([seg.ravel(), [-1.0]])
+
+
+def check_constants(constants) -> list[tuple[float, float]]:
+    """``--constant GAIN:OFFSET_R`` pairs as floats; ValueError unless both are in [-1, 1]."""
+    out = []
+    for pair in constants or []:
+        g, r = (float(v) for v in pair)
+        if not (-1.0 <= g <= 1.0 and -1.0 <= r <= 1.0):
+            raise ValueError(f"--constant GAIN:OFFSET_R must have both in [-1, 1] (supervisor "
+                             f"actions), got {g:g}:{r:g}")
+        out.append((g, r))
+    return out
+
+
+def constant_name(gain: float, offset_r: float) -> str:
+    return f"constant g={gain:g} r={offset_r:g}"
+
+
+def constant_rows(sc: Scenario, phase: float, passive: dict,
+                  constants: list[tuple[float, float]]) -> dict[str, dict]:
+    """The rows of the ``constants`` laws (:func:`constant_theta`) on one scenario, run as the
+    oracle's rollouts (one batch) and scored against its passive row."""
+    from rotordrop_env import BatchedRotorDropVecEnv
+    thetas = np.array([constant_theta(g, r) for g, r in constants])
+    venv = BatchedRotorDropVecEnv(ENV_ID, len(thetas), seed=0, **search_kwargs(sc, phase))
+    try:
+        kpis = rollout(venv, thetas, sc.env_kwargs["power_return_time"])
+    finally:
+        venv.close()
+    rows = {}
+    for (g, r), k in zip(constants, kpis):
+        row = kpi_row(k)
+        rows[constant_name(g, r)] = dict(row, J=episode_cost(row, passive))
+    return rows
+
+
 def sequence_actions(thetas: np.ndarray, t: float, power_return: float,
                      action_names: list[str]) -> np.ndarray:
     """(n, n_actions) actions at time ``t`` after the fault for the command sequences
@@ -185,14 +269,22 @@ def episode_cost(row: dict, passive: dict) -> float:
     return row_cost(row, passive, EPISODE_TIME, True)
 
 
+def search_kwargs(sc: Scenario, phase: float) -> dict:
+    """The env kwargs of the oracle's rollouts of one scenario: the benchmark's
+    :func:`episode_kwargs` of a supervisor entry at ``CONTROL_DT`` (the scenario's scene,
+    power return, sensor noise and latency)."""
+    entry = Entry("oracle", "full", None, {"command": COMMAND, "control_dt": CONTROL_DT})
+    return episode_kwargs(entry, sc, phase)
+
+
 def search_scenario(sc: Scenario, phase: float, passive: dict, population: int, iterations: int,
-                    seed: int, progress: bool) -> dict:
-    """Cross-entropy search of the command sequence of one scenario (module doc); each
-    generation is one batched rollout of ``population`` identical environments."""
+                    seed: int, progress: bool, start: np.ndarray | None = None) -> dict:
+    """Cross-entropy search of the command sequence of one scenario (module doc), from the
+    ``inner-loop`` sequence or ``start``; each generation is one batched rollout of
+    ``population`` identical environments."""
     from rotordrop_env import BatchedRotorDropVecEnv
     from .search import cross_entropy
-    entry = Entry("oracle", "full", None, {"command": COMMAND, "control_dt": CONTROL_DT})
-    kw = episode_kwargs(entry, sc, phase)
+    kw = search_kwargs(sc, phase)
     power_return = sc.env_kwargs["power_return_time"]
     venvs: dict[int, object] = {}
     seen: dict[bytes, tuple[float, dict]] = {}
@@ -209,7 +301,7 @@ def search_scenario(sc: Scenario, phase: float, passive: dict, population: int, 
             out.append(j + SHAPING * min(row["peak_whirl_revolutions"] / WHIRL_REVOLUTIONS, 1.0))
         return out
 
-    mean = inner_loop_theta()
+    mean = inner_loop_theta() if start is None else np.asarray(start, dtype=float)
     t0 = time.perf_counter()
     best, theta, history = cross_entropy(
         costs, mean, np.full(mean.shape, 0.5), -1.0, 1.0, iterations, population,
@@ -221,16 +313,20 @@ def search_scenario(sc: Scenario, phase: float, passive: dict, population: int, 
     j, row = seen[key]
     theta = np.frombuffer(key, dtype=float)
     return dict(theta=theta.tolist(), search_cost=best, J=j, kpis=row,
-                inner_loop_J=seen[mean.tobytes()][0],
+                start_J=seen[mean.tobytes()][0], start=mean.tolist(),
+                **({"inner_loop_J": seen[mean.tobytes()][0]} if start is None else {}),
                 rollouts=1 + iterations * population, wall_time_s=time.perf_counter() - t0,
                 history=[dict(iteration=h["iteration"], best_cost=h["best_cost"],
                               generation_best=h["generation_best"]) for h in history])
 
 
-def row_entries(policies: list[str] | None) -> list[Entry]:
+def row_entries(policies: list[str] | None, suite: str = "full") -> list[Entry]:
     """Every baseline with channels in the Full task, the shipped Full policies and the
-    ``--policy`` extras (paths or controller classes), as the benchmark builds them."""
-    from .benchmark import _entries, check_unique_names
+    ``--policy`` extras (paths or controller classes), as the benchmark builds them (with
+    ``suite`` robust: as the robust suite does, :func:`agents.benchmark.robust_entries`)."""
+    from .benchmark import _entries, check_unique_names, robust_entries
+    if suite == "robust":
+        return robust_entries(policies)[0]
     extra, custom = extras(policies or [])
     loaded = [load_shipped(n) for n in shipped_names()] + extra
     return check_unique_names([e for e in _entries(loaded, custom) if e.task == "full"])
@@ -256,52 +352,62 @@ def score_rows(per_scenario: list[dict], names: list[str]) -> list[dict]:
 
 def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iterations: int = 10,
            seed: int = 0, policies: list[str] | None = None, progress: bool = True,
-           plots: bool = True, search: bool = True, scenario_seed: int = SCENARIO_SEED,
-           friction: tuple[float, float] | None = None, friction_bins=None) -> dict:
+           plots: bool = True, search: bool = True, scenario_seed: int | None = None,
+           friction: tuple[float, float] | None = None, friction_bins=None,
+           suite: str = "full", constants=None, start_from_constants: bool = False) -> dict:
     """Search the command sequence of each scenario, score every row on the same scenarios and
     write ``oracle.json`` (and ``oracle.png``) into ``out`` (module doc). ``search=False``
     scores the rows only (no oracle row): the same comparison on many more scenarios.
     ``friction``: the (LO, HI) range of mu the scenarios are drawn from (default 0.38-0.6);
-    ``friction_bins``: the edges of the per-friction whirl table (:func:`friction_edges`)."""
+    ``friction_bins``: the edges of the per-friction whirl table (:func:`friction_edges`);
+    ``suite``: ``full`` (the drops above) or ``robust`` (the robust suite's, module doc;
+    ``scenario_seed`` defaults to its ``SUITE_SEED``); ``constants``: (gain, radial offset)
+    pairs scored as extra designed rows (:func:`constant_theta`, ``--constant``); with
+    ``start_from_constants`` each scenario's search starts from the best of ``inner-loop`` and
+    these rows there (so that the oracle is never worse than any of them)."""
     from tqdm.auto import tqdm
     from .score import fmt_or_dash
     if scenarios < 1 or population < 2 or iterations < 0:
         raise ValueError(f"need --scenarios >= 1, --population >= 2, --iterations >= 0 (got "
                          f"{scenarios}, {population}, {iterations})")
-    ranges = oracle_ranges(friction)
+    constants = check_constants(constants)
+    settings, ranges = suite_settings(suite, friction, scenario_seed)
     edges = friction_edges(ranges["contact.friction"], friction_bins)
+    settings.update(scenarios=scenarios, population=population, iterations=iterations, seed=seed)
+    if start_from_constants:
+        if not constants:
+            raise ValueError("--start-from-constants needs at least one --constant GAIN:OFFSET_R")
+        settings["search_start"] = ["inner-loop", *(list(c) for c in constants)]
+    settings = {k: settings[k] for k in SETTINGS_ORDER if k in settings}
+    drawn = suite_scenarios(suite, scenarios, settings["scenario_seed"], ranges["contact.friction"])
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    settings = dict(env_id=ENV_ID, command=COMMAND, scenarios=scenarios, population=population,
-                    iterations=iterations, seed=seed, scenario_seed=SCENARIO_SEED,
-                    ranges={k: list(v) for k, v in ranges.items()},
-                    segment_edges_ms=list(SEGMENT_EDGES_MS), segment_actions=list(SEGMENT_ACTIONS),
-                    max_delay_s=MAX_DELAY, control_dt=CONTROL_DT, shaping=SHAPING,
-                    episode_time_s=EPISODE_TIME)
-    settings["scenario_seed"] = scenario_seed
     done = _previous(out / "oracle.json", settings)
-    entries = row_entries(policies)
+    entries = row_entries(policies, suite)
     t0 = time.perf_counter()
     per_scenario = []
-    drawn = draw_scenarios(scenarios, scenario_seed, ranges["contact.friction"])
     if not search:
         done = {}
     bar = tqdm(total=scenarios, desc="oracle scenarios", unit="sc", disable=not progress)
-    for i, values in enumerate(drawn):
-        sc, phase = as_benchmark(values, f"#{i}")
+    for i, (sc, phase, values) in enumerate(drawn):
         rows = {}
         for entry in entries:
-            kpis = run_episodes(ENV_ID, entry.make, [0], episode_kwargs(entry, sc, phase))[0].kpis
+            kpis = run_episodes(ENV_ID, entry.make, [sc.seed],
+                                episode_kwargs(entry, sc, phase))[0].kpis
             rows[entry.name] = kpi_row(kpis)
         for row in rows.values():
             row["J"] = episode_cost(row, rows["passive"])
+        if constants:
+            rows.update(constant_rows(sc, phase, rows["passive"], constants))
         found = None
         if search:
-            found = done.get(i) or search_scenario(sc, phase, rows["passive"], population,
-                                                   iterations, seed + i, progress)
+            found = done.get(i) or search_scenario(
+                sc, phase, rows["passive"], population, iterations, seed + i, progress,
+                best_start(rows, constants) if start_from_constants else None)
             rows["oracle"] = dict(found["kpis"], J=found["J"])
         per_scenario.append(dict(index=i, scenario=values, rows=rows, search=found))
-        report = _report(settings, per_scenario, [e.name for e in entries], t0, search)
+        report = _report(settings, per_scenario, [e.name for e in entries], t0, search,
+                         [constant_name(g, r) for g, r in constants])
         write_json(out / "oracle.json", report)              # after every scenario: resumable
         bar.update(1)
     bar.close()
@@ -312,8 +418,10 @@ def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iteration
                              plot_whirl_by_friction(report, out / "whirl_by_friction.png").name]
     write_json(out / "oracle.json", report)
     lo, hi = ranges["contact.friction"]
+    where = ("the robust suite's first, sensor noise and latency" if suite == "robust" else
+             "power back 30-70 ms")
     print(f"{'oracle bound' if search else 'rows'}, {ENV_ID}, {scenarios} scenarios "
-          f"(friction {lo:g}-{hi:g}, power back 30-70 ms, seeds from {scenario_seed}):")
+          f"({where}, friction {lo:g}-{hi:g}, seeds from {settings['scenario_seed']}):")
     print("| controller | score | whirl rate | whirl where passive whirls | re-levitated |")
     print("|---|---:|---:|---:|---:|")
     for e in report["summary"]:
@@ -322,6 +430,43 @@ def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iteration
               f"{e['relevitation_rate']:.2f} |")
     print_whirl_by_friction(report["whirl_by_friction"])
     return report
+
+
+#: key order of ``settings`` in oracle.json (``suite`` and the sensing only with --suite robust,
+#: so that the full suite's settings, and the runs they resume, are as before)
+SETTINGS_ORDER = ("env_id", "command", "suite", "scenarios", "population", "iterations", "seed",
+                  "scenario_seed", "ranges", "sensor_noise_m", "latency_ms", "segment_edges_ms",
+                  "segment_actions", "max_delay_s", "control_dt", "shaping", "episode_time_s",
+                  "search_start")
+
+
+def best_start(rows: dict, constants: list[tuple[float, float]]) -> np.ndarray:
+    """The sequence of lowest J on this scenario among ``inner-loop`` and the constant laws."""
+    options = [(rows["inner-loop"]["J"], inner_loop_theta())]
+    options += [(rows[constant_name(g, r)]["J"], constant_theta(g, r)) for g, r in constants]
+    return min(options, key=lambda o: o[0])[1]
+
+
+def suite_settings(suite: str, friction, scenario_seed: int | None) -> tuple[dict, dict]:
+    """The suite's part of oracle.json's settings and its ranges (checked: ``friction`` only
+    with the full suite, whose range it sets)."""
+    settings = dict(env_id=ENV_ID, command=COMMAND, segment_edges_ms=list(SEGMENT_EDGES_MS),
+                    segment_actions=list(SEGMENT_ACTIONS), max_delay_s=MAX_DELAY,
+                    control_dt=CONTROL_DT, shaping=SHAPING, episode_time_s=EPISODE_TIME)
+    if check_suite(suite) == "robust":
+        from .robust import LATENCY_MS, ROBUST_RANGES, SENSOR_NOISE, SUITE_SEED
+        if friction is not None:
+            raise ValueError("--friction does not apply to --suite robust (its scenarios are the "
+                             "robust suite's, friction 0.3-0.6)")
+        ranges = dict(ROBUST_RANGES)
+        settings.update(suite=suite, sensor_noise_m=SENSOR_NOISE, latency_ms=list(LATENCY_MS))
+        default_seed = SUITE_SEED
+    else:
+        ranges = oracle_ranges(friction)
+        default_seed = SCENARIO_SEED
+    settings.update(ranges={k: list(v) for k, v in ranges.items()},
+                    scenario_seed=default_seed if scenario_seed is None else scenario_seed)
+    return settings, ranges
 
 
 def write_whirl_csv(table: dict, path: Path) -> Path:
@@ -351,14 +496,17 @@ def print_whirl_by_friction(table: dict) -> None:
 
 
 def _report(settings: dict, per_scenario: list[dict], names: list[str], t0: float,
-            search: bool = True) -> dict:
-    summary = score_rows(per_scenario, names + (["oracle"] if search else []))
+            search: bool = True, constants: list[str] = ()) -> dict:
+    """The summary of the rows so far; ``best_designed`` and the oracle's gain over it count
+    the baselines only, the ``constants`` rows are listed beside them (``constant_rows``)."""
+    summary = score_rows(per_scenario, names + list(constants) + (["oracle"] if search else []))
     learned = {n for n in names if n not in BASELINES}
     designed = [e for e in summary if e["controller"] in BASELINES and e["controller"] != "passive"]
     best = designed[0] if designed else None
     orc = next((e for e in summary if e["controller"] == "oracle"), None)
     return dict(settings=settings, per_scenario=per_scenario, summary=summary,
-                learned=sorted(learned), best_designed=best["controller"] if best else None,
+                learned=sorted(learned), constant_rows=list(constants),
+                best_designed=best["controller"] if best else None,
                 oracle_gain_over_best_designed=(orc["score"] - best["score"]
                                                 if best and orc else None),
                 wall_time_s=time.perf_counter() - t0)
@@ -389,13 +537,15 @@ def plot_oracle(report: dict, path: Path) -> Path:
     fig, axes = plt.subplots(1, 3, figsize=(16, 0.35 * len(names) + 2.5))
     y = np.arange(len(names))[::-1]
     axes[0].barh(y, [e["score"] for e in summary], color=colors)
+    suite = report["settings"].get("suite", "full")
     axes[0].set(yticks=y, yticklabels=names, xlabel="score (benchmark formula)",
-                title=f"{len(report['per_scenario'])} scenarios, RotorDrop-Full-v0")
+                title=f"{len(report['per_scenario'])} scenarios, RotorDrop-Full-v0"
+                      + (", robust suite" if suite == "robust" else ""))
     axes[1].barh(y, [e["whirl_rate"] for e in summary], color=colors)
     axes[1].set(yticks=y, yticklabels=[], xlabel="backward-whirl rate", xlim=(0, 1))
     idx = np.arange(len(report["per_scenario"]))
     show = ["passive", report["best_designed"], *(["oracle"] if "oracle" in names else []),
-            *report["learned"]]
+            *report.get("constant_rows", []), *report["learned"]]
     for name in dict.fromkeys(n for n in show if n):
         axes[2].plot(idx, [s["rows"][name]["J"] for s in report["per_scenario"]], "o-", ms=3,
                      label=name)

@@ -365,6 +365,13 @@ def test_a_friction_range_that_is_not_two_numbers_is_a_flag_error(capsys, tmp_pa
 @pytest.mark.parametrize("argv, message", [
     (["oracle", "--friction", "0.6:0.3", "--no-search"],
      "--friction must be LO:HI with 0 <= LO < HI <= 1, got 0.6:0.3"),
+    (["oracle", "--suite", "nominal", "--no-search"],
+     "--suite = 'nominal' must be one of full, robust"),
+    (["oracle", "--suite", "robust", "--friction", "0.3:0.5", "--no-search"],
+     "--friction does not apply to --suite robust (its scenarios are the robust suite's, "
+     "friction 0.3-0.6)"),
+    (["oracle", "--suite", "robust", "--constant", "0:1.5", "--no-search"],
+     "--constant GAIN:OFFSET_R must have both in [-1, 1] (supervisor actions), got 0:1.5"),
     (["train", "--env", "RotorDrop-Relevitate-v0", "--algo", "tqc", "--time-limit", "0"],
      "--time-limit must be a number of seconds > 0, got 0.0")])
 def test_a_bad_friction_range_or_time_limit_fails_before_anything_is_written(argv, message, capsys,

@@ -111,3 +111,57 @@ def test_a_friction_range_draws_there_and_bins_its_whirl_table(tmp_path, capsys)
         oracle(tmp_path / "bad", scenarios=1, search=False, friction=(0.3, 0.6),
                friction_bins=(0.3, 0.5, 0.4, 0.6))
     assert not (tmp_path / "bad").exists()                    # nothing written
+
+
+def test_robust_suite_searches_the_robust_scenario_with_its_sensing(tmp_path):
+    """--suite robust: the robust suite's first scenario (seed SUITE_SEED), its plant spread,
+    noise and latency in the oracle's rollouts and the rows, the rows' J as the robust
+    benchmark scores them; the oracle never scores worse than inner-loop there."""
+    from agents.benchmark import leaderboard, suite_rows
+    from agents.controllers import Passive
+    from agents.oracle import search_kwargs, suite_scenarios
+    from agents.robust import SENSOR_NOISE, SUITE_SEED, draw_scenario
+    from rotordrop_env import BatchedRotorDropVecEnv
+    sc, phase, record = suite_scenarios("robust", 1, SUITE_SEED)[0]
+    assert sc == draw_scenario(SUITE_SEED, "#0")
+    kw = search_kwargs(sc, phase)
+    venv = BatchedRotorDropVecEnv(ENV_ID, 1, seed=0, **kw)
+    venv.reset()
+    env = venv.envs[0]
+    assert env.sensor_noise == SENSOR_NOISE == record["sensor_noise"]
+    assert env._sensing.k == int(np.ceil(sc.latency_s / CONTROL_DT - 1e-9)) >= 1    # 1-3 ms
+    assert env.scene.amb.current_limit == pytest.approx(sc.overrides["amb.current_limit"])
+    assert env.scene.amb.coil_time_constant == pytest.approx(
+        sc.overrides["amb.coil_time_constant"])
+    venv.close()
+
+    rep = oracle(tmp_path, scenarios=1, population=4, iterations=1, progress=False, plots=False,
+                 suite="robust", constants=[(0.0, 0.0), (0.0, -0.75)], start_from_constants=True)
+    assert rep["settings"]["suite"] == "robust" and rep["settings"]["scenario_seed"] == SUITE_SEED
+    s = rep["per_scenario"][0]
+    assert s["scenario"] == record
+    rows = s["rows"]
+    assert rows["oracle"]["J"] <= rows["inner-loop"]["J"] * (1 + 1e-3)
+    score = {e["controller"]: e["score"] for e in rep["summary"]}
+    assert score["oracle"] >= score["inner-loop"] - 0.1
+    assert {"whirl-brake-robust", "sac-robust-full-scratch"} <= set(score)
+    # the constant law g = 0, r = 0 is the inner-loop sequence (here at a 5 ms control step);
+    # started from the best constant law, the oracle is never worse than any of them
+    assert rows["constant g=0 r=0"]["J"] == pytest.approx(rows["inner-loop"]["J"], rel=1e-3)
+    assert rows["oracle"]["J"] <= min(rows["constant g=0 r=0"]["J"],
+                                      rows["constant g=0 r=-0.75"]["J"])
+    assert rep["settings"]["search_start"] == ["inner-loop", [0.0, 0.0], [0.0, -0.75]]
+    assert rep["constant_rows"] == ["constant g=0 r=0", "constant g=0 r=-0.75"]
+    assert "constant g=0 r=-0.75" not in rep["learned"]
+    # the rows are the robust benchmark's own episodes of the scenario
+    bench = suite_rows(Entry("passive", "full", Passive, {}), [sc], (0.0,)) + suite_rows(
+        Entry("inner-loop", "full", InnerLoop, {"command": "supervisor"}), [sc], (0.0,))
+    leaderboard(bench, [sc], None, any_friction=True)
+    assert bench[1]["cost"] == pytest.approx(rows["inner-loop"]["J"], rel=1e-9)
+    with pytest.raises(ValueError, match="--suite = 'nominal' must be one of full, robust"):
+        oracle(tmp_path / "bad", scenarios=1, suite="nominal")
+    with pytest.raises(ValueError, match=r"--constant GAIN:OFFSET_R must have both in \[-1, 1\]"):
+        oracle(tmp_path / "bad", scenarios=1, suite="robust", constants=[(0.0, -1.5)])
+    with pytest.raises(ValueError, match="--start-from-constants needs at least one --constant"):
+        oracle(tmp_path / "bad", scenarios=1, suite="robust", start_from_constants=True)
+    assert not (tmp_path / "bad").exists()
