@@ -314,7 +314,6 @@ def search_scenario(sc: Scenario, phase: float, passive: dict, population: int, 
     theta = np.frombuffer(key, dtype=float)
     return dict(theta=theta.tolist(), search_cost=best, J=j, kpis=row,
                 start_J=seen[mean.tobytes()][0], start=mean.tolist(),
-                **({"inner_loop_J": seen[mean.tobytes()][0]} if start is None else {}),
                 rollouts=1 + iterations * population, wall_time_s=time.perf_counter() - t0,
                 history=[dict(iteration=h["iteration"], best_cost=h["best_cost"],
                               generation_best=h["generation_best"]) for h in history])

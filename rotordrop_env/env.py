@@ -587,21 +587,22 @@ def supervisor_scales(scene: Scene, authority: float = 1.0) -> tuple[float, floa
 def _check_authority(value, command) -> float:
     """``supervisor_authority``: a real number in (0, 1], other than 1 only with the supervisor
     command (elsewhere it would silently change nothing)."""
-    if (isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real)
-            or not (math.isfinite(value) and 0.0 < value <= 1.0)):
-        raise ValueError(f"supervisor_authority = {value!r} must be a real number in (0, 1]")
+    _positive("supervisor_authority", value, 0.0, 1.0, low_open=True)
     if value != 1.0 and command != "supervisor":
         raise ValueError(f"supervisor_authority = {value!r} applies to command='supervisor' only, "
                          f"not command={command!r}")
     return float(value)
 
 
-def _positive(name: str, value, lo: float, hi: float) -> None:
+def _positive(name: str, value, lo: float, hi: float, low_open: bool = False) -> None:
+    """ValueError naming ``name`` and the range unless ``value`` is a real number in [lo, hi]
+    (``low_open``: in (lo, hi])."""
+    interval = f"{'(' if low_open else '['}{lo:g}, {hi:g}]"
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
-        raise ValueError(f"{name} = {value!r} must be a real number in [{lo:g}, {hi:g}], "
+        raise ValueError(f"{name} = {value!r} must be a real number in {interval}, "
                          f"not a {type(value).__name__}")
-    if not (math.isfinite(value) and lo <= value <= hi):
-        raise ValueError(f"{name} = {value!r} must be in [{lo:g}, {hi:g}]")
+    if not (math.isfinite(value) and lo <= value <= hi) or (low_open and value == lo):
+        raise ValueError(f"{name} = {value!r} must be in {interval}")
 
 
 def _check_unused_ranges(randomization, randomize: bool, overrides, power_return_time) -> None:

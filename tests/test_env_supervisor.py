@@ -138,7 +138,7 @@ def test_tangential_offset_drives_a_forward_orbit():
 
 @pytest.mark.parametrize("bad", [0.0, -0.5, 1.5, math.nan, math.inf, "half", True])
 def test_supervisor_authority_out_of_range_names_the_range(bad):
-    with pytest.raises(ValueError, match=r"supervisor_authority = .* must be a real number in \(0, 1\]"):
+    with pytest.raises(ValueError, match=r"supervisor_authority = .* must be (a real number )?in \(0, 1\]"):
         gym.make("RotorDrop-Full-v0", command="supervisor", supervisor_authority=bad)
 
 

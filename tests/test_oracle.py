@@ -55,9 +55,10 @@ def test_batched_rollout_of_the_inner_loop_sequence_is_the_inner_loop_row():
 def test_oracle_never_worse_than_its_start_and_resumes(tmp_path):
     rep = oracle(tmp_path, scenarios=1, population=4, iterations=1, progress=False, plots=False)
     s = rep["per_scenario"][0]
-    assert s["rows"]["oracle"]["J"] <= s["search"]["inner_loop_J"]
+    assert s["search"]["start"] == inner_loop_theta().tolist()      # by default from inner-loop
+    assert s["rows"]["oracle"]["J"] <= s["search"]["start_J"]
     # the same commands at a 1 ms control step: the same drop up to the integrator's segments
-    assert s["search"]["inner_loop_J"] == pytest.approx(s["rows"]["inner-loop"]["J"], rel=1e-3)
+    assert s["search"]["start_J"] == pytest.approx(s["rows"]["inner-loop"]["J"], rel=1e-3)
     assert s["scenario"]["power_return_time"] * 200 == pytest.approx(
         round(s["scenario"]["power_return_time"] * 200))                # on the 5 ms grid
     names = [e["controller"] for e in rep["summary"]]

@@ -31,3 +31,28 @@ def test_research_usage_errors_are_one_line(tmp_path, capsys, args, message):
     assert main(["research", *args, "--out", str(tmp_path)]) == 2
     err = capsys.readouterr().err
     assert message in err and err.count("\n") == 1
+
+
+def test_collapse_diagnosis_tools_agree_with_the_validator_on_the_inner_loop():
+    """agents.research.diagnose_run / probe_commands (docs/agents.md, "Why the robust runs
+    collapse"): the inner loop through the diagnosis recorder and as the constant supervisor
+    command (both dampers C_max, levitate on, zero gain and offsets) score what the robust
+    validator gives the inner loop; it switches on at the first step that sees the power and
+    re-levitates every drop."""
+    from agents.controllers import InnerLoop
+    from agents.plant import Plant
+    from agents.research.diagnose_run import diagnose
+    from agents.research.probe_commands import ConstantCommands, probe
+    from agents.robust import ENV_ID, robust_validator, training_env_kwargs
+    from agents.rollout import make_env
+    validator = robust_validator()
+    kw = dict(training_env_kwargs(), command="supervisor")
+    ref, _ = validator.score(InnerLoop, kw)
+    env = make_env(ENV_ID, command="supervisor", control_dt=kw["control_dt"])
+    names = list(Plant.from_env(env).obs_names)
+    env.close()
+    d = diagnose("inner-loop", InnerLoop, kw, validator, names)
+    assert d["score"] == ref and d["relevitated"] == 1.0
+    assert d["never_switched_on"] == 0.0 and d["switch_on_after_power_ms_median"] == 0.0
+    p = probe(validator, lambda plant: ConstantCommands([1, 1, 1, 0, 0, 0, 0, 0]))
+    assert p["score"] == pytest.approx(ref, abs=0.5) and p["relevitated"] == 1.0

@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from agents.benchmark import EPISODE_TIME, Entry, leaderboard, suite_rows
+from agents.benchmark import EPISODE_TIME
 from agents.controllers import InnerLoop
 from agents.policies import LearnedPolicy
 from agents.reward import WEIGHTS, kpi_potential
@@ -46,7 +46,7 @@ class Recorder:
         return action, state
 
 
-def kpi_return(row: dict, power_return: float) -> float:
+def kpi_return(row: dict) -> float:
     """The KPI reward's episode return from a validation row's KPIs (agents/reward.py)."""
     w = {k: v for k, v in WEIGHTS.items() if k not in ("w_relevitate", "w_time")}
     phi = kpi_potential(min(row["peak_whirl_revolutions"], 3.0), row["peak_contact_force_N"],
@@ -60,11 +60,8 @@ def diagnose(name: str, make, env_kwargs: dict, validator, names: list[str],
              stochastic: bool = False) -> dict:
     log: list = []
     power_index = names.index("amb_power")
-    rows = suite_rows(Entry(name, validator.task,
-                            lambda plant: Recorder(make(plant), log, power_index, stochastic),
-                            env_kwargs), validator.scenarios, validator.phases)
-    board = leaderboard(validator.passive + rows, validator.scenarios, None)
-    score = next(e["score"] for e in board if e["controller"] == name)
+    score, rows = validator.score(lambda plant: Recorder(make(plant), log, power_index, stochastic),
+                                  env_kwargs)
     passive = {r["scenario"]: r for r in validator.passive}
     pr = {s.name: s.env_kwargs["power_return_time"] for s in validator.scenarios}
     relev = [r for r in rows if r["relevitated"]]
@@ -83,7 +80,7 @@ def diagnose(name: str, make, env_kwargs: dict, validator, names: list[str],
         disp_ratio=float(np.mean([r["max_displacement_um"] / passive[r["scenario"]]["max_displacement_um"]
                                   for r in rows])),
         mean_cost=float(np.mean([r["cost"] for r in rows])),
-        kpi_return=float(np.mean([kpi_return(r, pr[r["scenario"]]) for r in rows])),
+        kpi_return=float(np.mean([kpi_return(r) for r in rows])),
         mean_action_before_power=acts[~power].mean(axis=0).round(3).tolist(),
         mean_action_after_power=acts[power].mean(axis=0).round(3).tolist(),
         mean_abs_action_after_power=np.abs(acts[power]).mean(axis=0).round(3).tolist(),
@@ -99,9 +96,13 @@ def switch_delay_ms(episode, dt: float):
     return 1e3 * dt * (hit[0] - on[0]) if on and hit else None
 
 
+def step_of(checkpoint: Path) -> int:
+    """The training step of an SB3 checkpoint ``..._<step>_steps.zip``."""
+    return int(re.search(r"_(\d+)_steps\.zip$", checkpoint.name)[1])
+
+
 def checkpoints(run: Path) -> list[Path]:
-    steps = lambda p: int(re.search(r"_(\d+)_steps\.zip$", p.name)[1])
-    return sorted((run / "checkpoints").glob("*_steps.zip"), key=steps)
+    return sorted((run / "checkpoints").glob("*_steps.zip"), key=step_of)
 
 
 def main(argv=None) -> None:
@@ -116,8 +117,8 @@ def main(argv=None) -> None:
     validator = robust_validator()
     ckpts = checkpoints(args.run)[::args.every]
     if args.steps:
-        ckpts = [p for p in checkpoints(args.run)
-                 if int(re.search(r"_(\d+)_steps", p.name)[1]) in {int(s) for s in args.steps.split(",")}]
+        wanted = {int(s) for s in args.steps.split(",")}
+        ckpts = [p for p in checkpoints(args.run) if step_of(p) in wanted]
     if (args.run / "best" / "best_model.zip").is_file():
         ckpts.append(args.run / "best" / "best_model.zip")
     first = LearnedPolicy.load(ckpts[0])

@@ -17,7 +17,6 @@ import json
 
 import numpy as np
 
-from agents.benchmark import Entry, leaderboard, suite_rows
 from agents.robust import robust_validator, training_env_kwargs
 
 
@@ -39,9 +38,8 @@ class ConstantCommands:
 
 def probe(validator, make, authority: float = 1.0) -> dict:
     kw = dict(training_env_kwargs(), command="supervisor", supervisor_authority=authority)
-    rows = suite_rows(Entry("probe", validator.task, make, kw), validator.scenarios, validator.phases)
-    board = leaderboard(validator.passive + rows, validator.scenarios, None)
-    return dict(score=next(e["score"] for e in board if e["controller"] == "probe"),
+    score, rows = validator.score(make, kw)
+    return dict(score=score,
                 relevitated=float(np.mean([r["relevitated"] for r in rows])),
                 whirl_rate=float(np.mean([r["backward_whirl"] for r in rows])))
 
