@@ -369,7 +369,7 @@ class InnerLoop(Controller):
     2^(gain x the env's octaves)) and radial reference offset ``offset_r`` (clearances along the
     sensed orbit's radius, on both planes; negative pulls towards the centre), no tangential
     offset. Both are supervisor actions in [-1, 1], read by nothing before the PID is on; the
-    law reads no sensor. The class defaults ``GAIN``, ``OFFSET_R`` = 0 are ``inner-loop``, the
+    law reads no sensor. The class defaults ``GAINS`` (both 0) are ``inner-loop``, the
     "inner loop only" row (the same trajectory as ``builtin-relevitate`` with C_max); other
     values are ``inner-loop-lift`` (:class:`InnerLoopLift`) and the oracle's ``--constant``
     rows (:func:`agents.oracle.constant_entry`)."""
@@ -377,13 +377,12 @@ class InnerLoop(Controller):
     name = "inner-loop"
     needs = ("levitate", "offsets")
     sensors = False
-    GAIN = 0.0
-    OFFSET_R = 0.0
+    GAINS = dict(gain=0.0, offset_r=0.0)
 
     def __init__(self, plant: Plant, gain: float | None = None, offset_r: float | None = None):
         super().__init__(plant)
-        self.gain = supervisor_action("gain", self.GAIN if gain is None else gain)
-        self.offset_r = supervisor_action("offset_r", self.OFFSET_R if offset_r is None
+        self.gain = supervisor_action("gain", self.GAINS["gain"] if gain is None else gain)
+        self.offset_r = supervisor_action("offset_r", self.GAINS["offset_r"] if offset_r is None
                                           else offset_r)
 
     def commands(self, obs):
@@ -414,8 +413,7 @@ class InnerLoopLift(InnerLoop):
     (docs/agents.md, "Oracle on the robust suite")."""
 
     name = "inner-loop-lift"
-    GAIN = 0.5
-    OFFSET_R = -0.5
+    GAINS = dict(gain=0.5, offset_r=-0.5)
     control_dt = 0.005      # the oracle's rollouts' step, at which the constants were chosen
 
 
@@ -428,9 +426,10 @@ class WhirlBrakeSupervisor(InnerLoop):
 
     name = "whirl-brake-sup"
     sensors = True
+    GAINS = WhirlBrake.GAINS            # its keyword arguments are whirl-brake's gains
 
     def __init__(self, plant: Plant, **gains):
-        super().__init__(plant)
+        super().__init__(plant, gain=0.0, offset_r=0.0)
         self.g = WhirlBrake(plant, **gains).g
         self.per_offset = plant.current_limit / plant.pid[0] / plant.clearance
 
