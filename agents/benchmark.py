@@ -70,10 +70,13 @@ def task_of(env_id: str) -> str:
 
 def controller_env_kwargs(cls, env_id: str) -> dict:
     """The env kwargs a controller class needs in ``env_id``: the re-levitation command of its
-    channels (``controllers.command_for``) in the re-levitation environments, else nothing
-    (the passive reference keeps the AMBs off)."""
+    channels (``controllers.command_for``) in the re-levitation environments (the passive
+    reference keeps the AMBs off), and its ``control_dt`` where it sets one."""
     command = command_for(cls)
-    return {"command": command} if command and env_id in RELEVITATION_ENVS else {}
+    kw = {"command": command} if command and env_id in RELEVITATION_ENVS else {}
+    if getattr(cls, "control_dt", None) is not None:
+        kw["control_dt"] = cls.control_dt
+    return kw
 
 
 @dataclass(frozen=True)

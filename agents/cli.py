@@ -325,7 +325,8 @@ def register(sub) -> None:
                    metavar="GAIN:OFFSET_R",
                    help="extra designed row (repeatable): the inner-loop commands with a constant "
                         "PID gain scale and radial reference offset on both planes (supervisor "
-                        "actions in [-1, 1]), named 'constant g=GAIN r=OFFSET_R'")
+                        "actions in [-1, 1]), named 'constant g=GAIN r=OFFSET_R': the law of "
+                        "inner-loop-lift (0.5:-0.5) at its 5 ms control step")
     p.add_argument("--start-from-constants", action="store_true",
                    help="start each scenario's search from the best of inner-loop and the "
                         "--constant rows there (default: from inner-loop)")

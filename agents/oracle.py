@@ -31,7 +31,8 @@ rate per friction bin (``whirl_by_friction``, ``whirl_by_friction.png``) uses
 ``--friction-bins`` edges, by default :data:`FRICTION_BINS` on the default range and 0.05-wide
 bins on any other (:func:`friction_edges`). ``--constant GAIN:OFFSET_R`` adds designed rows
 that need no knowledge of the scenario: the inner loop with a constant gain scale and radial
-reference offset (:func:`constant_theta`), run as the oracle's rollouts;
+reference offset, the law of the baseline ``inner-loop-lift`` with other constants, at its
+5 ms control step (:func:`constant_entry`);
 ``--start-from-constants`` starts each scenario's search from the best of ``inner-loop`` and
 those rows there.
 
@@ -180,9 +181,10 @@ def inner_loop_theta() -> np.ndarray:
 
 
 def constant_theta(gain: float, offset_r: float) -> np.ndarray:
-    """The ``inner-loop`` sequence with a constant PID gain scale ``gain`` and radial reference
-    offset ``offset_r`` on both planes (actions in [-1, 1]): a causal law that does not know the
-    scenario (the commands act once the PID is on, at the power return)."""
+    """The law of :func:`constant_entry` (``InnerLoop(plant, gain, offset_r)``: C_max, the PID
+    on at the power return, a constant gain action ``gain`` and radial reference offset
+    ``offset_r`` on both planes) as a command sequence of the search: its start with
+    ``--start-from-constants`` (tests/test_oracle.py checks that both run the same drop)."""
     seg = inner_loop_theta()[:-1].reshape(len(SEGMENT_EDGES_MS) - 1, len(SEGMENT_ACTIONS))
     for name, value in (("gain", gain), ("offset_r1", offset_r), ("offset_r2", offset_r)):
         seg[:, SEGMENT_ACTIONS.index(name)] = value
@@ -205,22 +207,16 @@ def constant_name(gain: float, offset_r: float) -> str:
     return f"constant g={gain:g} r={offset_r:g}"
 
 
-def constant_rows(sc: Scenario, phase: float, passive: dict,
-                  constants: list[tuple[float, float]]) -> dict[str, dict]:
-    """The rows of the ``constants`` laws (:func:`constant_theta`) on one scenario, run as the
-    oracle's rollouts (one batch) and scored against its passive row."""
-    from rotordrop_env import BatchedRotorDropVecEnv
-    thetas = np.array([constant_theta(g, r) for g, r in constants])
-    venv = BatchedRotorDropVecEnv(ENV_ID, len(thetas), seed=0, **search_kwargs(sc, phase))
-    try:
-        kpis = rollout(venv, thetas, sc.env_kwargs["power_return_time"])
-    finally:
-        venv.close()
-    rows = {}
-    for (g, r), k in zip(constants, kpis):
-        row = kpi_row(k)
-        rows[constant_name(g, r)] = dict(row, J=episode_cost(row, passive))
-    return rows
+def constant_entry(gain: float, offset_r: float) -> Entry:
+    """The ``--constant GAIN:OFFSET_R`` row: the designed law of ``inner-loop-lift``
+    (:class:`agents.controllers.InnerLoop` with these constants, a causal law that does not know
+    the scenario and reads no sensor) at ``inner-loop-lift``'s control step, run and scored as
+    every other row; ``--constant 0.5:-0.5`` is ``inner-loop-lift`` itself."""
+    from .benchmark import controller_env_kwargs
+    from .controllers import InnerLoop, InnerLoopLift
+    return Entry(constant_name(gain, offset_r), "full",
+                 lambda plant: InnerLoop(plant, gain, offset_r),
+                 controller_env_kwargs(InnerLoopLift, ENV_ID))
 
 
 def sequence_actions(thetas: np.ndarray, t: float, power_return: float,
@@ -361,7 +357,7 @@ def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iteration
     ``friction_bins``: the edges of the per-friction whirl table (:func:`friction_edges`);
     ``suite``: ``full`` (the drops above) or ``robust`` (the robust suite's, module doc;
     ``scenario_seed`` defaults to its ``SUITE_SEED``); ``constants``: (gain, radial offset)
-    pairs scored as extra designed rows (:func:`constant_theta`, ``--constant``); with
+    pairs scored as extra designed rows (:func:`constant_entry`, ``--constant``); with
     ``start_from_constants`` each scenario's search starts from the best of ``inner-loop`` and
     these rows there (so that the oracle is never worse than any of them)."""
     from tqdm.auto import tqdm
@@ -383,6 +379,7 @@ def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iteration
     out.mkdir(parents=True, exist_ok=True)
     done = _previous(out / "oracle.json", settings)
     entries = row_entries(policies, suite)
+    const_entries = [constant_entry(g, r) for g, r in constants]
     t0 = time.perf_counter()
     per_scenario = []
     if not search:
@@ -390,14 +387,12 @@ def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iteration
     bar = tqdm(total=scenarios, desc="oracle scenarios", unit="sc", disable=not progress)
     for i, (sc, phase, values) in enumerate(drawn):
         rows = {}
-        for entry in entries:
+        for entry in entries + const_entries:
             kpis = run_episodes(ENV_ID, entry.make, [sc.seed],
                                 episode_kwargs(entry, sc, phase))[0].kpis
             rows[entry.name] = kpi_row(kpis)
         for row in rows.values():
             row["J"] = episode_cost(row, rows["passive"])
-        if constants:
-            rows.update(constant_rows(sc, phase, rows["passive"], constants))
         found = None
         if search:
             found = done.get(i) or search_scenario(
@@ -406,7 +401,7 @@ def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iteration
             rows["oracle"] = dict(found["kpis"], J=found["J"])
         per_scenario.append(dict(index=i, scenario=values, rows=rows, search=found))
         report = _report(settings, per_scenario, [e.name for e in entries], t0, search,
-                         [constant_name(g, r) for g, r in constants])
+                         [e.name for e in const_entries])
         write_json(out / "oracle.json", report)              # after every scenario: resumable
         bar.update(1)
     bar.close()
@@ -497,7 +492,7 @@ def print_whirl_by_friction(table: dict) -> None:
 def _report(settings: dict, per_scenario: list[dict], names: list[str], t0: float,
             search: bool = True, constants: list[str] = ()) -> dict:
     """The summary of the rows so far; ``best_designed`` and the oracle's gain over it count
-    the baselines only, the ``constants`` rows are listed beside them (``constant_rows``)."""
+    the baselines only, the ``constants`` rows are listed beside them (:func:`constant_entry`)."""
     summary = score_rows(per_scenario, names + list(constants) + (["oracle"] if search else []))
     learned = {n for n in names if n not in BASELINES}
     designed = [e for e in summary if e["controller"] in BASELINES and e["controller"] != "passive"]

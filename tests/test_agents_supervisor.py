@@ -62,3 +62,49 @@ def test_whirl_brake_sup_turns_whirl_brake_terms_into_offsets():
 def test_rows_relevitate_after_a_whirl_free_drop(cls):
     ep = run_episodes(FULL, cls, [0], KW)[0]
     assert ep.kpis["relevitated"] and not ep.kpis["backward_whirl"]
+
+
+def test_inner_loop_lift_commands_constants_and_switches_on_at_the_power_return():
+    """inner-loop-lift: C_max, levitate on, gain action 0.5 and radial offsets -0.5 clearance
+    on both planes (no tangential offset) at every step, at its 5 ms control step; the built-in
+    PID engages in the step the power returns (20 ms), not before; and the lift-assist
+    re-levitates sooner than the plain inner loop on the same drop."""
+    from agents.controllers import InnerLoopLift
+    kw = {**KW, **controller_env_kwargs(InnerLoopLift, FULL)}
+    assert kw["control_dt"] == 0.005 and BASELINES["inner-loop-lift"] is InnerLoopLift
+    env = make_env(FULL, **kw)
+    plant = Plant.from_env(env)
+    ctrl = InnerLoopLift(plant)
+    obs, _ = env.reset(seed=0)
+    col = {n: plant.action_names.index(n) for n in plant.action_names}
+    on_at = None
+    for k in range(10):
+        a, _ = ctrl.predict(obs)
+        assert a[col["damping1"]] == a[col["damping2"]] == 1.0 and a[col["levitate"]] == 1.0
+        assert a[col["gain"]] == 0.5
+        assert a[col["offset_r1"]] == a[col["offset_r2"]] == -0.5
+        assert a[col["offset_t1"]] == a[col["offset_t2"]] == 0.0
+        obs, *_ = env.step(a)
+        if on_at is None and plant.get(obs[None], "controller_on")[0] > 0.5:
+            on_at = k * 0.005                       # the step that engaged it started here
+    assert on_at == pytest.approx(KW["power_return_time"])
+    lift, plain = (run_episodes(FULL, cls, [0], kw)[0].kpis for cls in (InnerLoopLift, InnerLoop))
+    assert lift["relevitated"] and plain["relevitated"]
+    assert lift["relevitation_time_s"] < plain["relevitation_time_s"] - 0.01
+
+
+def test_inner_loop_constants_are_checked():
+    plant = Plant.from_env(make_env(FULL, **KW))
+    with pytest.raises(ValueError, match=r"^offset_r = -1.5 must be in \[-1, 1\] \(a supervisor action\)$"):
+        InnerLoop(plant, offset_r=-1.5)
+    with pytest.raises(ValueError, match=r"^gain = 2 must be in \[-1, 1\]"):
+        InnerLoop(plant, gain=2)
+
+
+def test_inner_loop_lift_is_a_full_task_baseline_of_both_suites():
+    from agents.benchmark import _entries, robust_entries
+    entries = {(e.task, e.name): e for e in _entries([])}
+    assert entries[("full", "inner-loop-lift")].env_kwargs == {"command": "supervisor",
+                                                                "control_dt": 0.005}
+    assert ("damping", "inner-loop-lift") not in entries
+    assert "inner-loop-lift" in {e.name for e in robust_entries([])[0]}

@@ -166,3 +166,26 @@ def test_robust_suite_searches_the_robust_scenario_with_its_sensing(tmp_path):
     with pytest.raises(ValueError, match="--start-from-constants needs at least one --constant"):
         oracle(tmp_path / "bad", scenarios=1, suite="robust", start_from_constants=True)
     assert not (tmp_path / "bad").exists()
+
+
+def test_inner_loop_lift_is_the_oracles_constant_row(tmp_path):
+    """On a robust drop: the oracle's --constant 0.5:-0.5 row is inner-loop-lift (same J), and
+    the same law as the search's command sequence (constant_theta, batched rollout at 5 ms)
+    runs the same drop to the last digit."""
+    from agents.benchmark import controller_entry
+    from agents.controllers import InnerLoopLift
+    from agents.oracle import constant_theta, search_kwargs, suite_scenarios
+    from rotordrop_env import BatchedRotorDropVecEnv
+    rep = oracle(tmp_path, scenarios=1, search=False, suite="robust", constants=[(0.5, -0.5)],
+                 progress=False, plots=False)
+    rows = rep["per_scenario"][0]["rows"]
+    assert rows["constant g=0.5 r=-0.5"] == rows["inner-loop-lift"]
+    assert rows["inner-loop-lift"]["J"] < rows["inner-loop"]["J"]      # re-levitates sooner
+    sc, phase, _ = suite_scenarios("robust", 1, 30_000)[0]
+    venv = BatchedRotorDropVecEnv(ENV_ID, 1, seed=0, **search_kwargs(sc, phase))
+    seq = kpi_row(rollout(venv, constant_theta(0.5, -0.5)[None], sc.env_kwargs[
+        "power_return_time"])[0])
+    venv.close()
+    entry = controller_entry(InnerLoopLift, ENV_ID)
+    ctrl = kpi_row(run_episodes(ENV_ID, entry.make, [sc.seed], episode_kwargs(entry, sc, phase))[0].kpis)
+    assert seq == ctrl

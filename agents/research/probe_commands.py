@@ -4,11 +4,15 @@ re-levitate at a given ``supervisor_authority``, and what do constant commands s
 
     python -m agents.research.probe_commands --random --authority 1,0.25,0.2,0.15,0.1
     python -m agents.research.probe_commands --constant 1,1,1,0.2,-0.2,0.2,-0.2,0.2
+    python -m agents.research.probe_commands --suite nominal --constant 1,1,1,0.5,-0.5,0,-0.5,0
 
 Random: every entry tanh(N(0, std²)) each step (SAC's initial actor: std 1), the draws seeded
 with 0. Constant: the 8 Full-supervisor entries (damping1, damping2, levitate, gain, offset_r1,
-offset_t1, offset_r2, offset_t2), every step. Both at the 5 ms step and with the sensing of the
-robust training runs (:func:`agents.robust.training_env_kwargs`).
+offset_t1, offset_r2, offset_t2), every step. Both at the 5 ms step; with ``--suite robust``
+(the default) on the robust validation set with the sensing of the robust training runs
+(:func:`agents.robust.training_env_kwargs`), with ``--suite nominal`` on the nominal validation
+suite of the Full task (:class:`agents.benchmark.Validator`: the one ``rotordrop train`` selects
+on and ``rotordrop tune`` tunes on).
 """
 from __future__ import annotations
 
@@ -17,7 +21,11 @@ import json
 
 import numpy as np
 
-from agents.robust import robust_validator, training_env_kwargs
+from agents.benchmark import Validator
+from agents.robust import ENV_ID, robust_validator, training_env_kwargs
+
+#: the probes' control step [s]
+CONTROL_DT = 0.005
 
 
 class RandomCommands:
@@ -36,8 +44,18 @@ class ConstantCommands:
         return self.action, None
 
 
-def probe(validator, make, authority: float = 1.0) -> dict:
-    kw = dict(training_env_kwargs(), command="supervisor", supervisor_authority=authority)
+def suite_validator(suite: str) -> tuple[Validator, dict]:
+    """The validation set of ``suite`` (robust or nominal) and its env kwargs at 5 ms."""
+    if suite == "robust":
+        return robust_validator(), training_env_kwargs(CONTROL_DT)
+    if suite == "nominal":
+        return Validator(ENV_ID), dict(control_dt=CONTROL_DT)
+    raise ValueError(f"--suite = {suite!r} must be one of nominal, robust")
+
+
+def probe(validator, make, authority: float = 1.0, env_kwargs: dict | None = None) -> dict:
+    base = training_env_kwargs(CONTROL_DT) if env_kwargs is None else env_kwargs
+    kw = dict(base, command="supervisor", supervisor_authority=authority)
     score, rows = validator.score(make, kw)
     return dict(score=score,
                 relevitated=float(np.mean([r["relevitated"] for r in rows])),
@@ -50,6 +68,8 @@ def floats(text: str) -> list[float]:
 
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--suite", default="robust", choices=("robust", "nominal"),
+                    help="validation set: the robust one (default) or the Full task's nominal one")
     ap.add_argument("--random", action="store_true", help="random commands at each --authority")
     ap.add_argument("--authority", type=floats, default=[1.0])
     ap.add_argument("--std", type=float, default=1.0)
@@ -60,15 +80,16 @@ def main(argv=None) -> None:
         ap.error("give --random and/or --constant")
     if any(len(c) != 8 for c in args.constant):
         ap.error("--constant needs 8 entries: damping1,damping2,levitate,gain,r1,t1,r2,t2")
-    validator = robust_validator()
+    validator, kw = suite_validator(args.suite)
     if args.random:
         for a in args.authority:
             rng = np.random.default_rng(0)
-            res = probe(validator, lambda plant: RandomCommands(args.std, rng), a)
-            print(json.dumps(dict(random_std=args.std, authority=a, **res)), flush=True)
+            res = probe(validator, lambda plant: RandomCommands(args.std, rng), a, kw)
+            print(json.dumps(dict(suite=args.suite, random_std=args.std, authority=a, **res)),
+                  flush=True)
     for c in args.constant:
-        print(json.dumps(dict(constant=c, **probe(validator, lambda plant: ConstantCommands(c)))),
-              flush=True)
+        res = probe(validator, lambda plant: ConstantCommands(c), 1.0, kw)
+        print(json.dumps(dict(suite=args.suite, constant=c, **res)), flush=True)
 
 
 if __name__ == "__main__":
