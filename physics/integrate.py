@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 
-from ._jit import njit
+from ._jit import njit, njit_borrow
 from .model import A_FR, A_LOAD, A_QMAX, N_AUX, N_AUX_PLANE, rhs
 
 # step-resolved peaks per retainer plane k at peaks[k * N_PEAK + j]
@@ -172,26 +172,22 @@ def integrate_segment(y, t0, t1, P, I, U, rtol, atol, h, h_max, h_min, fixed, ma
     return OK, t, h, out_pos, n_rhs, n_steps, n_rej
 
 
-@njit
-def sample_diagnostics(T, Y, i0, i1, P, I, U, AUX, Y_cols):
+@njit_borrow
+def sample_diagnostics(T, Y, i0, i1, P, I, U, AUX, Y_cols, block):
     """``AUX[k]``: the right-hand side's per-plane diagnostics at output sample ``k`` (time
     ``T[k]``, state ``Y[k]``, the integrator's row-major output) for k in [i0, i1), with
     controls ``U``; and ``Y_cols[k] = Y[k]``: ``Y_cols`` and ``AUX`` are column-major, the layout
     the metrics read (whole time series of single states), written here, after the integration,
     in blocks of ``SAMPLE_BLOCK`` samples (a column-major write per sample touches a cache line
-    per column). The values are those of :func:`physics.model.diagnostics`."""
+    per column) through ``block`` ((SAMPLE_BLOCK, N_AUX) scratch, row-major). The values are
+    those of :func:`physics.model.diagnostics`. Allocates nothing, so it is compiled without
+    reference counting (:data:`physics._jit.njit_borrow`): the rows ``Y[k]`` and ``block[k]``
+    are passed to ``rhs`` as views at no cost."""
     n = Y.shape[1]
-    block = np.empty((SAMPLE_BLOCK, N_AUX))
-    y = np.empty(n)         # the sample's state and diagnostics in buffers: a row view per
-    aux = np.empty(N_AUX)   # call (its reference count) costs ~5 % of this loop
     for k0 in range(i0, i1, SAMPLE_BLOCK):
         m = min(SAMPLE_BLOCK, i1 - k0)
         for k in range(m):
-            for i in range(n):
-                y[i] = Y[k0 + k, i]
-            rhs(T[k0 + k], y, P, I, U, None, aux)                   # diagnostics only
-            for j in range(N_AUX):
-                block[k, j] = aux[j]
+            rhs(T[k0 + k], Y[k0 + k], P, I, U, None, block[k])     # diagnostics only
         for j in range(N_AUX):
             for k in range(m):
                 AUX[k0 + k, j] = block[k, j]

@@ -23,7 +23,7 @@ from .ball_bearing import (ball_forces, ball_forces_with_dry, bearing_constants,
                            drag_torque_magnitude, film_thickness)
 from .contact import (contact_potential, friction_force, geometry, hunt_crossley, hysteresis_factor,
                       line_elastic_force, line_potential, normal_force, smooth_sign)
-from ._jit import njit
+from ._jit import njit, njit_borrow
 from .rotor import axis_at, tilt_accelerations, unbalance_force
 from .scene import Scene
 from .stator import damping_coefficient as stator_damping
@@ -309,7 +309,7 @@ def sleeve_motion(y, I, k):
     return y[i], y[i + 1], y[j], y[j + 1]
 
 
-@njit
+@njit_borrow
 def rhs(t, y, P, I, U, dy, aux):
     """dy/dt of the drop-down model (spec §1, §3-6). Fills ``aux`` with per-plane diagnostics.
 
@@ -627,7 +627,7 @@ def _same(a, b):
     return a == b and math.copysign(1.0, a) == math.copysign(1.0, b)
 
 
-@njit
+@njit_borrow
 def twin_planes(y, P, I):
     """The second retainer plane's inputs to :func:`rhs` (rotor axis, sleeve and housing motion,
     sleeve speed, cage angle, sleeve temperature) are the first one's bit for bit, so are its

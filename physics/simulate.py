@@ -8,8 +8,8 @@ from concurrent.futures import TimeoutError as FutureTimeout
 import numpy as np
 
 from .equilibrium import levitated_state
-from .integrate import (N_PEAK, NOT_FINITE, OK, STEP_COLLAPSE, TOO_MANY_STEPS, integrate_segment,
-                        sample_diagnostics)
+from .integrate import (N_PEAK, NOT_FINITE, OK, SAMPLE_BLOCK, STEP_COLLAPSE, TOO_MANY_STEPS,
+                        integrate_segment, sample_diagnostics)
 from .model import N_AUX, AMB_NONE, F_AMB, Model, build_model
 from .results import Result, RunStats
 from .scene import Scene, SceneError, param_meta
@@ -221,11 +221,12 @@ def sampled_diagnostics(model: Model, t_out: np.ndarray,
     the controls of its segment (a sample at the fault time: the unpowered one's)."""
     Y_cols = np.empty(Y.shape, order="F")
     aux = np.empty((len(t_out), N_AUX), order="F")
+    block = np.empty((SAMPLE_BLOCK, N_AUX))
     for a, b, powered in segments(model, t_out[-1]):
         i0 = int(np.searchsorted(t_out, a, "left"))
         i1 = int(np.searchsorted(t_out, b, "right")) if powered else len(t_out)
         sample_diagnostics(t_out, Y, i0, i1, model.P, model.I, model.controls(powered), aux,
-                           Y_cols)
+                           Y_cols, block)
     return Y_cols, aux
 
 

@@ -67,3 +67,17 @@ def test_a_progress_bar_changes_no_number_and_the_warm_up_compiles_everything_a_
     with_bar = compute_metrics(simulate(scene, progress=True))
     assert [len(k.signatures) for k in kernels] == compiled
     assert _numbers(plain) == _numbers(with_bar) and plain["rhs_evaluations"] > 1000
+
+
+def test_a_drop_after_another_takes_its_arrays_from_the_memory_the_first_one_freed():
+    """keep_freed_memory (run_chunk calls it): the next drop's output arrays come from memory
+    the previous drop freed, not from fresh pages faulted in one by one (without it each of
+    these drops faults in its output arrays again, ~900 pages)."""
+    import resource
+    from physics.sweep import keep_freed_memory, simulate_drop
+    if not keep_freed_memory():
+        pytest.skip("the C library has no mallopt (not glibc)")
+    simulate_drop(RUNS[0], drop_observables)
+    before = resource.getrusage(resource.RUSAGE_THREAD).ru_minflt
+    simulate_drop(RUNS[0], drop_observables)
+    assert resource.getrusage(resource.RUSAGE_THREAD).ru_minflt - before < 100
