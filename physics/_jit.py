@@ -57,11 +57,18 @@ njit = _cached()
 njit_parallel = _cached(parallel=True)
 """Kernel decorator for ``prange`` loops over environments (``@njit_parallel``)."""
 
-njit_borrow = _cached(_nrt=False)
+def _has_option(name: str) -> bool:
+    """True when this numba's CPU target takes the (private) option ``name``."""
+    from numba.core import cpu
+    return hasattr(getattr(cpu, "CPUTargetOptions", None), name)
+
+
+njit_borrow = _cached(_nrt=False) if _has_option("_nrt") else njit
 """Serial kernel decorator for kernels that allocate nothing and only read and write the arrays
 they are given (``@njit_borrow``): compiled without numba's reference counting (its ``_nrt``
 flag), so a call does not increment and decrement every array argument's count, nor a row view's
 (an atomic operation each; the arrays belong to the caller, which holds them through the call).
 Measured on ``rhs``, ``twin_planes`` and ``sample_diagnostics`` (paper drop, the same bits): the
 output samples' diagnostics 560 -> 380 ns per sample, the integration 43 -> 37.6 ms CPU per
-simulated second."""
+simulated second. ``_nrt`` is private to numba: a numba without it gets plain :data:`njit` (the
+same numbers, slower)."""
