@@ -57,6 +57,7 @@ njit = _cached()
 njit_parallel = _cached(parallel=True)
 """Kernel decorator for ``prange`` loops over environments (``@njit_parallel``)."""
 
+
 def _has_option(name: str) -> bool:
     """True when this numba's CPU target takes the (private) option ``name``."""
     from numba.core import cpu

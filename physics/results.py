@@ -24,7 +24,8 @@ def _axis_series(Y: np.ndarray, i: int, z: float) -> np.ndarray:
 
 
 def _same_bits(a: np.ndarray, b: np.ndarray) -> bool:
-    """The float64 arrays ``a`` and ``b`` hold the same bits (signed zeros apart)."""
+    """The float64 arrays ``a`` and ``b`` hold the same bits (0.0 and -0.0 differ, as in
+    :func:`physics.model.twin_planes`)."""
     return bool(np.array_equal(a.view(np.int64), b.view(np.int64)))
 
 
