@@ -88,6 +88,7 @@ class Plant:
     pid: tuple[float, float, float]        # built-in PID gains kp [A/m], ki [A/(m s)], kd [A s/m]
     feedforward: tuple[float, float]       # gravity currents of AMB1, AMB2 (y axes) [A]
     liftoff_ramp: float                    # [s]
+    damping_action: str = "linear"         # the env's damper map (``damping_action``)
 
     @classmethod
     def from_env(cls, env) -> "Plant":
@@ -109,7 +110,8 @@ class Plant:
                    damping_range=(s.support.damping_min, s.support.damping_max),
                    current_limit=s.amb.current_limit, pid=(s.amb.kp, s.amb.ki, s.amb.kd),
                    feedforward=(float(P[P_AMB_IFF1]), float(P[P_AMB_IFF2])),
-                   liftoff_ramp=s.amb.liftoff_ramp_time)
+                   liftoff_ramp=s.amb.liftoff_ramp_time,
+                   damping_action=getattr(u, "damping_action", "linear"))
 
     # ------------------------------------------------------------------ observations --
     def require_sensors(self, who: str) -> None:
@@ -177,6 +179,12 @@ class Plant:
         lo, hi = self.damping_range
         j, scale = self._damping
         return np.clip(2.0 * (obs[:, j] * scale - lo) / (hi - lo) - 1.0, -1.0, 1.0)
+
+    def damper_action(self, command: np.ndarray) -> np.ndarray:
+        """The env's damper action for damper commands in [-1, 1] (-1 C_min, +1 C_max, linear):
+        the command itself, or with ``damping_action="from_max"`` (where the action 0 is
+        already C_max) the action (command - 1) / 2 in [-1, 0] that gives the same damping."""
+        return command if self.damping_action == "linear" else 0.5 * (command - 1.0)
 
     def power_available(self, obs: np.ndarray) -> np.ndarray:
         if "amb_power" not in self.obs_names:
@@ -247,7 +255,7 @@ class Plant:
         if "damping" in cols:
             d = c.get("damping", hold_damping)
             if d is not None:
-                a[:, cols["damping"]] = d
+                a[:, cols["damping"]] = self.damper_action(d)
         if "levitate" in cols:
             a[:, cols["levitate"][0]] = -1.0 if lev is None else np.where(lev > 0.5, 1.0, -1.0)
         for ch in ("currents", "gain", "offsets"):

@@ -28,6 +28,8 @@ from .sensors import Sensing, check_latency, check_noise
 #: the kernel's re-levitation mode of each ``command``
 LEV_CODES = {"discrete": K.LEV_DISCRETE, "continuous": K.LEV_CONTINUOUS,
              "supervisor": K.LEV_SUPERVISOR}
+#: the kernel's map of each ``damping_action`` (damper action -> commanded damping)
+DAMPING_ACTIONS = {"linear": K.DAMP_LINEAR, "from_max": K.DAMP_FROM_MAX}
 #: command="supervisor": |offset| <= SUPERVISOR_OFFSET x clearance; gain scale in
 #: [2^-SUPERVISOR_OCTAVES, 2^SUPERVISOR_OCTAVES]
 SUPERVISOR_OFFSET = 1.0
@@ -46,7 +48,8 @@ FIXED_SETTINGS = frozenset(("control_dt", "dt", "episode_time", "n_steps", "rand
                             "power_return_time", "samples_per_step", "relevitation_hold",
                             "terminate_on_failure", "render_mode", "base_scene", "overrides",
                             "obs_names", "obs_scale", "action_names", "weights",
-                            "sensor_noise", "obs_latency_steps", "supervisor_authority"))
+                            "sensor_noise", "obs_latency_steps", "supervisor_authority",
+                            "damping_action"))
 
 
 def _weight(name: str, doc: str) -> property:
@@ -88,6 +91,10 @@ class RotorDropEnv(gym.Env):
     supervisor_authority        1.0         command="supervisor": a in (0, 1] scales the offset
                                             range (a x clearance) and the gain-scale range
                                             (2^-a ... 2^a); 1 is the full range
+    damping_action              "linear"    damping envs: map of the damper action a to the
+                                            damping, "linear" (-1 C_min, 0 mid-range, +1 C_max)
+                                            or "from_max" (a >= 0 C_max, linear to C_min at -1:
+                                            the zero action is full damping)
     power_return_time           0.05        re-levitation envs: power returns [s after fault]
     samples_per_step            5           monitor samples per control step (dense output)
     relevitation_hold           0.02        re-levitated after this long in the success region [s]
@@ -133,9 +140,10 @@ class RotorDropEnv(gym.Env):
                  obs_latency_steps: int | tuple[int, int] = 0, w_whirl: float = 10.0,
                  w_contact: float = 0.1, w_displacement: float = 0.1, w_effort: float = 0.01,
                  w_success: float = 10.0, w_failure: float = 10.0, render_mode: str | None = None,
-                 supervisor_authority: float = 1.0):
+                 supervisor_authority: float = 1.0, damping_action: str = "linear"):
         self._check_options(command, power_return_time, render_mode)
         self.supervisor_authority = _check_authority(supervisor_authority, command)
+        self.damping_action = self._check_damping_action(damping_action)
         _positive("control_dt", control_dt, 1e-6, 0.1)
         _positive("episode_time", episode_time, control_dt, 100.0)
         _positive("relevitation_hold", relevitation_hold, 0.0, 100.0)
@@ -235,6 +243,17 @@ class RotorDropEnv(gym.Env):
             raise ValueError(f"render_mode = {render_mode!r} must be None or one of "
                              f"{self.metadata['render_modes']}")
 
+    def _check_damping_action(self, value) -> str:
+        """``damping_action``: one of ``DAMPING_ACTIONS``, other than "linear" only in an
+        environment with damper commands (elsewhere it would silently change nothing)."""
+        if value not in DAMPING_ACTIONS:
+            raise ValueError(f"damping_action = {value!r} is not a damper map; the maps are "
+                             + ", ".join(repr(m) for m in DAMPING_ACTIONS))
+        if value != "linear" and not self._damping:
+            raise ValueError(f"damping_action = {value!r} applies to the environments with "
+                             f"damper commands (Damping, Full) only, not {type(self).__name__}")
+        return value
+
     def _make_scene(self, scene, overrides) -> Scene:
         if isinstance(scene, Mapping):          # Scene.to_dict / to_json form (a JSON env spec)
             scene = Scene.from_dict(scene)
@@ -277,7 +296,7 @@ class RotorDropEnv(gym.Env):
         b = self._b
         C = b.C
         C[K.C_DT] = self.dt
-        C[K.C_DAMP] = 1.0 if self._damping else 0.0
+        C[K.C_DAMP] = DAMPING_ACTIONS[self.damping_action] if self._damping else K.DAMP_NONE
         C[K.C_LEV] = LEV_CODES[self.command] if self._relevitate else K.LEV_NONE
         C[K.C_SUP_OFFSET], C[K.C_SUP_OCTAVES] = supervisor_scales(self.base_scene,
                                                                   self.supervisor_authority)
@@ -662,7 +681,8 @@ class DampingEnv(RotorDropEnv):
 
     Action space: ``Box(-1, 1, (2,), float32)``: ``damping1``, ``damping2``, the command of each
     housing's support damping, -1 -> C_min (``support.damping_min``, 2790 N s/m), +1 -> C_max
-    (``support.damping_max``, 27900 N s/m), linear in between. The damping follows its command
+    (``support.damping_max``, 27900 N s/m), linear in between (``damping_action="from_max"``:
+    every a >= 0 -> C_max, linear from C_min at -1 to C_max at 0). The damping follows its command
     with a first-order lag (``support.damper_time_constant``, 10 ms); it starts at
     ``support.damping``.
 

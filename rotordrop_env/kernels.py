@@ -32,6 +32,8 @@ from physics.model import (A_FR, A_QMAX, A_WS, I_AMB_FILT, I_AMB_INT, I_CS, N_AU
  C_F_REF, C_GAP, C_LOAD_RATING, C_HOLD, C_TERMINATE, C_FULL, C_CS_MIN, C_CS_MAX, C_ILIM,
  C_RELEV_RADIUS, C_WHIRL_RADIUS, C_WHIRL_REVS, C_SUP_OFFSET, C_SUP_OCTAVES, N_C) = range(32)
 LEV_NONE, LEV_DISCRETE, LEV_CONTINUOUS, LEV_SUPERVISOR = 0, 1, 2, 3
+#: C[C_DAMP]: no damper commands, or the damper action's map (env kwarg ``damping_action``)
+DAMP_NONE, DAMP_LINEAR, DAMP_FROM_MAX = 0.0, 1.0, 2.0
 #: supervisor: below this fraction of the clearance the observed orbit rate is zero
 SUP_MIN_RADIUS = 0.05
 
@@ -93,6 +95,15 @@ def _switch_on(t, y, P, I, U):
 
 
 @njit
+def damper_fraction(a, mode):
+    """(C - C_min) / (C_max - C_min) commanded by the damper action ``a`` (clipped to [-1, 1]):
+    linear over the box (``DAMP_LINEAR``: 0 is mid-range), or full damping for every a >= 0
+    and linear down to C_min at -1 (``DAMP_FROM_MAX``: the zero action is C_max)."""
+    a = min(max(a, -1.0), 1.0)
+    return 0.5 * (a + 1.0) if mode == DAMP_LINEAR else min(a + 1.0, 1.0)
+
+
+@njit
 def apply_action(a, y, P, I, U, C, M):
     """Map a checked action onto the controls U (and the PID reset).
 
@@ -102,7 +113,7 @@ def apply_action(a, y, P, I, U, C, M):
     n_eff = 0
     if C[C_DAMP] > 0.0:
         for k in range(2):                      # the damper commands come first
-            frac = 0.5 * (min(max(a[k], -1.0), 1.0) + 1.0)
+            frac = damper_fraction(a[k], C[C_DAMP])
             U[U_CS1 + k] = C[C_CS_MIN] + frac * (C[C_CS_MAX] - C[C_CS_MIN])
             effort += frac * frac
             n_eff += 1
