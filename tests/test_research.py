@@ -1,6 +1,7 @@
 """``rotordrop research``: the oracle whirl bound end to end on a tiny search, and its usage errors."""
 import json
 
+import numpy as np
 import pytest
 
 from agents.cli import main
@@ -33,6 +34,15 @@ def test_research_usage_errors_are_one_line(tmp_path, capsys, args, message):
     assert message in err and err.count("\n") == 1
 
 
+def test_diagnosis_reads_damper_actions_through_the_runs_map():
+    """The damper fraction (C - C_min) / (C_max - C_min) of a raw action: the linear map's zero
+    action is mid-range; under ``from_max`` every action >= 0 is C_max and -1 is C_min."""
+    from agents.research.diagnose_run import damper_fractions
+    a = np.array([[-1.0, -0.5], [0.0, 0.6]])
+    assert damper_fractions(a, "linear").tolist() == [[0.0, 0.25], [0.5, 0.8]]
+    assert damper_fractions(a, "from_max").tolist() == [[0.0, 0.5], [1.0, 1.0]]
+
+
 def test_collapse_diagnosis_tools_agree_with_the_validator_on_the_inner_loop():
     """agents.research.diagnose_run / probe_commands (docs/agents.md, "Why the robust runs
     collapse"): the inner loop through the diagnosis recorder and as the constant supervisor
@@ -54,5 +64,6 @@ def test_collapse_diagnosis_tools_agree_with_the_validator_on_the_inner_loop():
     d = diagnose("inner-loop", InnerLoop, kw, validator, names)
     assert d["score"] == ref and d["relevitated"] == 1.0
     assert d["never_switched_on"] == 0.0 and d["switch_on_after_power_ms_median"] == 0.0
+    assert d["mean_damper_fraction_before_power"] == d["mean_damper_fraction_after_power"] == [1.0, 1.0]
     p = probe(validator, lambda plant: ConstantCommands([1, 1, 1, 0, 0, 0, 0, 0]))
     assert p["score"] == pytest.approx(ref, abs=0.5) and p["relevitated"] == 1.0

@@ -11,8 +11,10 @@ Per row: validation score, re-levitated rate, re-levitation time after the power
 drop's, the mean benchmark cost J, the episode return of the KPI reward (``reward: kpi``, from
 the episode's KPIs: −Φ_T + w_relevitate [re-levitated] − (time without re-levitation) / T) and
 the mean action per entry (damping1, damping2, levitate, gain, offset_r1, offset_t1, offset_r2,
-offset_t2) before and after the power return, and when ``levitate`` first goes > 0 after the
-power is observed.
+offset_t2) before and after the power return, the mean commanded damping of each damper as the
+fraction (C - C_min) / (C_max - C_min) under the run's ``damping_action`` map (1: C_max; with
+``from_max`` the raw action's mean does not say this), and when ``levitate`` first goes > 0 after
+the power is observed.
 """
 from __future__ import annotations
 
@@ -29,6 +31,8 @@ from agents.policies import LearnedPolicy
 from agents.reward import WEIGHTS, kpi_potential
 from agents.robust import robust_validator
 from agents.score import write_json
+from rotordrop_env.env import DAMPING_ACTIONS
+from rotordrop_env.kernels import damper_fraction
 
 
 class Recorder:
@@ -69,6 +73,7 @@ def diagnose(name: str, make, env_kwargs: dict, validator, names: list[str],
     power = np.array([p for p, _ in steps]) > 0.5
     acts = np.array([a for _, a in steps])
     delays = [switch_delay_ms(ep, env_kwargs["control_dt"]) for ep in log]
+    frac = damper_fractions(acts[:, :2], env_kwargs.get("damping_action", "linear"))
     return dict(
         controller=name, score=score,
         relevitated=float(np.mean([r["relevitated"] for r in rows])),
@@ -84,9 +89,17 @@ def diagnose(name: str, make, env_kwargs: dict, validator, names: list[str],
         mean_action_before_power=acts[~power].mean(axis=0).round(3).tolist(),
         mean_action_after_power=acts[power].mean(axis=0).round(3).tolist(),
         mean_abs_action_after_power=np.abs(acts[power]).mean(axis=0).round(3).tolist(),
+        mean_damper_fraction_before_power=frac[~power].mean(axis=0).round(3).tolist(),
+        mean_damper_fraction_after_power=frac[power].mean(axis=0).round(3).tolist(),
         never_switched_on=float(np.mean([d is None for d in delays])),
         switch_on_after_power_ms_median=(float(np.median([d for d in delays if d is not None]))
                                          if any(d is not None for d in delays) else None))
+
+
+def damper_fractions(actions: np.ndarray, damping_action: str) -> np.ndarray:
+    """(C - C_min) / (C_max - C_min) commanded by each damper action under the env's map."""
+    mode = DAMPING_ACTIONS[damping_action]
+    return np.vectorize(lambda a: damper_fraction(a, mode), otypes=[float])(actions)
 
 
 def switch_delay_ms(episode, dt: float):
