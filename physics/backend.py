@@ -68,11 +68,13 @@ class Backend:
         return RaySession(self.address) if self.name == "ray" else Session()
 
 
-def add_backend_args(p, resume: bool = True) -> None:
-    """``--backend``, ``--address`` (and ``--resume``) for a command that runs batches."""
+def add_backend_args(p, resume: bool = True, jobs: bool = False) -> None:
+    """``--backend``, ``--address`` (and ``--resume``) for a command that runs batches
+    (``jobs``: the command has ``--jobs``, the local backend's threads)."""
+    local = "this process, --jobs threads" if jobs else "this process, one after the other"
     p.add_argument("--backend", choices=BACKENDS, default="local",
-                   help="where the drops run: local (this process, --jobs threads) or ray "
-                        "(a Ray cluster: one task per chunk of drops; needs the cluster extra)")
+                   help=f"where the drops run: local ({local}) or ray (a Ray cluster: one task "
+                        "per chunk of drops; needs the cluster extra)")
     p.add_argument("--address", default=None, metavar="HOST:PORT",
                    help="Ray cluster to connect to (with --backend ray; default: RAY_ADDRESS, or "
                         "a Ray started on this machine for the run)")

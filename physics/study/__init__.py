@@ -24,7 +24,7 @@ def register(subparsers) -> None:
     q.add_argument("--jobs", type=at_least(1), default=None,
                    help="threads (default: all cores; at most one per CPU and per drop)")
     q.add_argument("--quiet", action="store_true", help="no progress bar")
-    add_backend_args(q)
+    add_backend_args(q, jobs=True)
     q.set_defaults(func=cmd_study_paper)
 
     q = sub.add_parser("sweep", help="a parameter study of the passive drop over 1 to 3 scene keys, "
@@ -41,7 +41,7 @@ def register(subparsers) -> None:
                    help="threads (default: all cores; at most one per CPU and per drop)")
     q.add_argument("--no-plots", action="store_true", help="no sweep.png")
     q.add_argument("--quiet", action="store_true", help="no progress bar")
-    add_backend_args(q)
+    add_backend_args(q, jobs=True)
     q.set_defaults(func=cmd_study_sweep)
 
 
