@@ -18,7 +18,8 @@ def test_three_policies_ship_with_their_recipe():
 
 
 @pytest.mark.parametrize("name", ["ppo-damping", "ppo-relevitate", "ppo-full", "ppo-full-scratch",
-                                  "sac-full-scratch", "sac-robust-full-scratch"])
+                                  "sac-full-scratch", "sac-robust-full-scratch",
+                                  "ppo-robust-full-scratch"])
 def test_shipped_policy_acts_inside_the_action_space(name):
     pol = load_shipped(name)
     kw = {k: v for k, v in pol.env_kwargs.items() if k not in ("randomize", "randomization")}
