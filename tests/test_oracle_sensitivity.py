@@ -19,6 +19,11 @@ def test_copies_change_one_scene_value_by_the_stated_amount():
         assert others == {k: v for k, v in sc.scene_overrides(phase).items() if k != key}
     nominal, ph, _ = suite_scenarios("full", 1, 10_000)[0]
     assert perturbed(nominal, ph, PERTURBATIONS["phase +1 deg"])[1] == ph + 1.0
+    # a key the scenario does not override starts from the paper scene's value
+    from agents.benchmark import Scenario
+    from physics.scene import load_scene
+    bare = perturbed(Scenario("bare", 0.4), 0.0, PERTURBATIONS["stiffness +0.1 %"])[0]
+    assert bare.overrides == {"support.stiffness": load_scene("paper").support.stiffness * 1.001}
 
 
 def test_unchanged_copy_reproduces_the_oracle_and_the_designed_row(tmp_path):

@@ -52,10 +52,9 @@ def perturbed(sc, phase: float, change) -> tuple[object, float]:
     if key == "unbalance.angle_deg" and key not in sc.overrides:
         return sc, phase + delta
     base = sc.overrides.get(key)
-    if base is None:
+    if base is None:                            # the scene's own value (the Full env's default)
         from physics.scene import load_scene
-        section, name = key.split(".")
-        base = getattr(getattr(load_scene("paper"), section), name)
+        base = load_scene().get(key)
     value = base * (1.0 + delta) if relative else base + delta
     return replace(sc, overrides={**sc.overrides, key: value}), phase
 
