@@ -89,6 +89,9 @@ class Session:
     """Runs tasks in this process, one after the other (the ``local`` backend)."""
     name = "local"
 
+    def __init__(self):
+        self.ran_on: dict[int, str] = {}               # task index -> node that finished it
+
     def __enter__(self) -> "Session":
         return self
 
@@ -114,6 +117,7 @@ class RaySession(Session):
     name = "ray"
 
     def __init__(self, address: str | None):
+        super().__init__()
         self.address = address or os.environ.get("RAY_ADDRESS") or None
         self.started = False
         self.sent: list[int] = []                      # pickled bytes of each task's arguments
@@ -192,6 +196,7 @@ class RaySession(Session):
                     raise BackendError(f"--backend ray: task {i} failed (retried up to "
                                        f"{MAX_RETRIES} times): {first_line(exc)}") from None
                 self.nodes[node] = self.nodes.get(node, 0) + 1
+                self.ran_on[i] = node
                 yield i, result
 
     def describe(self) -> dict:
@@ -359,6 +364,6 @@ def _run_remote(session: Session, runs, todo: list[int], evaluate, store, bar) -
     tasks = [([runs[i] for i in c], evaluate, TASK_CPUS) for c in chunks]
     for k, records in session.imap(chunk_task, tasks):
         for i, rec in zip(chunks[k], records):
-            store.add(i, rec)
+            store.add(i, rec, node=session.ran_on.get(k))
             _tick(bar, Outcome(runs[i], **rec))
         store.sync()

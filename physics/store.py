@@ -3,8 +3,8 @@
 A batch writes ``<out>/drops/manifest.json`` (what the batch is: its number of drops, scenes and
 a fingerprint of every run's scene, overrides and labels, the ``evaluate`` function and the
 contents of a TOML scene file) and appends one JSON line per finished drop to
-``<out>/drops/done.jsonl`` (``{"i": index in the batch, "ok", "metrics", "extra", "error"}``),
-flushed at once. A killed driver therefore loses at most the line being written (a cut last
+``<out>/drops/done.jsonl`` (``{"i": index in the batch, "ok", "metrics", "extra", "error"}``,
+and on a Ray cluster ``"node"``: the address of the node that ran it), flushed at once. A killed driver therefore loses at most the line being written (a cut last
 line is dropped on reading); ``--resume`` keeps every stored drop and runs only the missing
 ones. A ``--resume`` folder of another batch is refused before anything is changed.
 """
@@ -76,11 +76,13 @@ class DropStore:
         """Indices of the drops not finished yet."""
         return [i for i in range(self.n) if i not in self._records]
 
-    def add(self, i: int, rec: dict) -> None:
-        """Keep drop ``i``'s record, as it reads back from JSON (on disk at once if opened)."""
-        line = json.dumps({"i": i, **rec}, separators=(",", ":"))
+    def add(self, i: int, rec: dict, node: str | None = None) -> None:
+        """Keep drop ``i``'s record, as it reads back from JSON (on disk at once if opened, with
+        the ``node`` that ran it when known: provenance, not part of the record)."""
+        line = json.dumps({"i": i, **rec, **({"node": node} if node else {})}, separators=(",", ":"))
         stored = json.loads(line)
         del stored["i"]
+        stored.pop("node", None)
         self._records[i] = stored
         self.begin()
         if self._fh is not None:
@@ -151,6 +153,7 @@ def read_records(path: Path, n: int) -> dict[int, dict]:
         try:
             rec = json.loads(line)
             i = rec.pop("i")
+            rec.pop("node", None)
         except (ValueError, KeyError, AttributeError):
             continue
         if isinstance(i, int) and 0 <= i < n:

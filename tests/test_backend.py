@@ -70,6 +70,19 @@ def test_a_store_of_another_batch_is_refused_and_left_untouched(tmp_path):
     assert done.read_bytes() == before[0]
 
 
+def test_the_node_that_ran_a_drop_is_on_disk_but_not_in_its_record(tmp_path):
+    runs = runs_of([0.2, 0.3])
+    store = DropStore.open(tmp_path, runs, None, "t")
+    rec = dict(ok=True, metrics={"steps": 3}, extra={}, error=None)
+    store.add(0, rec, node="127.0.0.3")
+    store.add(1, rec)
+    store.close()
+    lines = [json.loads(l) for l in (tmp_path / "drops" / "done.jsonl").read_text().splitlines()]
+    assert [l.get("node") for l in lines] == ["127.0.0.3", None]
+    assert store.records() == [rec, rec]
+    assert DropStore.open(tmp_path, runs, None, "t", resume=True).records() == [rec, rec]
+
+
 def test_a_scene_file_that_changed_is_another_batch(tmp_path):
     scene = tmp_path / "s.toml"
     scene.write_text('base = "paper"\n[contact]\nfriction = 0.2\n')
