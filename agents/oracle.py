@@ -274,28 +274,40 @@ def search_kwargs(sc: Scenario, phase: float) -> dict:
 
 
 def search_scenario(sc: Scenario, phase: float, passive: dict, population: int, iterations: int,
-                    seed: int, progress: bool, start: np.ndarray | None = None) -> dict:
+                    seed: int, progress: bool, start: np.ndarray | None = None,
+                    copies: tuple = ()) -> dict:
     """Cross-entropy search of the command sequence of one scenario (module doc), from the
     ``inner-loop`` sequence or ``start``; each generation is one batched rollout of
-    ``population`` identical environments."""
+    ``population`` identical environments (per drop). ``copies``: further ``(scenario, phase,
+    passive)`` drops the sequence must suit as well: a candidate's cost is its mean over the
+    scenario and its copies (a search blind to what tells them apart, e.g. a friction change
+    no sensor resolves); J is then that mean and ``kpis`` the scenario's own."""
     from rotordrop_env import BatchedRotorDropVecEnv
     from .search import cross_entropy
-    kw = search_kwargs(sc, phase)
-    power_return = sc.env_kwargs["power_return_time"]
-    venvs: dict[int, object] = {}
+    drops = [(sc, phase, passive), *copies]
+    venvs: dict[tuple[int, int], object] = {}
     seen: dict[bytes, tuple[float, dict]] = {}
 
     def costs(thetas: np.ndarray) -> list[float]:
         n = len(thetas)
-        if n not in venvs:
-            venvs[n] = BatchedRotorDropVecEnv(ENV_ID, n, seed=0, **kw)
-        out = []
-        for th, k in zip(thetas, rollout(venvs[n], thetas, power_return)):
-            row = kpi_row(k)
-            j = episode_cost(row, passive)
-            seen[th.tobytes()] = (j, row)
-            out.append(j + SHAPING * min(row["peak_whirl_revolutions"] / WHIRL_REVOLUTIONS, 1.0))
-        return out
+        shaped, true = np.zeros(n), np.zeros(n)
+        own: list[dict] = []
+        for c, (drop, drop_phase, drop_passive) in enumerate(drops):
+            if (c, n) not in venvs:
+                venvs[c, n] = BatchedRotorDropVecEnv(ENV_ID, n, seed=0,
+                                                     **search_kwargs(drop, drop_phase))
+            kpis = rollout(venvs[c, n], thetas, drop.env_kwargs["power_return_time"])
+            for m, k in enumerate(kpis):
+                row = kpi_row(k)
+                j = episode_cost(row, drop_passive)
+                true[m] += j / len(drops)
+                shaped[m] += (j + SHAPING * min(row["peak_whirl_revolutions"] / WHIRL_REVOLUTIONS,
+                                                1.0)) / len(drops)
+                if c == 0:
+                    own.append(row)
+        for th, j, row in zip(thetas, true, own):
+            seen[th.tobytes()] = (float(j), row)
+        return shaped.tolist()
 
     mean = inner_loop_theta() if start is None else np.asarray(start, dtype=float)
     t0 = time.perf_counter()

@@ -3,8 +3,17 @@ copies of their scenarios."""
 import pytest
 
 from agents.oracle import oracle, suite_scenarios
-from agents.research.oracle_sensitivity import PERTURBATIONS, perturbed, sensitivity
+from agents.research.blind_oracle import blind_oracle
+from agents.research.oracle_sensitivity import PERTURBATIONS, perturbed, searches, sensitivity
 from agents.robust import SUITE_SEED
+
+
+@pytest.fixture(scope="module")
+def robust_report(tmp_path_factory):
+    """A one-scenario robust oracle with inner-loop-lift's constants as a row and as the start."""
+    return oracle(tmp_path_factory.mktemp("oracle"), scenarios=1, population=4, iterations=1,
+                  progress=False, plots=False, suite="robust", constants=[(0.5, -0.5)],
+                  start_from_constants=True)
 
 
 def test_copies_change_one_scene_value_by_the_stated_amount():
@@ -19,6 +28,11 @@ def test_copies_change_one_scene_value_by_the_stated_amount():
         assert others == {k: v for k, v in sc.scene_overrides(phase).items() if k != key}
     nominal, ph, _ = suite_scenarios("full", 1, 10_000)[0]
     assert perturbed(nominal, ph, PERTURBATIONS["phase +1 deg"])[1] == ph + 1.0
+    # the phase wraps: 359.5 deg + 1 deg is 0.5 deg, not out of the scene's range
+    from dataclasses import replace
+    late = replace(sc, overrides={**sc.overrides, "unbalance.angle_deg": 359.5})
+    assert perturbed(late, phase, PERTURBATIONS["phase +1 deg"])[0].overrides["unbalance.angle_deg"] == 0.5
+    assert perturbed(nominal, 359.5, PERTURBATIONS["phase +1 deg"])[1] == 0.5
     # a key the scenario does not override starts from the paper scene's value
     from agents.benchmark import Scenario
     from physics.scene import load_scene
@@ -26,9 +40,8 @@ def test_copies_change_one_scene_value_by_the_stated_amount():
     assert bare.overrides == {"support.stiffness": load_scene("paper").support.stiffness * 1.001}
 
 
-def test_unchanged_copy_reproduces_the_oracle_and_the_designed_row(tmp_path):
-    rep = oracle(tmp_path, scenarios=1, population=4, iterations=1, progress=False, plots=False,
-                 suite="robust", constants=[(0.5, -0.5)], start_from_constants=True)
+def test_unchanged_copy_reproduces_the_oracle_and_the_designed_row(robust_report):
+    rep = robust_report
     out = sensitivity(rep, (0.5, -0.5), progress=False)
     assert out["scenarios"] == 1 and out["max_reproduction_error_J"] == 0.0
     rows = {r["perturbation"]: r for r in out["rows"]}
@@ -37,3 +50,41 @@ def test_unchanged_copy_reproduces_the_oracle_and_the_designed_row(tmp_path):
     assert rows["none"]["designed"] == pytest.approx(score["constant g=0.5 r=-0.5"], abs=1e-6)
     # a friction change of 0.001 is a different drop: its scores are not the unchanged ones
     assert rows["friction +0.001"]["designed"] != rows["none"]["designed"]
+    # per scenario: every copy's J and whirl, summing to the rows
+    copies = out["per_scenario"][0]["copies"]
+    assert copies["none"]["J_oracle"] == pytest.approx(rep["per_scenario"][0]["search"]["J"], abs=1e-12)
+    assert rows["friction +0.001"]["designed_whirls"] == int(copies["friction +0.001"]["whirl_designed"])
+
+    # the compact form kept in docs/img reads the same, and --top picks by the oracle's gain
+    name = "constant g=0.5 r=-0.5"
+    p = rep["per_scenario"][0]
+    compact = dict(settings=rep["settings"], per_scenario=[dict(
+        index=0, J={"oracle": p["search"]["J"], name: p["rows"][name]["J"]},
+        oracle_theta=p["search"]["theta"])])
+    assert searches(compact) == searches(rep)
+    assert searches(rep)[0]["J_designed"] == p["rows"][name]["J"]
+    top = sensitivity(compact, (0.5, -0.5), top=1, progress=False)
+    assert top["rows"] == out["rows"] and top["top"] == 1
+    with pytest.raises(ValueError, match="needs the designed row 'constant g=0.3 r=-0.5'"):
+        sensitivity(compact, (0.3, -0.5), top=1, progress=False)
+
+
+def test_blind_oracle_suits_three_friction_copies_and_never_ends_below_the_designed_law(robust_report):
+    rep = robust_report
+    out = blind_oracle(rep, top=1, delta=1e-3, population=4, iterations=1, progress=False)
+    (p,) = out["per_scenario"]
+    own, minus, plus = p["copies"]
+    assert [c["friction_change"] for c in p["copies"]] == [0.0, -1e-3, 1e-3]
+    # the exact oracle's sequence on its own drop reproduces its J; the copies are other drops
+    assert own["J_oracle"] == pytest.approx(rep["per_scenario"][0]["search"]["J"], abs=1e-12)
+    assert minus["J_passive"] != own["J_passive"] or minus["J_designed"] != own["J_designed"]
+    # the search starts from the designed law and keeps the best mean over the three copies
+    mean = lambda key: sum(c[key] for c in p["copies"]) / 3
+    assert mean("J_blind") <= mean("J_designed") + 1e-12
+    assert p["blind_rollouts"] == 1 + 1 * 4
+    # points of the suite score: 100 / sum of the passive J over the report's scenarios
+    scale = 100.0 / rep["per_scenario"][0]["rows"]["passive"]["J"]
+    assert out["per_copy"]["+0"]["oracle_gain_points"] == pytest.approx(
+        scale * (own["J_designed"] - own["J_oracle"]))
+    with pytest.raises(ValueError, match="delta = 0.2 must be in"):
+        blind_oracle(rep, top=1, delta=0.2, progress=False)
