@@ -7,11 +7,16 @@ reward found that lowering the support damping once a whirl had started lowered 
 penalties while it raised the peak force. :class:`KpiReward` replaces the reward by the
 decrease of a potential built from the running episode KPIs (``env.kpis()``),
 
-    Φ_t = w_whirl · min(max_{τ≤t} n_back(τ), 3) / 3 + w_force · F*_t / F_0 + w_disp · D*_t / D_0,
+    Φ_t = w_whirl · min(n*_t, 3) / 3 + w_verdict · [n*_t ≥ 3] + w_force · F*_t / F_0
+          + w_disp · D*_t / D_0,
     r_t = −(Φ_t − Φ_{t−1}),
 
-with n_back the net backward orbit revolutions (3 make a backward whirl), F* the peak contact
-force and D* the maximum displacement so far. The return of an episode is −Φ_T: minus the
+with n*_t = max_{τ≤t} n_back(τ) the peak net backward orbit revolutions (3 make a backward
+whirl), F* the peak contact force and D* the maximum displacement so far. The benchmark counts
+a whirl as a verdict (0 or 1 at 3 revolutions); the default ramp (``w_verdict`` 0) charges
+2.9 revolutions almost as much as a whirl, so a policy can trade near misses for whirls at no
+cost in reward. ``w_verdict`` moves part of the weight onto the verdict itself
+(``w_whirl`` 0.25, ``w_verdict`` 0.75 still charge 1 for a whirl). The return of an episode is −Φ_T: minus the
 benchmark cost of the episode's KPIs (with fixed references F_0, D_0 instead of the passive
 drop's), so maximising it is what the benchmark rewards, and the reward is dense: it arrives in
 the step in which a new peak or a backward revolution happens. Re-levitation tasks add
@@ -30,8 +35,8 @@ from .config_checks import ConfigError, check_keys, is_finite_number
 
 PEAK_KEYS = ("kpi_peak_whirl_revolutions", "kpi_peak_contact_force_N", "kpi_max_displacement_um")
 #: the ``reward_kwargs`` and their defaults
-WEIGHTS = dict(w_whirl=1.0, w_force=0.5, w_disp=0.5, force_ref=1e4, disp_ref_um=800.0,
-               w_relevitate=1.0, w_time=1.0)
+WEIGHTS = dict(w_whirl=1.0, w_verdict=0.0, w_force=0.5, w_disp=0.5, force_ref=1e4,
+               disp_ref_um=800.0, w_relevitate=1.0, w_time=1.0)
 REFERENCES = ("force_ref", "disp_ref_um")
 
 
@@ -46,10 +51,12 @@ def check_reward_kwargs(kwargs: dict) -> None:
 
 
 def kpi_potential(revs, force_N, disp_um, w_whirl: float, w_force: float, w_disp: float,
-                  force_ref: float, disp_ref_um: float):
+                  force_ref: float, disp_ref_um: float, w_verdict: float = 0.0):
     """Φ of the module docstring from the peak net backward revolutions, the peak contact force
     and the maximum displacement (floats or arrays)."""
+    revs = np.asarray(revs, dtype=float)
     return (w_whirl * np.minimum(revs, WHIRL_MIN_REVOLUTIONS) / WHIRL_MIN_REVOLUTIONS
+            + w_verdict * (revs >= WHIRL_MIN_REVOLUTIONS)
             + w_force * np.asarray(force_N) / force_ref + w_disp * np.asarray(disp_um) / disp_ref_um)
 
 

@@ -133,7 +133,18 @@ def test_evaluate_a_trained_policy_against_passive(trained, tmp_path):
 
 
 #: non-default KPI-reward weights, so the tests also see them reach the wrapper
-W = dict(w_whirl=2.0, w_force=0.25, w_disp=0.75, force_ref=5e3, disp_ref_um=600.0)
+W = dict(w_whirl=2.0, w_verdict=0.5, w_force=0.25, w_disp=0.75, force_ref=5e3, disp_ref_um=600.0)
+
+
+def test_kpi_potential_charges_the_whirl_verdict_at_three_revolutions():
+    """w_verdict is a step at the benchmark's whirl verdict (3 net backward revolutions), on top
+    of the capped ramp; with w_whirl 0.25 and w_verdict 0.75 a whirl costs 1, as in J."""
+    from agents.reward import kpi_potential
+    w = dict(w_whirl=0.25, w_verdict=0.75, w_force=0.0, w_disp=0.0, force_ref=1.0, disp_ref_um=1.0)
+    phi = kpi_potential(np.array([0.0, 1.5, 2.999, 3.0, 7.0]), 0.0, 0.0, **w)
+    np.testing.assert_allclose(phi, [0.0, 0.125, 0.25 * 2.999 / 3, 1.0, 1.0])
+    base = {k: v for k, v in w.items() if k != "w_verdict"}
+    assert kpi_potential(3.0, 0.0, 0.0, **base) == pytest.approx(0.25)     # default: no step
 
 
 def _final_potential(info: dict) -> float:
