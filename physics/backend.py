@@ -25,6 +25,7 @@ import socket
 import statistics
 import sys
 import tempfile
+from collections import Counter
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any, Callable, Iterator, Sequence
@@ -89,9 +90,6 @@ class Session:
     """Runs tasks in this process, one after the other (the ``local`` backend)."""
     name = "local"
 
-    def __init__(self):
-        self.ran_on: dict[int, str] = {}               # task index -> node that finished it
-
     def __enter__(self) -> "Session":
         return self
 
@@ -117,11 +115,10 @@ class RaySession(Session):
     name = "ray"
 
     def __init__(self, address: str | None):
-        super().__init__()
         self.address = address or os.environ.get("RAY_ADDRESS") or None
         self.started = False
         self.sent: list[int] = []                      # pickled bytes of each task's arguments
-        self.nodes: dict[str, int] = {}                # tasks finished per node address
+        self.ran_on: dict[int, str] = {}               # task index -> node that finished it
 
     def __enter__(self) -> "RaySession":
         quiet = {} if self.address in (None, "local", "auto") else CONNECT_ENV
@@ -195,7 +192,6 @@ class RaySession(Session):
                         raise cause from None             # the task's own error, as if local
                     raise BackendError(f"--backend ray: task {i} failed (retried up to "
                                        f"{MAX_RETRIES} times): {first_line(exc)}") from None
-                self.nodes[node] = self.nodes.get(node, 0) + 1
                 self.ran_on[i] = node
                 yield i, result
 
@@ -203,7 +199,7 @@ class RaySession(Session):
         """Backend, address, nodes and CPUs at the start, tasks (per node that finished them)
         and the pickled bytes of a task's arguments."""
         return dict(backend=self.name, address=self.address, **self.at_start, tasks=len(self.sent),
-                    tasks_per_node=dict(sorted(self.nodes.items())),
+                    tasks_per_node=dict(sorted(Counter(self.ran_on.values()).items())),
                     bytes_per_task=dict(median=statistics.median(self.sent), max=max(self.sent))
                     if self.sent else None)
 
@@ -358,7 +354,7 @@ def _run_local(runs, todo: list[int], evaluate, jobs, store, bar) -> None:
     run_chunk([runs[i] for i in todo], evaluate, threads=jobs, on_outcome=done)
 
 
-def _run_remote(session: Session, runs, todo: list[int], evaluate, store, bar) -> None:
+def _run_remote(session: "RaySession", runs, todo: list[int], evaluate, store, bar) -> None:
     size = max(1, math.ceil(len(todo) / (TASKS_PER_CPU * session.cpus())))
     chunks = [todo[k:k + size] for k in range(0, len(todo), size)]
     tasks = [([runs[i] for i in c], evaluate, TASK_CPUS) for c in chunks]

@@ -4,8 +4,9 @@ A batch writes ``<out>/drops/manifest.json`` (what the batch is: its number of d
 a fingerprint of every run's scene, overrides and labels, the ``evaluate`` function and the
 contents of a TOML scene file) and appends one JSON line per finished drop to
 ``<out>/drops/done.jsonl`` (``{"i": index in the batch, "ok", "metrics", "extra", "error"}``,
-and on a Ray cluster ``"node"``: the address of the node that ran it), flushed at once. A killed driver therefore loses at most the line being written (a cut last
-line is dropped on reading); ``--resume`` keeps every stored drop and runs only the missing
+and on a Ray cluster ``"node"``: the address of the node that ran it), flushed at once. A
+killed driver therefore loses at most the line being written (a cut last line is dropped on
+reading); ``--resume`` keeps every stored drop and runs only the missing
 ones. A ``--resume`` folder of another batch is refused before anything is changed.
 """
 from __future__ import annotations

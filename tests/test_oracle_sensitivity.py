@@ -4,7 +4,7 @@ import pytest
 
 from agents.oracle import oracle, suite_scenarios
 from agents.research.blind_oracle import blind_oracle
-from agents.research.oracle_sensitivity import PERTURBATIONS, perturbed, searches, sensitivity
+from agents.research.oracle_sensitivity import PERTURBATIONS, largest_gains, perturbed, searches, sensitivity
 from agents.robust import SUITE_SEED
 
 
@@ -38,6 +38,15 @@ def test_copies_change_one_scene_value_by_the_stated_amount():
     from physics.scene import load_scene
     bare = perturbed(Scenario("bare", 0.4), 0.0, PERTURBATIONS["stiffness +0.1 %"])[0]
     assert bare.overrides == {"support.stiffness": load_scene("paper").support.stiffness * 1.001}
+
+
+def test_top_k_are_the_drops_with_the_largest_oracle_gain():
+    found = [dict(position=i, theta=[], J=1.0, J_designed=1.0 + g)
+             for i, g in enumerate([0.1, 0.5, -0.2, 0.3])]
+    assert [f["position"] for f in largest_gains(found, 2)] == [1, 3]
+    assert largest_gains(found, None) == found                      # all, in suite order
+    with pytest.raises(ValueError, match="needs the designed row"):
+        largest_gains([dict(found[0], J_designed=None)], 1)
 
 
 def test_unchanged_copy_reproduces_the_oracle_and_the_designed_row(robust_report):

@@ -30,7 +30,8 @@ from pathlib import Path
 import numpy as np
 
 from agents.oracle import check_constants, constant_theta, search_scenario, suite_scenarios
-from agents.research.oracle_sensitivity import largest_gains, passive_row, perturbed, replay, searches
+from agents.research.oracle_sensitivity import (largest_gains, passive_row, perturbed, replay, row_J,
+                                                searches)
 from agents.score import write_json
 
 COPIES = (0.0, -1.0, 1.0)          # friction of each copy: mu + k delta (the scenario first)
@@ -38,8 +39,7 @@ COPIES = (0.0, -1.0, 1.0)          # friction of each copy: mu + k delta (the sc
 
 def suite_passive_J(report: dict) -> float:
     """Sum of the passive drops' J over every scenario of the report (the score's denominator)."""
-    return float(sum(p["rows"]["passive"]["J"] if "rows" in p else p["J"]["passive"]
-                     for p in report["per_scenario"]))
+    return float(sum(row_J(p, "passive") for p in report["per_scenario"]))
 
 
 def blind_oracle(report: dict, top: int = 8, delta: float = 1e-3, population: int | None = None,

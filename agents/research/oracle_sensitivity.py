@@ -87,6 +87,14 @@ def replay(sc, phase: float, thetas: np.ndarray) -> tuple[list[float], list[bool
             episode_cost(passive, passive))
 
 
+def row_J(scenario: dict, name: str) -> float | None:
+    """J of row ``name`` in one ``per_scenario`` entry of an ``oracle.json`` (``rows``) or of the
+    compact form of ``docs/img`` (``J``); None if the report does not hold that row."""
+    if "rows" in scenario:
+        return scenario["rows"].get(name, {}).get("J")
+    return scenario.get("J", {}).get(name)
+
+
 def searches(report: dict, designed=(0.5, -0.5)) -> list[dict]:
     """Per searched scenario: its position in the suite, the oracle's sequence and J, and the
     designed row's J where the report holds it (None otherwise). Reads both an ``oracle.json``
@@ -96,13 +104,12 @@ def searches(report: dict, designed=(0.5, -0.5)) -> list[dict]:
     found = []
     for pos, p in enumerate(report["per_scenario"]):
         if p.get("search"):
-            theta, j, j_designed = (p["search"]["theta"], p["search"]["J"],
-                                    p.get("rows", {}).get(name, {}).get("J"))
+            theta, j = p["search"]["theta"], p["search"]["J"]
         elif p.get("oracle_theta") is not None:
-            theta, j, j_designed = p["oracle_theta"], p["J"]["oracle"], p["J"].get(name)
+            theta, j = p["oracle_theta"], p["J"]["oracle"]
         else:
             continue
-        found.append(dict(position=pos, theta=theta, J=j, J_designed=j_designed))
+        found.append(dict(position=pos, theta=theta, J=j, J_designed=row_J(p, name)))
     return found
 
 
@@ -179,9 +186,10 @@ def main(argv=None) -> int:
     if not path.is_file():
         ap.error(f"{path} does not exist: give an output folder of rotordrop oracle or its JSON")
     report = json.loads(path.read_text())
-    if not searches(report, designed):
+    found = searches(report, designed)
+    if not found:
         ap.error(f"{path} has no oracle search (a --no-search run): nothing to replay")
-    if a.top is not None and any(f["J_designed"] is None for f in searches(report, designed)):
+    if a.top is not None and any(f["J_designed"] is None for f in found):
         ap.error(f"--top needs the designed row {a.designed} in {path} (run rotordrop oracle "
                  f"with --constant {a.designed})")
     out = sensitivity(report, designed, a.top)
