@@ -24,6 +24,8 @@ algorithm's constructor arguments a block may hold:
 ``validation``     ``true``: keep as ``best/`` the model with the highest benchmark score on the
                    validation suite (:class:`agents.benchmark.Validator`: frictions and unbalance
                    phases the benchmark does not use) instead of the highest evaluation reward
+``action_log_std`` PPO: initial log std of named action entries, e.g. ``{gain: -1.0}``; the
+                   others keep ``log_std_init`` (:mod:`agents.exploration`)
 =================  ===========================================================================
 
 The same file trains with rl-zoo3 (``python -m rl_zoo3.train --algo ppo --env ID --gym-packages
@@ -38,6 +40,7 @@ rl-zoo3 entry                                                          means
 ``vec_env_wrapper: [{agents.reward.KpiReward: {weights...}}]``         ``reward: kpi``,
                                                                        ``reward_kwargs``
 ``callback: [agents.validation.ValidationCallback]``                   ``validation: true``
+``callback: [{agents.exploration.ActionSpread: {log_std: {...}}}]``    ``action_log_std: {...}``
 =====================================================================  ===========================
 
 (residual first: the list is applied inside out). ``eval_freq``, ``n_eval_episodes`` and
@@ -69,7 +72,8 @@ ALGOS = ("ppo", "sac", "td3", "tqc")
 CONTRIB_ALGOS = ("tqc",)
 META_KEYS = ("n_timesteps", "n_envs", "policy", "policy_kwargs", "normalize", "env_kwargs",
              "eval_freq", "n_eval_episodes", "checkpoint_freq", "noise_type", "noise_std",
-             "reward", "reward_kwargs", "residual", "residual_scale", "validation")
+             "reward", "reward_kwargs", "residual", "residual_scale", "validation",
+             "action_log_std")
 REWARDS = ("env", "kpi")
 #: evaluation and checkpoint intervals [environment steps] and evaluation episodes of a run
 #: when neither the command line nor the config sets them (rl-zoo3's eval_freq too)
@@ -78,6 +82,9 @@ RUN_DEFAULTS = dict(eval_freq=25_000, n_eval_episodes=8, checkpoint_freq=100_000
 RESIDUAL_WRAPPER = "agents.residual.ResidualAction"
 KPI_WRAPPER = "agents.reward.KpiReward"
 VALIDATION_CALLBACK = "agents.validation.ValidationCallback"
+SPREAD_CALLBACK = "agents.exploration.ActionSpread"
+#: project keys that rl-zoo3's ``callback:`` entries set
+CALLBACK_KEYS = ("validation", "action_log_std")
 WRAPPER_KEYS = ("residual", "residual_scale", "reward", "reward_kwargs")
 #: rl-zoo3 keys rotordrop train cannot honour (the batched VecEnv steps unwrapped envs)
 ZOO_ONLY = {"env_wrapper": "gym wrappers around each environment",
@@ -171,7 +178,7 @@ def load_hyperparams(algo: str, env_id: str, config: str | Path | None = None) -
             raise ConfigError(f"config file {config} has no block for {env_id} (has {', '.join(user)})")
         if not isinstance(block, dict):
             raise ConfigError(f"config file {config}: the {env_id} block must be a mapping")
-        for entry, keys in (("vec_env_wrapper", WRAPPER_KEYS), ("callback", ("validation",))):
+        for entry, keys in (("vec_env_wrapper", WRAPPER_KEYS), ("callback", CALLBACK_KEYS)):
             if entry in block:
                 for key in keys:
                     hp.pop(key, None)
@@ -210,9 +217,14 @@ def project_keys(block: dict) -> dict:
             raise ConfigError(f"vec_env_wrapper {name}: rotordrop train knows {RESIDUAL_WRAPPER} "
                               f"and {KPI_WRAPPER}; other wrappers run under python -m rl_zoo3.train")
     for name, kwargs in _entries(block.get("callback"), "callback"):
+        if name == SPREAD_CALLBACK:
+            check_keys(name, kwargs, ("log_std", "verbose"))
+            found["action_log_std"] = kwargs.get("log_std")
+            continue
         if name != VALIDATION_CALLBACK:
             raise ConfigError(f"callback {name}: rotordrop train knows {VALIDATION_CALLBACK} "
-                              "(validation: true); other callbacks run under python -m rl_zoo3.train")
+                              f"(validation: true) and {SPREAD_CALLBACK} (action_log_std); other "
+                              "callbacks run under python -m rl_zoo3.train")
         check_keys(name, kwargs, ("eval_freq", "save_path", "verbose"))
         if kwargs.get("save_path") is not None:
             raise ConfigError(f"callback {name}: save_path is where rl-zoo3 keeps the best model; "
@@ -336,6 +348,9 @@ def split(hp: dict) -> tuple[dict, dict]:
             raise ConfigError(f"residual_scale must be in (0, 2], got {meta['residual_scale']}")
     if not isinstance(meta.setdefault("validation", False), bool):
         raise ConfigError(f"validation must be true or false, got {meta['validation']!r}")
+    if "action_log_std" in meta:
+        from .exploration import check_action_log_std
+        meta["action_log_std"] = check_action_log_std(meta["action_log_std"])
     if not isinstance(meta.setdefault("reward_kwargs", {}) or {}, dict):
         raise ConfigError(f"reward_kwargs must be a mapping, got {meta['reward_kwargs']!r}")
     for key, value in RUN_DEFAULTS.items():

@@ -420,6 +420,9 @@ def _training_callbacks(env_id: str, algo: str, meta: dict, seed: int, out: Path
         setattr(eval_cb, key, values)
     eval_cb.best_mean_reward = _best(curve, "mean_reward")
     cbs = [eval_cb]
+    if "action_log_std" in meta:
+        from .exploration import ActionSpread
+        cbs.insert(0, ActionSpread(meta["action_log_std"]))
     if meta["validation"]:
         cbs.append(ValidationCallback(env_id, algo, meta["env_kwargs"], meta, out / "best", eval_cb,
                                       best=_best(curve, "validation_score")))
@@ -510,6 +513,12 @@ def check_env(env_id: str, algo: str, meta: dict) -> None:
                 make_baseline(residual, Plant.from_env(env))
             except ValueError as exc:
                 raise ConfigError(f"residual: {exc}") from exc
+        if "action_log_std" in meta:
+            from .exploration import check_action_log_std
+            if algo != "ppo" or not isinstance(space, Box):
+                raise ConfigError(f"action_log_std sets PPO's per-entry Gaussian spread: it needs "
+                                  f"--algo ppo and continuous actions (got --algo {algo}, {space})")
+            check_action_log_std(meta["action_log_std"], env.unwrapped.action_names)
     finally:
         env.close()
 

@@ -1,10 +1,12 @@
 """Hyperparameter files, a short SB3 training run (saved, loadable, resumable) and evaluate on it."""
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-from agents.hyperparams import ConfigError, load_hyperparams, parse_literal, schedule, split
+from agents.hyperparams import (ConfigError, load_hyperparams, parse_literal, read_yaml, schedule,
+                                split)
 
 from helpers import phys
 
@@ -22,6 +24,24 @@ def test_shipped_configs_parse(algo):
         env = make_env(env_id, **meta["env_kwargs"])          # the env the config trains on
         if algo != "ppo":       # SAC/TD3/TQC need continuous actions
             assert isinstance(env.action_space, Box), (algo, env_id)
+
+
+CONFIG_FILES = sorted(Path(__file__).resolve().parents[1].glob("agents/configs/*-*.yaml"))
+
+
+@pytest.mark.parametrize("cfg", CONFIG_FILES, ids=lambda p: p.stem)
+def test_every_experiment_config_passes_the_checks_rotordrop_train_makes(cfg):
+    """The documented experiment configs (agents/configs/<algo>-<name>.yaml, applied with
+    --config over <algo>.yaml) pass the checks a run makes before it writes anything."""
+    from agents.hyperparams import check_sb3
+    from agents.train import check_env, resolve_config
+    algo = cfg.stem.split("-")[0]
+    env_ids = [k for k in read_yaml(cfg) if k.startswith("RotorDrop-")]
+    assert env_ids, cfg
+    for env_id in env_ids:
+        meta, kwargs = split(resolve_config(env_id, algo, cfg))
+        check_sb3(algo, env_id, meta, kwargs)
+        check_env(env_id, algo, meta)
 
 
 def test_config_override_and_literals(tmp_path):
