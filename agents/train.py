@@ -491,7 +491,8 @@ def _resumed_model(algo: str, env_id: str, ckpt: tuple, norm, venv, out: Path, v
 def check_env(env_id: str, algo: str, meta: dict) -> None:
     """Build the configured environment once: a bad ``env_kwargs`` value, an action space the
     algorithm or the residual cannot drive, a residual baseline without the channels it
-    commands are ConfigErrors."""
+    commands, an ``action_log_std`` naming entries the environment lacks (or set for another
+    algorithm than PPO) are ConfigErrors."""
     from gymnasium.spaces import Box
 
     from .controllers import make_baseline
