@@ -237,7 +237,10 @@ def _rebuilt(model, cls: type, meta: dict | None) -> tuple:
     kwargs = {k: v for k, v in model.policy_kwargs.items() if k != KEY}
     if meta is not None:
         kwargs[KEY] = meta
-    policy = cls(model.observation_space, model.action_space, model.lr_schedule, **kwargs).to(model.device)
+    # on-policy algorithms pass gSDE to the policy outside policy_kwargs (off-policy ones inside)
+    sde = {"use_sde": True} if getattr(model, "use_sde", False) and "use_sde" not in kwargs else {}
+    policy = cls(model.observation_space, model.action_space, model.lr_schedule, **kwargs,
+                 **sde).to(model.device)
     buffers = {"obs_mean", "obs_var"}
     state = {k: v for k, v in model.policy.state_dict().items() if k not in buffers}
     missing, unexpected = policy.load_state_dict(state, strict=False)

@@ -67,14 +67,17 @@ def test_a_shipped_policy_pickles_as_its_file_and_acts_the_same():
     obs = _episode_obs(env, pol.bound(plant), seeds=(3,), steps=20)
     assert np.array_equal(again.bound(plant).predict(obs)[0], pol.predict(obs)[0])
 
-def _trained_run(tmp_path, algo, residual=None):
-    """A tiny model of ``algo`` with VecNormalize statistics from a few hundred steps."""
+def _trained_run(tmp_path, algo, residual=None, sde=False):
+    """A tiny model of ``algo`` with VecNormalize statistics from a few hundred steps
+    (``sde``: with gSDE exploration)."""
     from stable_baselines3.common.env_util import make_vec_env
     from stable_baselines3.common.vec_env import VecNormalize
     env_id = "RotorDrop-Full-v0"
     env_kwargs = dict(command="continuous", episode_time=0.02, randomize=True)
     venv = VecNormalize(make_vec_env(env_id, 2, seed=0, env_kwargs=env_kwargs))
     kw = dict(n_steps=64, batch_size=64) if algo == "ppo" else dict(learning_starts=50, buffer_size=500)
+    if sde:
+        kw["use_sde"] = True
     model = algo_class(algo)("MlpPolicy", venv, seed=0, device="cpu",
                              policy_kwargs=dict(net_arch=[16, 16]), **kw)
     model.learn(160)
@@ -82,9 +85,12 @@ def _trained_run(tmp_path, algo, residual=None):
     return model, venv, env_id, env_kwargs
 
 
-@pytest.mark.parametrize("algo", ["ppo", "sac", "td3", "tqc"])
-def test_an_exported_model_acts_as_model_plus_vecnormalize_plus_residual(tmp_path, algo):
-    model, vn, env_id, env_kwargs = _trained_run(tmp_path, algo)
+@pytest.mark.parametrize("algo, sde", [("ppo", False), ("sac", False), ("td3", False),
+                                       ("tqc", False), ("ppo", True), ("sac", True)])
+def test_an_exported_model_acts_as_model_plus_vecnormalize_plus_residual(tmp_path, algo, sde):
+    """Also with gSDE, which PPO passes to its policy outside policy_kwargs (the export once
+    rebuilt it without, and a gSDE run failed when saving its final model)."""
+    model, vn, env_id, env_kwargs = _trained_run(tmp_path, algo, sde=sde)
     out = export_self_contained(model, vn, tmp_path / "policy.zip", env_id=env_id,
                                 env_kwargs=env_kwargs, residual="whirl-brake", residual_scale=0.5)
     plain = algo_class(algo).load(out, device="cpu")
