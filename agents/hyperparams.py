@@ -404,7 +404,8 @@ def signature_keys(fn, skip: tuple[str, ...] = ("self",)) -> tuple[str, ...]:
 
 def check_sb3(algo: str, env_id: str, meta: dict, algo_kwargs: dict) -> None:
     """The keys of ``split``'s output against what they are passed to: the algorithm's
-    constructor, ``VecNormalize`` and the environment's constructor (ConfigError naming the key)."""
+    constructor, ``VecNormalize`` and the environment's constructor, and ``action_log_std``
+    against the algorithm (ConfigError naming the key)."""
     from stable_baselines3.common.vec_env import VecNormalize
     for key in algo_kwargs:
         if key in SET_BY_TRAIN:
@@ -412,6 +413,10 @@ def check_sb3(algo: str, env_id: str, meta: dict, algo_kwargs: dict) -> None:
     check_keys(f"{algo} config", algo_kwargs,
                list(dict.fromkeys([k for k in signature_keys(algo_class(algo).__init__)
                                    if k not in SET_BY_TRAIN] + list(META_KEYS))))
+    if "action_log_std" in meta and (algo != "ppo" or algo_kwargs.get("use_sde")):
+        raise ConfigError(f"action_log_std sets the per-entry log std of PPO's Gaussian policy: it "
+                          f"needs --algo ppo without use_sde (got --algo {algo}"
+                          f"{', use_sde: true' if algo_kwargs.get('use_sde') else ''})")
     if isinstance(meta["normalize"], dict):
         check_keys("normalize (VecNormalize arguments)", meta["normalize"],
                    signature_keys(VecNormalize.__init__, skip=("self", "venv")))

@@ -491,8 +491,7 @@ def _resumed_model(algo: str, env_id: str, ckpt: tuple, norm, venv, out: Path, v
 def check_env(env_id: str, algo: str, meta: dict) -> None:
     """Build the configured environment once: a bad ``env_kwargs`` value, an action space the
     algorithm or the residual cannot drive, a residual baseline without the channels it
-    commands, an ``action_log_std`` naming entries the environment lacks (or set for another
-    algorithm than PPO) are ConfigErrors."""
+    commands, an ``action_log_std`` naming entries the environment lacks are ConfigErrors."""
     from gymnasium.spaces import Box
 
     from .controllers import make_baseline
@@ -516,9 +515,8 @@ def check_env(env_id: str, algo: str, meta: dict) -> None:
                 raise ConfigError(f"residual: {exc}") from exc
         if "action_log_std" in meta:
             from .exploration import check_action_log_std
-            if algo != "ppo" or not isinstance(space, Box):
-                raise ConfigError(f"action_log_std sets PPO's per-entry Gaussian spread: it needs "
-                                  f"--algo ppo and continuous actions (got --algo {algo}, {space})")
+            if not isinstance(space, Box):
+                raise ConfigError(f"action_log_std needs continuous actions: {fix}")
             check_action_log_std(meta["action_log_std"], env.unwrapped.action_names)
     finally:
         env.close()

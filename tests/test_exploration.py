@@ -76,12 +76,15 @@ def test_rotordrop_train_starts_from_the_configured_spread(tmp_path):
     ("  action_log_std: {gain: -1.0}\n", "ppo",
      r"action_log_std: 'gain' is not an action entry of this environment; its entries: "
      r"damping1, damping2"),
-    ("  action_log_std: {damping1: -1.0}\n", "sac", r"action_log_std sets PPO's .* needs --algo ppo"),
+    ("  action_log_std: {damping1: -1.0}\n", "sac",
+     r"action_log_std sets the per-entry log std .* needs --algo ppo without use_sde \(got --algo sac\)"),
+    ("  action_log_std: {damping1: -1.0}\n  use_sde: true\n", "ppo",
+     r"needs --algo ppo without use_sde \(got --algo ppo, use_sde: true\)"),
 ])
 def test_bad_spreads_are_named_before_anything_is_written(tmp_path, extra, algo, match):
     cfg = tmp_path / "t.yaml"
-    cfg.write_text(TINY.replace("  n_steps: 64\n  batch_size: 64\n  n_epochs: 1\n", "")
-                   + extra if algo == "sac" else TINY + extra)
+    ppo_only = "  n_steps: 64\n  batch_size: 64\n  n_epochs: 1\n"
+    cfg.write_text((TINY.replace(ppo_only, "") if algo == "sac" else TINY) + extra)
     with pytest.raises(ConfigError, match=match):
         train("RotorDrop-Damping-v0", algo, tmp_path / "run", timesteps=128, config=cfg,
               progress=False)
@@ -89,7 +92,9 @@ def test_bad_spreads_are_named_before_anything_is_written(tmp_path, extra, algo,
 
 
 def test_a_policy_without_a_per_entry_log_std_is_refused():
-    model = _model()
-    model.policy.use_sde = True
+    """What rl-zoo3 would run: a gSDE PPO, whose log std is per latent feature and entry."""
+    venv = make_vec_env("RotorDrop-Damping-v0", 1, seed=0, env_kwargs=dict(episode_time=0.02))
+    model = PPO("MlpPolicy", venv, n_steps=64, batch_size=64, seed=0, device="cpu", use_sde=True,
+                policy_kwargs=dict(net_arch=[8]))
     with pytest.raises(ConfigError, match="needs a policy with one state-independent log std"):
         model.learn(64, callback=ActionSpread(SPREAD))
