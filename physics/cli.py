@@ -136,8 +136,11 @@ def _post_fault_tables(m: dict) -> list[str]:
     p0 = m.get("rating_pressure_MPa")
     lines += ["s0: static safety factor C_0 / peak bearing load; p_max: Hertz pressure of the worst "
               "ball" + (f" (s0 = 1 at {p0:.0f} MPa for this bearing)" if p0 else ""),
-              "friction heat: generated at the rotor-sleeve contact after the fault (net: under the "
-              "paper slip law the contact can also return energy)"]
+              "friction heat: generated at the rotor-sleeve contact after the fault"
+              + (" (net: the paper slip law also created "
+                 + ", ".join(f"{p} {v['friction_energy_created_J']:.1f} J" for p, v in m["planes"].items())
+                 + ")" if any(v["friction_energy_created_J"] > 0.0 for v in m["planes"].values())
+                 else "")]
     if "max_temperature_rise_K" in next(iter(m["planes"].values())):       # effects.thermal
         lines.append("sleeve heating: " + ", ".join(
             f"{p} +{v['max_temperature_rise_K']:.1f} K max, mu {v['min_friction_coefficient']:.3f}"

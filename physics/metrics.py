@@ -11,6 +11,7 @@ import numpy as np
 from .amb import weight_shares
 from .ball_bearing import film_thickness, max_contact_pressure, static_max_ball_load
 from .contact import line_validity
+from .dissipation import dissipation_check
 from .integrate import P_FR, P_LOAD, P_QMAX
 from .model import F_FILM, F_RB, F_STATOR, P_FILM, PLANES, RB_SM
 from .results import AMB_PLANES, Result
@@ -93,6 +94,15 @@ def friction_heat(result: Result, plane: str, post: np.ndarray) -> np.ndarray:
     return np.concatenate(([0.0], np.cumsum(0.5 * (p[1:] + p[:-1]) * np.diff(t))))[:len(t)]
 
 
+def friction_energy_created(result: Result, plane: str, post: slice) -> float:
+    """Energy [J] the rotor-sleeve friction created over the samples ``post``: the integral of its
+    negative power. Zero for a law that dissipates; the paper's slip law creates energy whenever
+    it pushes along the sliding (``friction_heat_J`` is then a net figure)."""
+    p, t = result.friction_power(plane)[post], result.t[post]
+    neg = np.minimum(p, 0.0)
+    return float(-np.sum(0.5 * (neg[1:] + neg[:-1]) * np.diff(t))) if len(t) > 1 else 0.0
+
+
 @functools.lru_cache(maxsize=64)
 def rating_pressure(bearing) -> float:
     """Worst ball-race Hertz pressure [Pa] at s_0 = 1: the bearing statically carrying its load
@@ -126,6 +136,7 @@ def retainer_loading(result: Result, plane: str, post: np.ndarray) -> dict:
                 max_ball_load_N=q if balls else None,
                 max_contact_pressure_MPa=float(max_contact_pressure(bearing, q)) * 1e-6 if balls else None,
                 friction_heat_J=float(friction_heat(result, plane, post)[-1]) if len(t) else 0.0,
+                friction_energy_created_J=friction_energy_created(result, plane, post),
                 max_sleeve_speed_rpm=float(np.abs(ws).max() * RPM) if len(ws) else 0.0)
 
 
@@ -220,7 +231,11 @@ def amb_plane_metrics(result: Result) -> dict:
         out[p] = dict(max_displacement_um=math.sqrt(r2) * 1e6, stator_contact=r2 >= gap * gap)
         out[p].update(stator_contact_events(result, p) if modelled else
                       dict(stator_contacts=None, stator_peak_force_N=None, stator_contact_time_s=None))
-        out[p]["stator_penetration_um"] = max(math.sqrt(r2) - gap, 0.0) * 1e6
+        q = result.stator(p)                    # the stator's own motion on its mount
+        rel = np.hypot(o[:, 0] - q[:, 0], o[:, 1] - q[:, 1]) if len(o) else np.zeros(1)
+        out[p]["stator_penetration_um"] = max(float(rel.max()) - gap, 0.0) * 1e6
+        out[p]["max_stator_displacement_um"] = float(np.hypot(q[:, 0], q[:, 1]).max() * 1e6) \
+            if len(q) else 0.0
     return out
 
 
@@ -345,6 +360,15 @@ def warnings_of(m: dict, scene) -> list[str]:
                    f"bearing's radial internal play P_d/2 = {m['bearing_radial_play_um']:.1f} µm: "
                    "the film preloads the balls with the rotor centred, beyond what the film model"
                    " was made for (check bearing.clearance, bearing.viscosity)")
+    if not m["dissipation"]["ok"]:
+        d = m["dissipation"]
+        out.append(f"{', '.join(d['negative'])} created {d['created_energy_J']:.3g} J (negative "
+                   "dissipated power): "
+                   + ("effects.friction = 'paper' drives the friction by Omega - omega_s, not by "
+                      "the contact's sliding velocity; its heat and energy figures are not "
+                      "physical (effects.friction = 'kinematic' dissipates)"
+                      if scene.effects.friction == "paper" else
+                      "an element does positive work on the motion; please report this scene"))
     if m["output_rate_too_coarse"]:
         out.append(f"solver.output_rate = {m['output_rate_hz']:g} Hz is below "
                    f"{m['min_output_rate_hz']:.0f} Hz ({SAMPLES_PER_PERIOD} samples per "
@@ -386,6 +410,7 @@ def compute_metrics(result: Result) -> dict:
     balls = result.model.I[F_RB] == RB_SM
     out["rating_pressure_MPa"] = rating_pressure(result.model.scene.bearing) * 1e-6 if balls else None
     out.update(check_metrics(result, out))
+    out["dissipation"] = dissipation_check(result)
     out["warnings"] = warnings_of(out, result.model.scene)
     return out
 

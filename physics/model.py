@@ -53,6 +53,8 @@ from .support import housing_force
 # sleeve heating (effects.thermal, physics/thermal.py): heat capacity, loss conductance, contact
 # heat partition, relative mu slope, mu ratio floor and ceiling, bearing heat partition
 P_TH_C, P_TH_G, P_TH_A, P_TH_SLOPE, P_TH_RMIN, P_TH_RMAX, P_TH_B, N_P = range(N_P, N_P + 8)
+# stator mount (effects.stator_mount, physics/stator.py): stiffness, damping, mass per AMB plane
+P_STM_K, P_STM_C, P_STM_M, N_P = range(N_P, N_P + 4)
 
 # ------------------------------------------------------------------- flags and indices I --
 (F_GRAV, F_UNB, F_GYRO, F_AMB, F_RB, F_FILM, F_BFRIC, F_HOUSING, F_SLEEVE_J, F_FRIC, F_AUDIT,
@@ -68,6 +70,8 @@ F_STATOR, F_LAW, N_I = range(N_I_BASE, N_I_BASE + 3)
 # sleeve temperatures of RB1 and RB2, then the heat audit's heat_lost and friction_work
 # (thermal.STATE_NAMES; -1 when effects.thermal is off)
 I_THERM, N_I = N_I, N_I + 1
+# stator on its mount: x, y, vx, vy of AMB1's stator, then AMB2's (-1 without effects.stator_mount)
+I_STM, N_I = N_I, N_I + 1
 AMB_AXES = ("AMB1.x", "AMB1.y", "AMB2.x", "AMB2.y")
 
 AMB_NONE, AMB_LINEAR, AMB_ACTUATOR = 0, 1, 2
@@ -88,11 +92,18 @@ LAW_PAPER, LAW_HERTZ_LINE = 0, 1
  N_U) = 0, 1, 2, 3, 4, 8, 9, 13, 17, 18
 
 # ------------------------------------------------------------------- diagnostics aux --
-# per plane k at aux[k*N_AUX_PLANE + j]
-(A_FR, A_FMU, A_DELTA, A_LOAD, A_WS, A_DRAG, A_PFRIC, A_QMAX, N_AUX_PLANE) = range(9)
-# then the stator's normal force at AMB plane k at aux[A_STATOR + k] (zero without stator contact)
+# per plane k at aux[k*N_AUX_PLANE + j]; A_P* are the powers [W] each dissipative element takes
+# out of the mechanical energy (physics/dissipation.py checks each is >= 0): contact friction,
+# contact normal damping, ball-bearing dashpot, bearing drag, support dashpot
+(A_FR, A_FMU, A_DELTA, A_LOAD, A_WS, A_DRAG, A_PFRIC, A_QMAX, A_PCDAMP, A_PBDAMP, A_PDRAG,
+ A_PSUPPORT, N_AUX_PLANE) = range(13)
+# then per AMB plane k: the stator's normal force at aux[A_STATOR + k] (zero without stator
+# contact), the stator contact's dashpot and friction powers at A_ST_PDAMP + k, A_ST_PFRIC + k
 A_STATOR = 2 * N_AUX_PLANE
-N_AUX = A_STATOR + 2
+A_ST_PDAMP = A_STATOR + 2
+A_ST_PFRIC = A_STATOR + 4
+A_ST_PMOUNT = A_STATOR + 6               # ... and its mount's dashpot (effects.stator_mount)
+N_AUX = A_STATOR + 8
 
 PLANES = ("RB1", "RB2")
 STANDARD_GRAVITY = 9.80665  # m/s^2: sets the hertz_line reference impact speed sqrt(2 g c)
@@ -220,6 +231,12 @@ def build_model(scene: Scene) -> Model:
                 add(name, thermal.TEMPERATURE_SIZE, thermal.TEMPERATURE_OBS)
             else:
                 add(name, e_scale, e_spin)
+    if fx.stator_contact and fx.stator_mount:
+        I[I_STM] = len(names)
+        for plane in ("AMB1", "AMB2"):
+            for n, sz, obs in (("x", 0.1 * c, c), ("y", 0.1 * c, c), ("vx", 0.01, VELOCITY),
+                               ("vy", 0.01, VELOCITY)):
+                add(f"{plane}.stator_{n}", sz, obs)
 
     # parameters
     g = s.world.gravity if fx.gravity else 0.0
@@ -275,6 +292,8 @@ def _pack_contact_extensions(s: Scene, P: np.ndarray) -> None:
     e_star = b.youngs_modulus / (2.0 * (1.0 - b.poisson ** 2))     # steel journal in a steel sleeve
     P[P_HL_A] = math.pi * c.length * e_star
     P[P_HL_CHI] = hysteresis_factor(c.restitution, math.sqrt(2.0 * STANDARD_GRAVITY * c.clearance))
+    P[P_STM_K], P[P_STM_M] = st.mount_stiffness, st.mount_mass
+    P[P_STM_C] = 2.0 * st.mount_damping_ratio * math.sqrt(st.mount_stiffness * st.mount_mass)
 
 
 # ------------------------------------------------------------------------------- kernels --
@@ -284,6 +303,16 @@ def axis_motion(y, I, z):
     px, py = axis_at(z, y[I[S_X]], y[I[S_Y]], y[I[S_A]], y[I[S_B]])
     vx, vy = axis_at(z, y[I[S_VX]], y[I[S_VY]], y[I[S_VA]], y[I[S_VB]])
     return px, py, vx, vy
+
+
+@njit
+def stator_motion(y, I, k):
+    """Stator position and velocity at AMB plane k on its mount; zeros when fixed to ground."""
+    i = I[I_STM]
+    if i < 0:
+        return 0.0, 0.0, 0.0, 0.0
+    i += 4 * k
+    return y[i], y[i + 1], y[i + 2], y[i + 3]
 
 
 @njit
@@ -431,6 +460,8 @@ def rhs(t, y, P, I, U, dy, aux):
         f_r = 0.0
         f_mu = 0.0
         p_fric = 0.0                             # power dissipated by the contact friction
+        p_cdamp = 0.0                            # ... by the contact's normal damping
+        p_drag = 0.0                             # ... by the retainer bearing's drag torque
         if delta > 0.0:
             ddelta = nx * rel_vx + ny * rel_vy
             if I[F_LAW] == LAW_PAPER:
@@ -438,7 +469,8 @@ def rhs(t, y, P, I, U, dy, aux):
             else:
                 f_el = line_elastic_force(delta, P[P_HL_A], P[P_CLR])
                 f_r = hunt_crossley(f_el, ddelta, P[P_HL_CHI])
-            p_diss += (f_r - f_el) * ddelta
+            p_cdamp = (f_r - f_el) * ddelta
+            p_diss += p_cdamp
         et = tx * rel_vx + ty * rel_vy           # whirl velocity along t
         fric = I[F_FRIC]
         if fric != FRIC_NONE and f_r > 0.0:
@@ -465,6 +497,7 @@ def rhs(t, y, P, I, U, dy, aux):
                 ws = w_roll * min(1.0, mu * f_r / drag) if drag > 0.0 else w_roll
                 p_fric = f_mu * (et + W * P[P_RJ] - ws * P[P_RS])
                 # all the rotor loses: p_fric plus the bearing drag f_mu ws R the sleeve passes on
+                p_drag = f_mu * P[P_RS] * ws      # the drag F_mu R the sleeve passes on
                 p_diss += f_mu * (et + W * P[P_RJ])
         # forces on the rotor at this plane: -F_r n - F_mu t, spin torque -r F_mu
         cfx = f_r * nx + f_mu * tx               # force on the sleeve side
@@ -478,6 +511,7 @@ def rhs(t, y, P, I, U, dy, aux):
         # --- retainer bearing between sleeve (inner ring) and housing (outer ring) ---
         bfx = 0.0                                # bearing force on the sleeve
         bfy = 0.0
+        p_bdamp = 0.0                            # power of the bearing's dashpot c_b
         load = f_r
         qsum = 0.0
         qmax = 0.0                               # most heavily loaded ball (SM bearing only)
@@ -504,7 +538,8 @@ def rhs(t, y, P, I, U, dy, aux):
             bfx = -qx - P[P_CB] * uvx
             bfy = -qy - P[P_CB] * uvy
             load = math.sqrt(qx * qx + qy * qy)
-            p_diss += P[P_CB] * (uvx * uvx + uvy * uvy)
+            p_bdamp = P[P_CB] * (uvx * uvx + uvy * uvy)
+            p_diss += p_bdamp
             p_ext += dV * P[P_CAGE] * ws          # cage rotation under load (no torque in the model)
             if dy is not None:
                 dy[i_th] = ws
@@ -512,7 +547,8 @@ def rhs(t, y, P, I, U, dy, aux):
             bfx = -P[P_KLIN] * ux - P[P_CB] * uvx
             bfy = -P[P_KLIN] * uy - P[P_CB] * uvy
             load = P[P_KLIN] * math.sqrt(ux * ux + uy * uy)
-            p_diss += P[P_CB] * (uvx * uvx + uvy * uvy)
+            p_bdamp = P[P_CB] * (uvx * uvx + uvy * uvy)
+            p_diss += p_bdamp
 
         # --- sleeve spin ---
         drag_t = 0.0
@@ -520,7 +556,8 @@ def rhs(t, y, P, I, U, dy, aux):
             if I[F_BFRIC]:
                 drag_t = drag_torque_magnitude(ws, load, P[P_M0_LOW], P[P_M0_COEF], P[P_M1_COEF],
                                                P[P_MSEAL]) * smooth_sign(ws, P[P_WL])
-                p_diss += drag_t * ws
+                p_drag = drag_t * ws
+                p_diss += p_drag
             if dy is not None:
                 dws = (P[P_RS] * f_mu - drag_t) / P[P_JS]
                 dy[i_ws] = dws
@@ -536,16 +573,20 @@ def rhs(t, y, P, I, U, dy, aux):
             dy[I[base + J_SVX]] = (cfx + bfx) / ms
             dy[I[base + J_SVY]] = (cfy + bfy) / ms - g
         # --- housing ---
-        if dy is not None and i_hx >= 0:
+        p_support = 0.0                          # power of the support dashpot C_s
+        if i_hx >= 0:
             cs = U[U_CS1 + k]
             if I[I_CS] >= 0:                     # semi-active damper lags its command (spec §6)
+                cs = y[I[I_CS] + k]
+            p_support = cs * (hvx * hvx + hvy * hvy)
+            p_diss += p_support
+        if dy is not None and i_hx >= 0:
+            if I[I_CS] >= 0:
                 # the clamp is needed: U is a public input, and even the env's command
                 # C_min + frac (C_max - C_min) can exceed C_max by one ulp at frac = 1
                 i_cs = I[I_CS] + k
-                dy[i_cs] = (amb_mod.clamp(cs, P[P_CS_MIN], P[P_CS_MAX]) - y[i_cs]) / P[P_CS_TAU]
-                cs = y[i_cs]
+                dy[i_cs] = (amb_mod.clamp(U[U_CS1 + k], P[P_CS_MIN], P[P_CS_MAX]) - cs) / P[P_CS_TAU]
             gx, gy = housing_force(hx, hy, hvx, hvy, P[P_KS], cs)
-            p_diss += cs * (hvx * hvx + hvy * hvy)
             if i_sx >= 0:                        # reaction of the bearing
                 gx -= bfx
                 gy -= bfy
@@ -566,6 +607,10 @@ def rhs(t, y, P, I, U, dy, aux):
         aux[o + A_DRAG] = drag_t
         aux[o + A_PFRIC] = p_fric
         aux[o + A_QMAX] = qmax
+        aux[o + A_PCDAMP] = p_cdamp
+        aux[o + A_PBDAMP] = p_bdamp
+        aux[o + A_PDRAG] = p_drag
+        aux[o + A_PSUPPORT] = p_support
 
     i_heat = I[I_THERM]
     if dy is not None and i_heat >= 0:           # effects.thermal: sleeve heating, heat audit
@@ -574,11 +619,7 @@ def rhs(t, y, P, I, U, dy, aux):
         for k in range(2):
             o = k * N_AUX_PLANE
             p = aux[o + A_PFRIC]
-            # bearing friction power M omega_s; a massless sleeve passes its drag on as F_mu R
-            if I[I_PLANES + k * N_PLANE_IDX + J_WS] >= 0:
-                d = aux[o + A_DRAG] * aux[o + A_WS]
-            else:
-                d = aux[o + A_FMU] * P[P_RS] * aux[o + A_WS]
+            d = aux[o + A_PDRAG]                 # bearing friction power M omega_s
             dy[i_heat + k], q = thermal.heat_rates(p, d, y[i_heat + k], P[P_TH_C], P[P_TH_G],
                                                    P[P_TH_A], P[P_TH_B])
             q_lost += q
@@ -589,19 +630,34 @@ def rhs(t, y, P, I, U, dy, aux):
         for k in range(2):
             z = P[P_Z_AMB1 + k]
             px, py, pvx, pvy = axis_motion(y, I, z)
-            sfx, sfy, torque, f_n, _, p_st = stator_force(px, py, pvx, pvy, W, P[P_ST_GAP],
-                                                          P[P_ST_K], P[P_ST_C], P[P_ST_MU],
-                                                          P[P_ST_R], P[P_ST_VL])
+            qx, qy, qvx, qvy = stator_motion(y, I, k)
+            sfx, sfy, torque, f_n, _, p_sd, p_sf = stator_force(
+                px - qx, py - qy, pvx - qvx, pvy - qvy, W, P[P_ST_GAP], P[P_ST_K], P[P_ST_C],
+                P[P_ST_MU], P[P_ST_R], P[P_ST_VL])
+            p_mount = 0.0
+            i_q = I[I_STM]
+            if i_q >= 0:                         # the stator on its mount takes the reaction
+                i_q += 4 * k
+                p_mount = P[P_STM_C] * (qvx * qvx + qvy * qvy)
+                p_diss += p_mount
+                if dy is not None:
+                    dy[i_q] = qvx
+                    dy[i_q + 1] = qvy
+                    dy[i_q + 2] = (-sfx - P[P_STM_K] * qx - P[P_STM_C] * qvx) / P[P_STM_M]
+                    dy[i_q + 3] = (-sfy - P[P_STM_K] * qy - P[P_STM_C] * qvy) / P[P_STM_M]
             Fx += sfx
             Fy += sfy
             Ma += z * sfx
             Mb += z * sfy
             T += torque
-            p_diss += p_st
+            p_diss += p_sd + p_sf
             aux[A_STATOR + k] = f_n
+            aux[A_ST_PDAMP + k] = p_sd
+            aux[A_ST_PFRIC + k] = p_sf
+            aux[A_ST_PMOUNT + k] = p_mount
     else:
-        aux[A_STATOR] = 0.0
-        aux[A_STATOR + 1] = 0.0
+        for j in range(A_STATOR, N_AUX):
+            aux[j] = 0.0
 
     if dy is None:
         return
@@ -741,7 +797,9 @@ def mechanical_energy(y, P, I):
             E += line_potential(er - P[P_CLR], P[P_HL_A], P[P_CLR])
         if I[F_STATOR]:
             ax, ay, _, _ = axis_motion(y, I, P[P_Z_AMB1 + k])
-            E += stator_potential(ax, ay, P[P_ST_GAP], P[P_ST_K])
+            qx, qy, qvx, qvy = stator_motion(y, I, k)
+            E += stator_potential(ax - qx, ay - qy, P[P_ST_GAP], P[P_ST_K])
+            E += 0.5 * P[P_STM_M] * (qvx * qvx + qvy * qvy) + 0.5 * P[P_STM_K] * (qx * qx + qy * qy)
         ux, uy = sx - hx, sy - hy
         if I[F_RB] == RB_SM:        # zero film without sleeve inertia (see rhs)
             h = film_thickness(ws, P[P_FILM])[0] if I[F_FILM] and i_ws >= 0 else 0.0

@@ -7,7 +7,7 @@ import numpy as np
 
 from . import thermal
 from .model import (A_DELTA, A_DRAG, A_FMU, A_FR, A_LOAD, A_PFRIC, A_QMAX, A_STATOR, A_WS, I_PLANES,
-                    I_THERM, J_HX, J_SX, N_AUX_PLANE, N_PLANE_IDX, P_MU, P_TH_C, P_TH_RMAX, P_TH_RMIN,
+                    I_STM, I_THERM, J_HX, J_SX, N_AUX_PLANE, N_PLANE_IDX, P_MU, P_TH_C, P_TH_RMAX, P_TH_RMIN,
                     P_TH_SLOPE, P_Z_AMB1, P_Z_RB1, PLANES, S_EDISS, S_W, S_WEXT, S_X, Model, energies)
 
 AMB_PLANES = ("AMB1", "AMB2")
@@ -84,6 +84,15 @@ class Result:
         """Rotor axis position (x, y) at AMB plane ``AMB1``/``AMB2`` [m], relative to the stator
         centre: what the environments check against the stator (``amb.air_gap``)."""
         return self._axis(self.model.P[P_Z_AMB1 + self._plane(plane, AMB_PLANES)])
+
+    def stator(self, plane: str) -> np.ndarray:
+        """Stator centre (x, y) at AMB plane ``AMB1``/``AMB2`` on its mount [m] (zeros when the
+        stator is fixed: without ``effects.stator_mount`` or stator contact)."""
+        i = self.model.I[I_STM]
+        if i < 0:
+            return np.zeros((len(self.t), 2))
+        i += 4 * self._plane(plane, AMB_PLANES)
+        return self.Y[:, i:i + 2]
 
     def orbit_after(self, plane: str, t0: float, relative: bool = False) -> np.ndarray:
         """:meth:`orbit` at the samples t >= ``t0`` (``relative``: minus :meth:`sleeve`, the

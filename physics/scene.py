@@ -130,6 +130,16 @@ class Stator:
     friction: float = param(0.3, "-", 0.0, 1.0, "dry rotor-stator friction coefficient mu_st", "A")
     rotor_radius: float = param(0.045, "m", 1e-3, 1.0,
                                 "rotor radius R_a at the AMB planes (friction torque lever)", "A")
+    # the stator on its mount (effects.stator_mount): no source gives these; a radial AMB stator
+    # of a 100 kg rotor (stack ~200 mm outside, 40 mm long, with its coils) in a machine frame
+    mount_stiffness: float = param(2e8, "N/m", 1e5, 1e12,
+                                   "stiffness k_m of the stator's mount to the frame, per AMB plane"
+                                   " and axis, in series with the contact", "A")
+    mount_mass: float = param(8.0, "kg", 1e-2, 1e4,
+                              "participating mass m_m of each AMB stator (stack, coils)", "A")
+    mount_damping_ratio: float = param(0.05, "-", 0.0, 2.0,
+                                       "damping ratio of the stator on its mount (dashpot"
+                                       " c_m = 2 zeta sqrt(k_m m_m))", "A")
 
 
 @dataclass(frozen=True)
@@ -245,11 +255,22 @@ class Effects:
                           doc="friction heat warms each sleeve (one temperature state per plane"
                               " and two heat quadratures); the friction coefficient follows the"
                               " temperature (thermal.*); beyond the paper", tag="A")
-    friction: str = param("paper", "-", doc="rotor-sleeve friction slip definition",
+    friction: str = param("kinematic", "-",
+                          doc="rotor-sleeve friction slip law: kinematic (the friction opposes the"
+                              " sliding velocity of the contact points, v = r Omega + e_t -"
+                              " R omega_s, so it only dissipates) or paper (eq. 19 as printed: it"
+                              " follows Omega - omega_s, which for r != R pushes along the sliding"
+                              " and creates energy; for reproducing the paper, its metrics report"
+                              " the energy created)",
                           choices=("none", "paper", "kinematic"))
     stator_contact: bool = param(False, "-",
                                  doc="rotor-stator contact at the AMB planes once the rotor reaches"
                                      " amb.air_gap (stator.* parameters; no state)", tag="A")
+    stator_mount: bool = param(True, "-",
+                               doc="with stator_contact: each AMB stator is a mass on a spring-damper"
+                                   " mount (stator.mount_*; 4 states per AMB plane), so the"
+                                   " contact and the mount share a whip's force; off: the stator is"
+                                   " fixed to ground", tag="A")
     semi_active_damper: bool = param(False, "-",
                                      doc="support damping C_s is a controlled state lagging its command"
                                          " (needs housing; adds one state per housing)")

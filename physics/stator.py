@@ -51,14 +51,15 @@ def stator_force(px, py, pvx, pvy, W, gap, k, c, mu, radius, v_l):
     """Contact of the rotor axis at (px, py), moving at (pvx, pvy) and spinning at W, with the
     fixed stator bore of radial gap ``gap`` centred at the origin.
 
-    Returns (fx, fy, torque, f_n, elastic, p_diss): the force (fx, fy) and spin torque on the rotor,
-    the normal force F_n >= 0, its elastic part k δ and the power the contact dissipates (dashpot
-    and friction, >= 0 for the friction). All zero while the rotor is inside the gap.
+    Returns (fx, fy, torque, f_n, elastic, p_damp, p_fric): the force (fx, fy) and spin torque on
+    the rotor, the normal force F_n >= 0, its elastic part k δ and the powers the contact's
+    dashpot, (F_n − k δ) δ̇, and friction, F_μ v, take out of the motion (both >= 0). All zero
+    while the rotor is inside the gap.
     """
     r, nx, ny = geometry(px, py)
     delta = r - gap
     if delta <= 0.0:
-        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     tx, ty = -ny, nx
     ddelta = nx * pvx + ny * pvy
     elastic = k * delta
@@ -68,7 +69,7 @@ def stator_force(px, py, pvx, pvy, W, gap, k, c, mu, radius, v_l):
     slip = tx * pvx + ty * pvy + W * radius     # rotor surface velocity over the stator, along t
     f_mu = mu * f_n * smooth_sign(slip, v_l)
     return (-f_n * nx - f_mu * tx, -f_n * ny - f_mu * ty, -radius * f_mu, f_n, elastic,
-            (f_n - elastic) * ddelta + f_mu * slip)
+            (f_n - elastic) * ddelta, f_mu * slip)
 
 
 @njit

@@ -24,6 +24,7 @@ from hypothesis import strategies as st
 
 from physics import IntegrationError, SceneError, load_scene, simulate
 from agents.cli import main as cli_main
+from physics.dissipation import dissipation_check
 from physics.scene import GROUPS, Scene, parameter_table
 
 from helpers import energy_residual
@@ -73,7 +74,8 @@ CASES = list(_one_factor_extremes()) + list(_combined()) + list(_corners())
 
 # ---------------------------------------------------------------------------- the checks --
 def check_stable(result) -> None:
-    """Finite values and the energy balance kept (spec §1); unless the paper's slip law is on
+    """Finite values, every dissipative element's power >= 0 at every sample (the paper slip
+    law's friction excepted), and the energy balance kept (spec §1); unless the paper's slip law is on
     (its friction can do positive work), the dissipated energy does not decrease beyond
     integration noise, so the mechanical energy stays within the energy put in (up to the
     integration error). Step-size collapse and an exhausted step budget stop ``simulate`` with
@@ -88,6 +90,13 @@ def check_stable(result) -> None:
     # corners (linear 1e10 N/m contact, undamped support, no spin); an instability grows the
     # energy by orders of magnitude
     assert residual.max() <= 5e-2 * scale, "energy balance violated"
+    d = dissipation_check(result)
+    if scene.effects.friction == "paper":
+        # its friction may create energy (and the metrics report it); every other element
+        # still dissipates
+        assert set(d["negative"]) <= {"RB1.contact_friction", "RB2.contact_friction"}, d["negative"]
+    else:
+        assert d["ok"], f"negative dissipated power in {d['negative']}"
     if scene.effects.friction != "paper":
         # every dissipation term has non-negative power, so the dissipated energy may give back
         # only the balance's own error and the integrator's noise: the dense output of a step

@@ -13,8 +13,8 @@ from physics.stator import damping_coefficient, damping_ratio, restitution_of_da
 
 from helpers import energy_residual
 
-# sha256 of Result.Y (float64, C order) of simulate(load_scene("paper", {"contact.friction": mu}),
-# t_end=0.3), computed on the `ensembles` branch at bd3cbbd (its PI step control, beta 0.06),
+# sha256 of Result.Y (float64, C order) of simulate(load_scene("paper", {"contact.friction": mu,
+# "effects.friction": "paper"}), t_end=0.3) (the paper slip law was then the default), computed on the `ensembles` branch at bd3cbbd (its PI step control, beta 0.06),
 # before stator contact, the contact laws, the validity metrics and the thermal model existed. The new effects are off in the paper preset: the state history must not move
 # by one bit (a different CPU / numba / LLVM build could change the last bits; then re-derive the
 # hashes from main's code the same way before trusting a failure).
@@ -26,15 +26,38 @@ PAPER_STATE_SHA256 = {
 
 @pytest.mark.parametrize("mu", sorted(PAPER_STATE_SHA256))
 def test_paper_drop_is_bit_for_bit_unchanged_with_the_new_effects_off(mu):
-    r = simulate(load_scene("paper", {"contact.friction": mu}), t_end=0.3)
+    r = simulate(load_scene("paper", {"contact.friction": mu, "effects.friction": "paper"}),
+                 t_end=0.3)
     assert hashlib.sha256(np.ascontiguousarray(r.Y).tobytes()).hexdigest() == PAPER_STATE_SHA256[mu]
     assert not r.stator_force("AMB1").any()
 
 
-def test_stator_contact_adds_no_state():
-    on = simulate(load_scene("paper", {"effects.stator_contact": True}), t_end=0.12)
+def test_stator_contact_adds_no_state_and_its_mount_four_per_plane():
+    fixed = simulate(load_scene("paper", {"effects.stator_contact": True,
+                                          "effects.stator_mount": False}), t_end=0.12)
     off = simulate(load_scene("paper"), t_end=0.12)
-    assert on.model.names == off.model.names
+    assert fixed.model.names == off.model.names
+    mounted = simulate(load_scene("paper", {"effects.stator_contact": True}), t_end=0.12)
+    assert mounted.model.names == off.model.names + tuple(
+        f"{p}.stator_{n}" for p in ("AMB1", "AMB2") for n in ("x", "y", "vx", "vy"))
+    # no stator contact in this drop: the mounted stators stay at rest
+    assert not mounted.stator("AMB1").any()
+
+
+def test_a_mounted_stator_shares_a_whip_with_its_mount():
+    """A soft support lets the rotor reach the stators in a whirl. On its mount each stator
+    moves, the pair's forces are equal and opposite (the audit closes with the mount's energy),
+    and the stator moves by about F / k_m: the contact and the mount share the force."""
+    scene = load_scene("paper", {"effects.stator_contact": True, "support.stiffness": 5e6,
+                                 "contact.friction": 0.5, "solver.rtol": 1e-7})
+    r = simulate(scene, t_end=0.5)
+    f = r.stator_force("AMB1")
+    assert f.max() > 1000.0
+    q = np.hypot(*r.stator("AMB1").T)
+    k_m = scene.stator.mount_stiffness
+    assert q.max() == pytest.approx(f.max() / k_m, rel=0.5)         # quasi-static share
+    res, e = energy_residual(r)
+    assert res.max() < 1e-5 * e["dissipated"][-1]
 
 
 def point_mass_rebound(m, k, c, gap, v0, g=0.0, h=1e-7):
@@ -69,7 +92,8 @@ def test_a_rotor_dropped_straight_onto_the_stator_rebounds_like_the_point_mass()
     falls through the 600 µm air gap and hits both stators at once, its lever-rule share m/2 on
     each. Its rebound ratio (at the gap crossings) equals the point mass's under gravity (0.489;
     0.5 without gravity)."""
-    ov = {"effects.stator_contact": True, "contact.clearance": 0.003, "rotor.speed_rpm": 0.0,
+    ov = {"effects.stator_contact": True, "effects.stator_mount": False,     # a fixed stator
+          "contact.clearance": 0.003, "rotor.speed_rpm": 0.0,
           "effects.unbalance": False, "solver.output_rate": 1e6, "solver.rtol": 1e-8}
     r = simulate(load_scene("paper", ov), t_end=0.125)
     gap = r.model.scene.amb.air_gap
@@ -95,14 +119,16 @@ def test_stator_friction_opposes_the_surface_slip_and_brakes_the_spin():
     along -t = -Y (against its surface velocity Omega R_a t), its torque is -R_a mu F_n, and the
     contact dissipates F_mu times the slip speed."""
     k, gap, mu, R, W = 2e9, 600e-6, 0.3, 0.045, 1000.0
-    fx, fy, torque, f_n, elastic, p = stator_force(gap + 1e-5, 0.0, 0.0, 0.0, W, gap, k, 0.0, mu, R, 1e-3)
+    fx, fy, torque, f_n, elastic, p_damp, p = stator_force(gap + 1e-5, 0.0, 0.0, 0.0, W, gap, k,
+                                                           0.0, mu, R, 1e-3)
     assert f_n == pytest.approx(k * 1e-5) and elastic == pytest.approx(f_n)
     assert fx == pytest.approx(-f_n)                    # pushes the rotor back inside
     assert fy == pytest.approx(-mu * f_n)
     assert torque == pytest.approx(-R * mu * f_n)
     assert p == pytest.approx(mu * f_n * W * R)
+    assert p_damp == 0.0                                # no dashpot (c = 0)
     # inside the gap: nothing
-    assert stator_force(gap - 1e-6, 0.0, 1.0, 0.0, W, gap, k, 1e5, mu, R, 1e-3) == (0.0,) * 6
+    assert stator_force(gap - 1e-6, 0.0, 1.0, 0.0, W, gap, k, 1e5, mu, R, 1e-3) == (0.0,) * 7
 
 
 def test_default_stator_stiffness_is_the_line_contact_secant():

@@ -1,0 +1,113 @@
+"""Every dissipative element takes energy out of the motion, at every output sample.
+
+The energy audit (test_energy.py) ties each applied force to the power it integrates; these
+tests tie each power's sign to its physics (physics/dissipation.py). Together they fail when a
+friction or damping sign is flipped in the kernel: tests/mutants.py flips each one in a copy of
+the package and runs this file and test_energy.py against it.
+"""
+import numpy as np
+import pytest
+
+from physics import load_scene, simulate
+from physics.dissipation import PLANE_TERMS, STATOR_TERMS, dissipation_check, dissipation_powers
+from physics.metrics import compute_metrics
+
+from helpers import energy_residual
+
+# a drop that exercises every element: whirl (sliding under load), stator contact, a
+# semi-active damper, and a second, unsymmetric plane
+WHIRL = {"contact.friction": 0.5}
+VARIANTS = [
+    ("paper", {}),
+    ("paper, whirl", WHIRL),
+    ("spec", {}),
+    ("asymmetric, whirl", WHIRL),
+    ("paper, whirl, stator contact", {**WHIRL, "effects.stator_contact": True,
+                                      "support.stiffness": 5e6}),
+    ("paper, whirl, semi-active damper", {**WHIRL, "effects.semi_active_damper": True}),
+    ("paper, whirl, linear bearing", {**WHIRL, "effects.retainer_bearing": "linear"}),
+    ("paper, whirl, massless sleeve", {**WHIRL, "effects.sleeve_inertia": False}),
+    ("paper, whirl, hertz_line", {**WHIRL, "contact.law": "hertz_line"}),
+    ("paper, whirl, thermal", {**WHIRL, "effects.thermal": True, "thermal.mu_slope": 0.02}),
+]
+
+
+def _drop(name: str, overrides: dict, t_end: float = 0.5):
+    return simulate(load_scene(name.split(",")[0], overrides), t_end=t_end)
+
+
+@pytest.mark.parametrize("label, overrides", VARIANTS, ids=[v[0] for v in VARIANTS])
+def test_every_element_dissipates_at_every_sample(label, overrides):
+    r = _drop(label, overrides)
+    check = dissipation_check(r)
+    assert check["ok"], check["negative"]
+    assert check["created_energy_J"] == 0.0
+    powers = dissipation_powers(r)
+    # the elements this drop switches on do work (so the check saw them act)
+    assert powers["RB1.contact_friction"].max() > 100.0
+    assert powers["RB1.contact_damping"].max() > 0.0
+    if "stator" in label:
+        assert powers["AMB1.stator_friction"].max() > 0.0
+        assert powers["AMB1.stator_damping"].max() > 0.0
+        assert powers["AMB1.stator_mount_damping"].max() > 0.0
+    # the per-element powers add up to the audit's dissipated energy: the check reads the
+    # powers the kernel integrates, not a copy of them (the massless sleeve also counts the
+    # drag it passes on, which is one of these terms)
+    e = r.energy()
+    t = r.t
+    total = sum(powers.values())
+    integral = np.sum(0.5 * (total[1:] + total[:-1]) * np.diff(t))
+    assert integral == pytest.approx(e["dissipated"][-1] - e["dissipated"][0], rel=2e-2)
+
+
+def test_the_paper_slip_law_creates_energy_and_says_so():
+    """Eq. 19 as printed follows Omega - omega_s: with r != R it pushes along the sliding (the
+    sleeve driven towards Omega overtakes the no-slip speed Omega r / R), and the metrics report
+    the energy it created; the kinematic law on the same drop creates none."""
+    scene = load_scene("paper", {"effects.friction": "paper"})
+    r = simulate(scene)
+    m = compute_metrics(r)
+    d = m["dissipation"]
+    assert not d["ok"] and set(d["negative"]) == {"RB1.contact_friction", "RB2.contact_friction"}
+    created = [m["planes"][p]["friction_energy_created_J"] for p in ("RB1", "RB2")]
+    assert min(created) > 0.1
+    assert d["created_energy_J"] == pytest.approx(sum(created), rel=0.05)   # (pre-fault too)
+    assert any("created" in w and "paper" in w for w in m["warnings"])
+    # the sleeve ends faster than the no-slip speed Omega r / R: the law drove it past
+    ratio = scene.rotor.journal_radius / (scene.rotor.journal_radius + scene.contact.clearance)
+    assert r.sleeve_speed("RB1")[-1] > 1.005 * ratio * r.rotor_speed[-1]
+    kin = compute_metrics(simulate(scene.with_overrides({"effects.friction": "kinematic"})))
+    assert kin["dissipation"]["ok"] and not any("created" in w for w in kin["warnings"])
+    assert all(kin["planes"][p]["friction_energy_created_J"] == 0.0 for p in ("RB1", "RB2"))
+    # and there the sleeve ends at the no-slip speed
+    rk = simulate(scene.with_overrides({"effects.friction": "kinematic"}))
+    assert rk.sleeve_speed("RB1")[-1] == pytest.approx(ratio * rk.rotor_speed[-1], rel=2e-3)
+
+
+def test_the_default_law_dissipates_in_every_preset():
+    for name in ("paper", "spec", "asymmetric"):
+        assert load_scene(name).effects.friction == "kinematic", name
+
+
+def test_stiff_support_whirl_heats_both_planes_over_six_seconds():
+    """K_s = 5e8, mu = 0.25: the whirl runs away after 1 s; under the paper law the net friction
+    work per plane turned negative at 2.05 s. With the default law the friction heat stays
+    positive and never decreases, to the end."""
+    r = simulate(load_scene("paper", {"support.stiffness": 5e8, "solver.output_rate": 2000.0}),
+                 t_end=6.0)
+    m = compute_metrics(r)
+    assert m["backward_whirl"]
+    assert m["dissipation"]["ok"], m["dissipation"]["negative"]
+    for p in ("RB1", "RB2"):
+        assert m["planes"][p]["friction_heat_J"] > 100.0
+        assert m["planes"][p]["friction_energy_created_J"] == 0.0
+    res, e = energy_residual(r)
+    assert res.max() < 1e-3 * e["dissipated"][-1]
+
+
+def test_the_check_names_every_element():
+    """The diagnostics cover every dissipative element of the kernel (a new one must be added
+    to physics/dissipation.py to be checked)."""
+    assert set(PLANE_TERMS) == {"contact_friction", "contact_damping", "bearing_damping",
+                                "bearing_drag", "support_damping"}
+    assert set(STATOR_TERMS) == {"stator_damping", "stator_friction", "stator_mount_damping"}
