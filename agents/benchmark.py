@@ -8,7 +8,7 @@
 2. **Scenarios** (:func:`scenario_suite`): frictions μ* + 0.05, + 0.10, + 0.15 (passive whirls),
    0.10 (passive rests: a controller must do no harm), 0.25 (the paper's base case) and 0.6; at
    μ* + 0.05: support stiffness 2e6 and 1e9 N/m, spin speed 6000 and 15000 rpm, a 5 g
-   unbalance, the kinematic friction law, and (re-levitation tasks) power back at 0.15 s. A
+   unbalance, the paper's slip law (eq. 19 as printed: a model-form change), and (re-levitation tasks) power back at 0.15 s. A
    scenario is in-distribution when all its values lie inside the environments' default
    randomisation ranges (the training distribution of the shipped policies), else out of it.
    Each scenario runs once per unbalance phase (``PHASES``): the episodes are deterministic.
@@ -145,7 +145,7 @@ def scenario_suite(threshold: float | None, quick: bool = False,
               Scenario("6000 rpm", mu, {"rotor.speed_rpm": 6000.0}),
               Scenario("15000 rpm", mu, {"rotor.speed_rpm": 15000.0}),
               Scenario("unbalance 5 g", mu, {"unbalance.mass": 5e-3}),
-              Scenario("kinematic friction", mu, {"effects.friction": "kinematic"}),
+              Scenario("paper slip law", mu, {"effects.friction": "paper"}),
               Scenario("power back at 0.15 s", mu, env_kwargs={"power_return_time": 0.15},
                        tasks=relev)]
     if power_return is not None:

@@ -5,7 +5,7 @@ disagree with the criterion rather than with a bare yes/no.
 """
 from __future__ import annotations
 
-from .paper import BASE, DAMPING, SOFT, STIFF, STIFFNESS
+from .paper import BASE, DAMPING, PRIMARY_SLIP, SOFT, STIFF, STIFFNESS
 
 PAPER_THRESHOLD = 0.39          # paper §V-A
 PAPER_SOFT_Y_UM = 600.0         # paper §V-B
@@ -38,21 +38,21 @@ def _fmt(x, spec=".2f", none="-"):
 
 
 # -- friction study -------------------------------------------------------------------------
-def _onset(a, slip="paper"):
+def _onset(a, slip=PRIMARY_SLIP):
     return a["friction_onset"][f"{slip}, drag on"]
 
 
-def _obs(a, slip="paper"):
+def _obs(a, slip=PRIMARY_SLIP):
     return a["friction_observables"][f"{slip}, drag on"]
 
 
 def _threshold(a, _c):
-    p, k = _onset(a, "paper"), _onset(a, "kinematic")
+    p, k = _onset(a, "kinematic"), _onset(a, "paper")
     th = p["threshold"]
     ok = th is not None and abs(th - PAPER_THRESHOLD) <= 0.03
-    ours = (f"50 % whirl probability at μ = {_fmt(th)} (paper slip), {_fmt(k['threshold'])} "
-            f"(kinematic); lowest μ that ever whirls {_fmt(p['lowest_whirl'])}; every drop whirls "
-            f"from μ = {_fmt(p['certain_from'])}; p crosses 50 % {p['crossings']} time(s)")
+    ours = (f"50 % whirl probability at μ = {_fmt(th)} (kinematic slip), {_fmt(k['threshold'])} "
+            f"(paper's eq. 19); lowest μ that ever whirls {_fmt(p['lowest_whirl'])}; every drop "
+            f"whirls from μ = {_fmt(p['certain_from'])}; p crosses 50 % {p['crossings']} time(s)")
     why = ("the onset in this model is not a sharp μ: whirl windows open below the μ from which "
            "every drop whirls, and their position moves with the assumed housing mass and the "
            "contact-stiffness unit reading (see Sensitivity); one deterministic run per μ, as in "

@@ -13,7 +13,7 @@ from ..plots import RPM, orbit_panel, save_figure  # noqa: E402
 from ..results import Result  # noqa: E402
 from .checks import counts_text, warnings_note  # noqa: E402
 from .claims import PAPER_SOFT_Y_UM, PAPER_THRESHOLD  # noqa: E402
-from .paper import BASE, SOFT  # noqa: E402
+from .paper import BASE, PRIMARY_SLIP, SOFT  # noqa: E402
 from .labels import PLANE_KPIS, value_label  # noqa: E402
 
 PLANE = "RB1"           # the paper's figures are at retainer bearing 1
@@ -88,7 +88,7 @@ def plot_friction_runs(runs: dict[float, Result], out: Path) -> list[str]:
 
 
 def plot_friction_response(a: dict, out: Path) -> str:
-    rows = a["friction_observables"]["paper, drag on"]
+    rows = a["friction_observables"][f"{PRIMARY_SLIP}, drag on"]
     fig, axes = plt.subplots(1, 2, figsize=(10, 3.8), constrained_layout=True)
     for tag, st in (("no_whirl", "C0o"), ("whirl", "C3s")):
         pts = [(r["friction"], r[tag]) for r in rows if r[tag] is not None]
@@ -104,7 +104,7 @@ def plot_friction_response(a: dict, out: Path) -> str:
     for ax in axes:
         ax.set_xlabel("friction coefficient μ")
         ax.legend(fontsize=8)
-    fig.suptitle("Response against friction, split by outcome (paper slip, bearing drag on)")
+    fig.suptitle(f"Response against friction, split by outcome ({PRIMARY_SLIP} slip, bearing drag on)")
     return _save(fig, out / "friction_response.png")
 
 
@@ -206,8 +206,8 @@ def write_report(a: dict, out: Path, figures: dict[str, list[str]], meta: dict) 
     w(_checks_text(a))
     w("## Summary\n")
     w("| quantity | paper | ours |\n|---|---|---|")
-    w(f"| whirl threshold (50 % probability), paper slip | 0.39 | {_f(th['paper'])} |")
-    w(f"| whirl threshold (50 % probability), kinematic slip | – | {_f(th['kinematic'])} |")
+    w(f"| whirl threshold (50 % probability), kinematic slip (default) | 0.39 | {_f(th['kinematic'])} |")
+    w(f"| whirl threshold (50 % probability), paper's eq. 19 (creates energy) | – | {_f(th['paper'])} |")
     soft = next((r for r in a["support_stiffness"] if r["stiffness"] == SOFT), {})
     w(f"| max Y at {_soft_case(a)} | ≈ 600 µm | {_f(soft.get('max_y_displacement_um'), '.0f')} µm |")
     n_ok = sum(c["reproduced"] for c in a["claims"])
@@ -293,7 +293,7 @@ def write_report(a: dict, out: Path, figures: dict[str, list[str]], meta: dict) 
     w(f"Each assumed [A] parameter moved within its plausible range, one at a time, around the "
       f"`{a['scene']}` scene: whirl onset from μ = {a['plan']['sensitivity_frictions'][0]:g} … "
       f"{a['plan']['sensitivity_frictions'][-1]:g} with {a['plan']['sensitivity_members']} drops "
-      f"per μ (paper slip), and the soft-support response ({_soft_case(a)}, median of "
+      f"per μ ({PRIMARY_SLIP} slip), and the soft-support response ({_soft_case(a)}, median of "
       f"{a['plan']['soft_members']}).\n")
     w(f"![sensitivity]({figures['sensitivity'][0]})\n")
     w("| parameter | value | 50 % crossing | every drop whirls from | lowest whirl | "

@@ -10,7 +10,7 @@ from ..backend import Backend, plan_threads
 from . import report
 from .checks import warnings_note
 from .claims import claims
-from .paper import (SENSITIVITY, Plan, StudyInput, analyse, plan_runs, run_study,
+from .paper import (PRIMARY_SLIP, SENSITIVITY, Plan, StudyInput, analyse, plan_runs, run_study,
                     simulate_figure_drop)
 
 
@@ -55,7 +55,7 @@ def run_paper_study(source: str, overrides: dict, out_dir, quick: bool = False,
     ok = sum(c["reproduced"] for c in a["claims"])
     flagged = warnings_note(a["warnings"]["total"])
     notes = [n for n in (jobs_note and f"note: {jobs_note}", dispatch.note(), flagged) if n]
-    return (f"whirl threshold (50 %): paper slip {th['paper']}, kinematic {th['kinematic']}; "
+    return (f"whirl threshold (50 %): kinematic slip {th['kinematic']}, paper's eq. 19 {th['paper']}; "
             f"{ok}/{len(a['claims'])} claims reproduced; {a['runs']['failed']} of "
             f"{a['runs']['total']} runs failed; {wall:.0f} s\n" + "".join(n + "\n" for n in notes)
             + f"wrote {path}, {out / 'study.json'}")
@@ -79,14 +79,14 @@ def friction_runs(base: StudyInput, plan: Plan) -> dict:
 def interesting_runs(a: dict, outcomes, base: StudyInput, plan: Plan) -> list[tuple[str, str]]:
     """Reproduce commands for a few drops worth looking at."""
     fr = [o for o in outcomes if o.ok and o.run.label["study"] == "friction"
-          and o.run.label["slip"] == "paper" and o.run.label["drag"]]
+          and o.run.label["slip"] == PRIMARY_SLIP and o.run.label["drag"]]
     fr.sort(key=lambda o: (o.run.label["friction"], o.run.label["member"]))
     out = []
     first = next((o for o in fr if o.metrics["backward_whirl"]), None)
     if first is not None:
         out.append((f"the lowest-μ drop that whirls (μ = {first.run.label['friction']:g})",
                     first.run.to_dict()["command"]))
-    certain = a["friction_onset"]["paper, drag on"].get("certain_from")
+    certain = a["friction_onset"][f"{PRIMARY_SLIP}, drag on"].get("certain_from")
     if certain is not None:
         calm = [o for o in fr if not o.metrics["backward_whirl"] and o.run.label["friction"] < certain]
         if calm:
