@@ -147,7 +147,9 @@ def hard_section(reports: list[tuple[dict, str]]) -> list[str]:
     out = ["## Hard benchmark", "",
            "Re-levitation on raw coil currents, learned from scratch in 60 minutes on one core "
            "([rules and commands](agents.md#hard-benchmark-raw-currents-from-scratch)); every "
-           "row is `rotordrop evaluate` on the 200 held-out drops.", "",
+           "row is `rotordrop evaluate` on the 200 held-out drops. A baseline's row "
+           "(`pid-relevitate`: designed PD with gravity feed-forward on the currents) is the "
+           "reference a learned entry is compared with.", "",
            "| policy | drops | re-levitation rate | after the power return (median / 90 % / max) | "
            "whirl rate | stator contact | data |",
            "|---|---|---:|---:|---:|---:|---|"]
