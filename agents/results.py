@@ -158,34 +158,42 @@ def hard_section(reports: list[tuple[dict, str]]) -> list[str]:
 
 
 def learning_curves(root: Path) -> list[str]:
-    """One row per learning-curve figure under docs/img (learning-*.png, hard-*.png with a CSV)."""
-    img = root / IMG
-    pngs = sorted(p for p in img.glob("learning-*.png")) + sorted(
+    """One row per curve of each learning-curve figure under docs/img (``learning-*.png``, and
+    ``hard-*.png`` with a CSV): from the CSV beside the figure (``python -m
+    agents.learning_curves`` writes it), the runs, the last step and the best point; and the
+    pages that discuss the figure."""
+    img, docs = root / IMG, root / "docs"
+    pngs = sorted(img.glob("learning-*.png")) + sorted(
         p for p in img.glob("hard-*.png") if p.with_suffix(".csv").exists())
+    pages = [p for p in sorted(docs.rglob("*.md")) if p.name != RESULTS.name]
     out = ["## Learning curves", "",
            "Each figure is drawn by `python -m agents.learning_curves` from the runs' "
-           "`training.json`; where the CSV beside it is committed, the table gives its best "
-           "point (mean over the runs at that step).", "",
-           "| figure | runs | seeds | last step | best point (mean over seeds) |",
-           "|---|---|---:|---:|---|"]
+           "`training.json`, with a CSV beside it; the table gives, per curve, the best point of "
+           "the mean over its runs (± the std over runs at that step).", "",
+           "| figure | curve | runs | last step | best point | discussed in |",
+           "|---|---|---:|---:|---|---|"]
     for png in pngs:
-        rel = png.relative_to(root / "docs").as_posix()
+        rel = png.relative_to(docs).as_posix()
+        seen = [p for p in pages if png.name in p.read_text()]
+        where = ", ".join(f"[{p.stem}]({p.relative_to(docs).as_posix()})" for p in seen) or "–"
         c = png.with_suffix(".csv")
         if not c.exists():
-            out.append(f"| [{png.name}]({rel}) | – | – | – | no CSV committed |")
+            out.append(f"| [{png.name}]({rel}) | – | – | – | no CSV committed | {where} |")
             continue
         with c.open(newline="") as fh:
             rows = list(csv.DictReader(fh))
         qty = next(k[:-5] for k in rows[0] if k.endswith("_mean"))
-        labels = list(dict.fromkeys(r["label"] for r in rows))
-        best = max(rows, key=lambda r: float(r[f"{qty}_mean"]))
-        runs = "; ".join(f"{lab} ({max(int(r['runs']) for r in rows if r['label'] == lab)})"
-                         for lab in labels)
-        last = max(int(r["timesteps"]) for r in rows)
-        out.append(f"| [{png.name}]({rel}) | {runs} | "
-                   f"{max(int(r['runs']) for r in rows)} | {last} | {qty} "
-                   f"{float(best[f'{qty}_mean']):.4g} at {int(best['timesteps'])} "
-                   f"({best['label']}) |")
+        for i, label in enumerate(dict.fromkeys(r["label"] for r in rows)):
+            mine = [r for r in rows if r["label"] == label]
+            best = max(mine, key=lambda r: float(r[f"{qty}_mean"]))
+            std = float(best.get(f"{qty}_std") or 0.0)
+            point = (f"{qty} {float(best[f'{qty}_mean']):.4g}"
+                     + (f" ± {std:.2g}" if int(best["runs"]) > 1 else "")
+                     + f" at step {int(best['timesteps'])}")
+            first = f"[{png.name}]({rel})" if i == 0 else ""
+            out.append(f"| {first} | {label} | {max(int(r['runs']) for r in mine)} | "
+                       f"{max(int(r['timesteps']) for r in mine)} | {point} | "
+                       f"{where if i == 0 else ''} |")
     return out + [""]
 
 
