@@ -261,8 +261,8 @@ def generated(root: Path = ROOT) -> dict[Path, str]:
     return {root / RESULTS: results_page(root), root / README: readme_text(root)}
 
 
-def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog="python -m agents.results", description=__doc__.split("\n")[0])
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """The options of ``python -m agents.results`` and ``rotordrop results``."""
     p.add_argument("--nominal", help="a `rotordrop benchmark` benchmark.json to store as "
                                      "docs/data/leaderboard-nominal.json")
     p.add_argument("--robust", help="a `rotordrop benchmark --suite robust` benchmark.json to "
@@ -273,10 +273,14 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--root", default=str(ROOT), help="the project folder (default: this checkout)")
     p.add_argument("--check", action="store_true",
                    help="write nothing; exit 1 if the committed pages differ from the data")
-    args = p.parse_args(argv)
+
+
+def run(args) -> int:
+    """Store the given benchmark output in docs/data and regenerate the pages (or ``--check``)."""
     root = Path(args.root)
     if args.check and (args.nominal or args.robust or args.hard):
-        p.error("--check takes no data files")
+        print("results: error: --check takes no data files", file=sys.stderr)
+        return 2
     stored = []
     if args.nominal:
         stored.append(store(args.nominal, root / DATA / "leaderboard-nominal.json", drop=DROPPED_KEYS))
@@ -302,6 +306,12 @@ def main(argv: list[str] | None = None) -> int:
     print("wrote " + ", ".join(str(s.relative_to(root)) for s in stored + stale) if stored + stale
           else "nothing to change")
     return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(prog="python -m agents.results", description=__doc__.split("\n")[0])
+    add_arguments(p)
+    return run(p.parse_args(argv))
 
 
 if __name__ == "__main__":
