@@ -165,7 +165,8 @@ def learning_curves(root: Path) -> list[str]:
     img, docs = root / IMG, root / "docs"
     pngs = sorted(img.glob("learning-*.png")) + sorted(
         p for p in img.glob("hard-*.png") if p.with_suffix(".csv").exists())
-    pages = [p for p in sorted(docs.rglob("*.md")) if p.name != RESULTS.name]
+    pages = [docs / "agents.md"] + sorted((docs / "experiments").glob("*.md"))
+    pages = [p for p in pages if p.exists()]
     out = ["## Learning curves", "",
            "Each figure is drawn by `python -m agents.learning_curves` from the runs' "
            "`training.json`, with a CSV beside it; the table gives, per curve, the best point of "
