@@ -13,6 +13,8 @@ Data files (each written by the project's own commands; only what the tables nee
 =====================================  =======================================================
 ``docs/data/leaderboard-nominal.json``  ``rotordrop benchmark --out DIR``: ``DIR/benchmark.json``
 ``docs/data/leaderboard-robust.json``   ``rotordrop benchmark --suite robust --out DIR``: ``DIR/benchmark.json``
+``docs/data/oracle-nominal.json``       ``rotordrop oracle --out DIR``: ``DIR/oracle.json``
+``docs/data/oracle-robust.json``        ``rotordrop oracle --suite robust --out DIR``: ``DIR/oracle.json``
 ``docs/data/hard-<name>.json``          ``rotordrop evaluate ... --episodes 200 --seed 900000 --out DIR``: ``DIR/kpis.json``
 =====================================  =======================================================
 
@@ -20,6 +22,7 @@ After re-running a benchmark, hand its output to the command, which stores it an
 the pages in one go::
 
     python -m agents.results --nominal out/bench/benchmark.json --robust out/robust/benchmark.json \\
+        --oracle-nominal out/oracle/oracle.json --oracle-robust out/oracle-robust/oracle.json \\
         --hard out/hard-tqc/kpis.json
 
 ``--check`` writes nothing and exits 1 when the committed pages differ from what the committed
@@ -115,6 +118,48 @@ def robust_section(report: dict, source: str) -> list[str]:
             out.append(f"| {', '.join(f'`{m}`' for m in g['members'])} | "
                        f"{', '.join(_f(s) for s in g['scores'])} | {_f(g['mean'])} | "
                        f"{_f(g['std'])} | {_f(g['mean_minus_std'])} |")
+        out.append("")
+    return out
+
+
+ORACLE_KEYS = ("command", "settings", "summary")
+
+
+def _learned_names(root: Path) -> set[str]:
+    return {p.stem for p in (root / "agents" / "policies").glob("*.zip")}
+
+
+def oracle_section(reports: list[tuple[str, dict, str]], root: Path) -> list[str]:
+    """The per-drop bound of the supervisor interface (``rotordrop oracle``) against the designed
+    rows scored on the same drops. Learned rows are left out here (policies are replaced; their
+    standing is in the leaderboards above)."""
+    learned = _learned_names(root)
+    out = ["## Oracle bound", "",
+           "`rotordrop oracle` searches, per drop, the best open-loop command sequence of the "
+           "supervisor interface, knowing the drop in advance: it bounds what any policy of that "
+           "interface reaches on those drops, within the search's budget "
+           "([how](agents.md#the-supervisor-interface)). Designed rows scored on the same drops; a "
+           "row `constant g=G r=R` is `inner-loop` with the constant gain action G and radial "
+           "offset R clearance (`inner-loop-lift` is g=0.5 r=-0.5).", ""]
+    for title, r, src in reports:
+        s = r["settings"]
+        rows = [e for e in r["summary"] if e["controller"] == "oracle"
+                or (e["controller"] not in learned and "@" not in e["controller"])]
+        designed = [e for e in rows if e["controller"] != "oracle"]
+        oracle = next((e for e in rows if e["controller"] == "oracle"), None)
+        best = max(designed, key=lambda e: e["score"]) if designed else None
+        seed = s.get("scenario_seed")
+        out += [f"### {title}", "",
+                f"{s.get('scenarios')} drops (scenario seeds {seed}–{seed + s.get('scenarios', 1) - 1}), "
+                f"search {s.get('population')} × {s.get('iterations')} per drop (data: `{src}`)."
+                + (f" Oracle over the best designed row (`{best['controller']}`): "
+                   f"**{oracle['score'] - best['score']:+.2f}** points." if oracle and best else ""), "",
+                "| row | score | whirl rate | whirl where passive whirls | re-levitated | mean J |",
+                "|---|---:|---:|---:|---:|---:|"]
+        for e in rows:
+            out.append(f"| `{e['controller']}` | {_f(e['score'])} | {_f(e['whirl_rate'])} | "
+                       f"{_f(e.get('whirl_rate_where_passive_whirls'))} | "
+                       f"{_f(e.get('relevitation_rate'))} | {_f(e.get('mean_J'), '.3f')} |")
         out.append("")
     return out
 
@@ -219,6 +264,12 @@ def results_page(root: Path = ROOT) -> str:
     robust = _load(data / "leaderboard-robust.json")
     if robust:
         lines += robust_section(robust, (DATA / "leaderboard-robust.json").as_posix())
+    oracles = [(title, json.loads((data / name).read_text()), (DATA / name).as_posix())
+               for title, name in (("Nominal drops", "oracle-nominal.json"),
+                                   ("Robust suite", "oracle-robust.json"))
+               if (data / name).exists()]
+    if oracles:
+        lines += oracle_section(oracles, root)
     hard = [(json.loads(p.read_text()), (DATA / p.name).as_posix())
             for p in sorted(data.glob("hard-*.json"))]
     if hard:
@@ -271,6 +322,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--hard", action="append", default=[],
                    help="a `rotordrop evaluate` kpis.json of the hard benchmark to store as "
                         "docs/data/hard-<policy>.json (repeatable)")
+    p.add_argument("--oracle-nominal", help="a `rotordrop oracle` oracle.json (nominal drops) to "
+                                            "store as docs/data/oracle-nominal.json")
+    p.add_argument("--oracle-robust", help="a `rotordrop oracle --suite robust` oracle.json to "
+                                           "store as docs/data/oracle-robust.json")
     p.add_argument("--root", default=str(ROOT), help="the project folder (default: this checkout)")
     p.add_argument("--check", action="store_true",
                    help="write nothing; exit 1 if the committed pages differ from the data")
@@ -279,7 +334,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def run(args) -> int:
     """Store the given benchmark output in docs/data and regenerate the pages (or ``--check``)."""
     root = Path(args.root)
-    if args.check and (args.nominal or args.robust or args.hard):
+    given = (args.nominal, args.robust, args.hard, args.oracle_nominal, args.oracle_robust)
+    if args.check and any(given):
         print("results: error: --check takes no data files", file=sys.stderr)
         return 2
     stored = []
@@ -287,6 +343,10 @@ def run(args) -> int:
         stored.append(store(args.nominal, root / DATA / "leaderboard-nominal.json", drop=DROPPED_KEYS))
     if args.robust:
         stored.append(store(args.robust, root / DATA / "leaderboard-robust.json", drop=DROPPED_KEYS))
+    for src, name in ((args.oracle_nominal, "oracle-nominal.json"),
+                      (args.oracle_robust, "oracle-robust.json")):
+        if src:
+            stored.append(store(src, root / DATA / name, keep=ORACLE_KEYS))
     for h in args.hard:
         name = re.sub(r"[^A-Za-z0-9_.-]+", "-", json.loads(Path(h).read_text())["policy"]).strip("-")
         stored.append(store(h, root / DATA / f"hard-{name}.json", keep=HARD_KEYS))
