@@ -255,8 +255,9 @@ def results_page(root: Path = ROOT) -> str:
              "do not edit by hand. -->", "",
              "Every table on this page is generated from committed benchmark output by "
              "`python -m agents.results` (after re-running a benchmark: "
-             "`python -m agents.results --nominal out/bench/benchmark.json`, likewise "
-             "`--robust` and `--hard`). How the rows came to be is in the "
+             "`rotordrop results --nominal out/bench/benchmark.json`, likewise `--robust`, "
+             "`--oracle-nominal`, `--oracle-robust` and `--hard`; "
+             "[the commands](agents.md#benchmark-results)). How the rows came to be is in the "
              "[experiment log](experiments/index.md).", ""]
     nominal = _load(data / "leaderboard-nominal.json")
     if nominal:

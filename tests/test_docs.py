@@ -33,6 +33,11 @@ def test_results_command_stores_benchmark_output_and_regenerates(tmp_path):
     assert "\nold\n" not in readme and "| 1 | `whirl-brake` |" in readme
     assert "## Nominal suite" in (root / "docs/results.md").read_text()
     assert results.main(["--root", str(root), "--check"]) == 0
+    oracle = tmp_path / "oracle.json"
+    oracle.write_text((ROOT / "docs/data/oracle-robust.json").read_text())
+    assert results.main(["--root", str(root), "--oracle-robust", str(oracle)]) == 0
+    page = (root / "docs/results.md").read_text()
+    assert "## Oracle bound" in page and "| `oracle` |" in page
     (root / "docs/results.md").write_text("edited by hand\n")
     assert results.main(["--root", str(root), "--check"]) == 1
 
