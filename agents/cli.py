@@ -1,5 +1,5 @@
 """The ``rotordrop`` command line (entry point :func:`main`) and agents' commands ``train |
-evaluate | benchmark | oracle | tune | ride-through | export-policy`` (and ``research``, :mod:`agents.research`).
+evaluate | benchmark | oracle | tune | ride-through | export-policy | results`` (and ``research``, :mod:`agents.research`).
 
 This top-layer module builds the parser from every layer's ``register(subparsers)``: physics'
 ``drop``, ``params`` (:mod:`physics.cli`), ``study`` and ``accuracy``, then agents' own. Registration
@@ -373,12 +373,25 @@ def register(sub) -> None:
     p.set_defaults(func=cmd_ride_through)
 
 
+def cmd_results(args) -> int:
+    from . import results
+    return results.run(args)
+
+
+def register_results(sub) -> None:
+    from . import results
+    p = sub.add_parser("results", help="docs/results.md and the README leaderboard from the "
+                                       "benchmark output committed in docs/data")
+    results.add_arguments(p)
+    p.set_defaults(func=cmd_results)
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="rotordrop", description="AMB rotor drop onto retainer "
                                      "bearings: simulation, studies, Gymnasium environments and agents")
     sub = parser.add_subparsers(dest="command", required=True)
     for register_commands in (physics_cli.register, study.register, accuracy.register, register,
-                              research.register):
+                              register_results, research.register):
         register_commands(sub)
     return parser
 

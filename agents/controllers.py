@@ -410,7 +410,7 @@ class InnerLoopLift(InnerLoop):
     radius, which shortens the ramped lift-off (on the robust suite it re-levitates a median
     16 ms after the power return, ``inner-loop`` 63 ms). The two constants were chosen on the robust validation set (seeds 40 000-40 019) among gain
     {0, 0.5, 1} x offset {0, -0.25, -0.5, -0.75, -1} before any test drop was scored with them
-    (docs/agents.md, "Oracle on the robust suite")."""
+    (docs/experiments/2026-11-26-robust-oracle.md)."""
 
     name = "inner-loop-lift"
     GAINS = dict(gain=0.5, offset_r=-0.5)

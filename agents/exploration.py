@@ -5,7 +5,7 @@ interface the entries differ: noise on the dampers costs reward at every step (a
 command below C_max lets the bounce grow), while the gain scale and the radial offsets are
 read by nothing before the PID is on, and the lift assist that pays lies half a clearance
 away (``inner-loop-lift``: gain 0.5, offsets −0.5). With one small spread (std 0.14) the
-runs of docs/agents.md stopped at offsets of about −0.15. ``action_log_std`` sets the initial
+runs of docs/experiments/2026-11-27-full-authority-from-max.md stopped at offsets of about −0.15. ``action_log_std`` sets the initial
 log standard deviation of the named entries; the others keep ``log_std_init``. The spread is
 still learned; it is only where training starts.
 

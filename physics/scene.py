@@ -96,7 +96,8 @@ class Amb:
 
 @dataclass(frozen=True)
 class Contact:
-    clearance: float = param(300e-6, "m", 1e-6, 0.01, "rotor-sleeve radial air gap c = R - r")
+    clearance: float = param(300e-6, "m", 1e-6, 0.01, "rotor-sleeve radial air gap c = R - r (the retainer"
+                                " clearance; not bearing.clearance, the ball bearing's play)")
     stiffness: float = param(1e8, "N/m^e", 1e5, 1e12,
                              "contact stiffness K (paper: 1e8, unit reading N/m^1.1 assumed;"
                              " the N-mm reading would be 2.0e8)")
@@ -187,7 +188,8 @@ class Bearing:
     pitch_diameter: float = param(0.110, "m", 1e-3, 2.0, "pitch diameter d_m")
     ball_diameter: float = param(0.01905, "m", 1e-4, 0.5, "ball diameter D")
     balls: int = param(10, "-", 3, 100, "number of balls z")
-    clearance: float = param(15e-6, "m", 0.0, 1e-3, "diametral clearance P_d")
+    clearance: float = param(15e-6, "m", 0.0, 1e-3, "ball-bearing internal diametral play P_d (not"
+                                " contact.clearance, the rotor-sleeve air gap)")
     damping: float = param(250.0, "N s/m", 0.0, 1e6, "bearing damping c_b")
     conformity: float = param(0.52, "-", 0.501, 0.7, "race conformity f (inner and outer)")
     static_load_rating: float = param(40e3, "N", 1.0, 1e8, "static load rating C_0")

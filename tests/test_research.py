@@ -8,8 +8,8 @@ from agents.cli import main
 
 
 def test_whirl_bound_never_reports_worse_than_its_baseline(tmp_path, capsys):
-    """At mu = 0.48 with the power back at 50 ms whirl-brake does not stop the whirl (docs/agents.md:
-    3.18 revolutions); the search starts from the baseline (zero correction), so its best is at
+    """At mu = 0.48 with the power back at 50 ms whirl-brake does not stop the whirl (docs/experiments/
+    2026-11-21-baselines-and-residual-policies.md: 3.18 revolutions); the search starts from the baseline (zero correction), so its best is at
     most the baseline's, and the pushes at 12 angles are all recorded."""
     out = tmp_path / "wb"
     assert main(["research", "whirl-bound", "--friction", "0.48", "--phase", "0", "--segments", "1",
@@ -44,8 +44,8 @@ def test_diagnosis_reads_damper_actions_through_the_runs_map():
 
 
 def test_collapse_diagnosis_tools_agree_with_the_validator_on_the_inner_loop():
-    """agents.research.diagnose_run / probe_commands (docs/agents.md, "Why the robust runs
-    collapse"): the inner loop through the diagnosis recorder and as the constant supervisor
+    """agents.research.diagnose_run / probe_commands (docs/experiments/
+    2026-11-26-robust-collapse.md): the inner loop through the diagnosis recorder and as the constant supervisor
     command (both dampers C_max, levitate on, zero gain and offsets) score what the robust
     validator gives the inner loop; it switches on at the first step that sees the power and
     re-levitates every drop."""

@@ -1,5 +1,4 @@
-"""Diagnose a supervisor training run on the robust validation set (docs/agents.md, "Why the
-robust runs collapse"): every checkpoint of ``RUN/checkpoints`` (and ``inner-loop`` in the same
+"""Diagnose a supervisor training run on the robust validation set (docs/experiments/2026-11-26-robust-collapse.md): every checkpoint of ``RUN/checkpoints`` (and ``inner-loop`` in the same
 interface) on the 20 validation drops, with the score's terms split and the mean command.
 
     python -m agents.research.diagnose_run runs/diag-0 --out runs/diag-0/diagnosis.json

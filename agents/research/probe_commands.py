@@ -1,5 +1,4 @@
-"""Open-loop probes of the supervisor interface on the robust validation set (docs/agents.md,
-"Why the robust runs collapse"): how often do random commands, as a fresh SAC actor samples them,
+"""Open-loop probes of the supervisor interface on the robust validation set (docs/experiments/2026-11-26-robust-collapse.md): how often do random commands, as a fresh SAC actor samples them,
 re-levitate at a given ``supervisor_authority``, and what do constant commands score?
 
     python -m agents.research.probe_commands --random --authority 1,0.25,0.2,0.15,0.1
