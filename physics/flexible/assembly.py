@@ -38,8 +38,8 @@ class Material:
     rho: float = 7810.0
 
     def __post_init__(self):
-        _finite_in(f"material {self.name!r}: E", self.E, 0.0, 1e13)
-        _finite_in(f"material {self.name!r}: G_s", self.G_s, 0.0, 1e13)
+        _finite_in(f"material {self.name!r}: E", self.E, 0.0, 1e16)
+        _finite_in(f"material {self.name!r}: G_s", self.G_s, 0.0, 1e16)
         _finite_in(f"material {self.name!r}: rho", self.rho, 0.0, 1e5)
         _finite_in(f"material {self.name!r}: Poisson ratio E/(2 G_s) - 1", self.nu, -1.0, 0.5)
 
@@ -239,6 +239,18 @@ def assemble(rotor: FlexibleRotor) -> FEModel:
         for j, zp in enumerate(planes):
             model.planes[f"{prefix}{j + 1}"] = model.node_at(zp)
     return model
+
+
+def support_matrix(model: FEModel, supports) -> np.ndarray:
+    """Stiffness (or damping) matrix of linear point supports ``[(node, kxx, kyy), ...]`` on the
+    x and y DOFs (e.g. an AMB's linearised stiffness, or ROSS's bearings)."""
+    S = np.zeros((model.ndof, model.ndof))
+    for node, kxx, kyy in supports:
+        _require(0 <= node < model.n_nodes,
+                 f"support node = {node!r}: allowed [0, {model.n_nodes - 1}]")
+        S[model.dof(node, "x"), model.dof(node, "x")] += kxx
+        S[model.dof(node, "y"), model.dof(node, "y")] += kyy
+    return S
 
 
 def rigid_properties(rotor: FlexibleRotor) -> dict:

@@ -41,10 +41,19 @@ def free_free_frequencies(model: FEModel) -> np.ndarray:
     return np.sqrt(np.clip(lam, 0.0, None))
 
 
-def force_dofs(model: FEModel, planes: tuple[str, ...] | None = None) -> list[int]:
-    """x and y DOFs of the named planes (default: every AMB, retainer and unbalance plane)."""
+def force_dofs(model: FEModel, planes: tuple[str, ...] | None = None,
+               extra_nodes: tuple[int, ...] = ()) -> list[int]:
+    """x and y DOFs of the named planes (default: every AMB, retainer and unbalance plane) and
+    of ``extra_nodes`` (e.g. other support nodes)."""
     names = model.planes if planes is None else planes
-    nodes = sorted({model.planes[p] for p in names})
+    for p in names:
+        if p not in model.planes:
+            raise ValueError(f"planes: {p!r} is not a plane of the model; allowed "
+                             f"{sorted(model.planes)}")
+    for n in extra_nodes:
+        if not 0 <= n < model.n_nodes:
+            raise ValueError(f"extra_nodes: {n!r}: allowed [0, {model.n_nodes - 1}]")
+    nodes = sorted({model.planes[p] for p in names} | set(extra_nodes))
     return [model.dof(i, w) for i in nodes for w in "xy"]
 
 
@@ -66,10 +75,11 @@ class ReducedModel:
 
 
 def reduce(model: FEModel, omega_cut: float | None = None, n_bending: int | None = None,
-           planes: tuple[str, ...] | None = None) -> ReducedModel:
+           planes: tuple[str, ...] | None = None, extra_nodes: tuple[int, ...] = ()
+           ) -> ReducedModel:
     """Reduced model: rigid modes, free-free bending modes below ``omega_cut`` (rad/s) or the
     first ``n_bending`` of them (counting x and y planes separately), and the static correction
-    modes of the force DOFs of ``planes`` (default all named planes)."""
+    modes of the x, y DOFs of ``planes`` (default all named planes) and ``extra_nodes``."""
     nd = model.ndof
     M, K = model.M, model.K
     R = model.rigid_body_modes()
@@ -87,7 +97,7 @@ def reduce(model: FEModel, omega_cut: float | None = None, n_bending: int | None
     keep = np.arange(len(wb)) < n_bending if n_bending is not None else wb < omega_cut
     Phi = Vb[:, keep]
     # inertia-relief attachment modes
-    dofs = force_dofs(model, planes)
+    dofs = force_dofs(model, planes, extra_nodes)
     MR = M @ R
     mR = R.T @ MR
     E = np.zeros((nd, len(dofs)))
@@ -98,6 +108,7 @@ def reduce(model: FEModel, omega_cut: float | None = None, n_bending: int | None
     Psi -= R @ np.linalg.solve(mR, MR.T @ Psi)               # M-orthogonal to R
     Psi -= Phi @ (Phi.T @ (M @ Psi))                         # and to the retained modes
     T0 = np.hstack([R, Phi, Psi])
+    T0 = T0 / np.sqrt(np.einsum("ij,ij->j", T0, M @ T0))    # unit M-norm columns
     # M-orthonormalise and diagonalise the reduced problem (Rayleigh-Ritz)
     Mr, Kr = T0.T @ M @ T0, T0.T @ K @ T0
     Mr, Kr = (Mr + Mr.T) / 2, (Kr + Kr.T) / 2
@@ -142,10 +153,13 @@ def whirl_direction(shape: np.ndarray, x_dofs: np.ndarray, y_dofs: np.ndarray) -
 
 
 def campbell(M: np.ndarray, G: np.ndarray, K: np.ndarray, speeds: np.ndarray, n_modes: int,
-             x_dofs: np.ndarray, y_dofs: np.ndarray, C: np.ndarray | None = None) -> dict:
+             x_dofs: np.ndarray, y_dofs: np.ndarray, C: np.ndarray | None = None,
+             T: np.ndarray | None = None) -> dict:
     """Campbell diagram: for each speed (rad/s) the first ``n_modes`` forward and backward
     whirl frequencies (rad/s, Im s; NaN where fewer exist). Rigid-body (s ~ 0) modes are
-    excluded by ``Im s > 0``. Returns {"speed", "forward", "backward"}, arrays (speeds, n_modes).
+    excluded by ``Im s > 0``. For a reduced model pass its basis ``T``: the shapes are mapped
+    to the full DOFs (``x_dofs``, ``y_dofs``) before their whirl is classified.
+    Returns {"speed", "forward", "backward"}, arrays (speeds, n_modes).
     """
     fw = np.full((len(speeds), n_modes), np.nan)
     bw = np.full((len(speeds), n_modes), np.nan)
@@ -157,6 +171,8 @@ def campbell(M: np.ndarray, G: np.ndarray, K: np.ndarray, speeds: np.ndarray, n_
             # branches they continue into as the speed rises)
             b, f = s.imag[0::2], s.imag[1::2]
         else:
+            if T is not None:
+                V = T @ V
             d = np.array([whirl_direction(V[:, j], x_dofs, y_dofs) for j in range(len(s))])
             f, b = s.imag[d > 0], s.imag[d <= 0]
         fw[i, :min(n_modes, len(f))] = f[:n_modes]
