@@ -53,3 +53,44 @@ def test_machine_flexible_first_forward_bending_between_1_5_and_3_x_running_spee
 def test_shaft_heavier_than_the_paper_rotor_is_refused():
     with pytest.raises(ValueError, match=r"disks\[0\].I_d = -\d"):
         examples.matched_rotor(0.1, 0.16, 0.4, "too-heavy")
+
+
+@pytest.mark.parametrize("make", [examples.paper_flexible, examples.machine_flexible])
+def test_stiff_limit_is_the_rigid_rotor_of_the_paper_scene(make):
+    """E x 1000: the reduced flexible model on the paper scene's AMB springs whirls at the rigid
+    rotor's frequencies of physics/campbell.py (same scene, same sign convention: forward
+    positive) at 0 and 10 000 rpm."""
+    from dataclasses import replace
+
+    from physics import campbell, load_scene
+    scene = load_scene("paper")
+    stiff = replace(asm.STEEL, E=asm.STEEL.E * 1000, G_s=asm.STEEL.G_s * 1000)
+    model = asm.assemble(make(stiff))
+    k = scene.amb.stiffness
+    S = asm.support_matrix(model, [(model.planes[p], k, k) for p in ("amb1", "amb2")])
+    red = modal.reduce(model, n_bending=2)
+    x, y = modal.model_whirl_dofs(model)
+    for omega in (1.0, RUN):
+        rigid = campbell.whirl_frequencies(scene, omega)
+        c = modal.campbell(red.M, red.G, red.K + red.T.T @ S @ red.T, [omega], 2, x, y, T=red.T)
+        assert np.sort(c["forward"][0]) == pytest.approx(np.sort(rigid[rigid > 0]), rel=1e-4)
+        assert np.sort(c["backward"][0]) == pytest.approx(np.sort(-rigid[rigid < 0]), rel=1e-4)
+
+
+def test_the_flexible_campbell_example_writes_its_diagram(tmp_path):
+    """docs/examples/flexible_campbell.py: the machine rotor's first forward bending line at
+    10 000 rpm is the stated 402 Hz, and the figure is written."""
+    import json
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+    root = Path(__file__).resolve().parent.parent
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(root), os.environ.get("PYTHONPATH", "")]))
+    subprocess.run([sys.executable, str(root / "docs/examples/flexible_campbell.py"), "--out",
+                    str(tmp_path), "--max-rpm", "30000"], check=True, capture_output=True,
+                   cwd=root, env=env)
+    data = json.loads((tmp_path / "campbell.json").read_text())
+    i = data["rpm"].index(10000.0)
+    assert data["forward_hz"][i][2] == pytest.approx(402.2, rel=5e-4)
+    assert (tmp_path / "campbell.png").stat().st_size > 10_000

@@ -16,19 +16,21 @@ Each is a symmetric steel shaft 0.9 m long (journals, a thicker core) plus one r
 """
 from __future__ import annotations
 
-from .assembly import Disk, FlexibleRotor, ShaftSection, rigid_properties
+from .assembly import STEEL, Disk, FlexibleRotor, Material, ShaftSection, rigid_properties
 
 PAPER_MASS, PAPER_I_P, PAPER_I_D = 97.3, 0.39, 2.82
 LENGTH = 0.9
 
 
 def matched_rotor(journal_diameter: float, core_diameter: float, core_length: float,
-                  name: str, max_element_length: float = 0.025) -> FlexibleRotor:
+                  name: str, max_element_length: float = 0.025,
+                  material: Material = STEEL) -> FlexibleRotor:
     """Symmetric journal-core-journal shaft from z = -0.45 m plus the central disk that brings
     shaft + disk to the paper's m, I_d, I_p (ValueError if the shaft alone exceeds them)."""
     journal = (LENGTH - core_length) / 2
-    sections = (ShaftSection(journal, journal_diameter), ShaftSection(core_length, core_diameter),
-                ShaftSection(journal, journal_diameter))
+    sections = (ShaftSection(journal, journal_diameter, 0.0, material),
+                ShaftSection(core_length, core_diameter, 0.0, material),
+                ShaftSection(journal, journal_diameter, 0.0, material))
     shaft = rigid_properties(FlexibleRotor(sections, z_start=-LENGTH / 2))
     disk = Disk(0.0, PAPER_MASS - shaft["mass"], PAPER_I_D - shaft["I_d"],
                 PAPER_I_P - shaft["I_p"])
@@ -37,11 +39,11 @@ def matched_rotor(journal_diameter: float, core_diameter: float, core_length: fl
                          max_element_length=max_element_length, name=name)
 
 
-def paper_flexible() -> FlexibleRotor:
+def paper_flexible(material: Material = STEEL) -> FlexibleRotor:
     """The paper rotor as a stiff shaft + disk (first bending ~740 Hz)."""
-    return matched_rotor(0.07, 0.16, 0.4, "paper-flexible")
+    return matched_rotor(0.07, 0.16, 0.4, "paper-flexible", material=material)
 
 
-def machine_flexible() -> FlexibleRotor:
+def machine_flexible(material: Material = STEEL) -> FlexibleRotor:
     """Same rigid-body properties, first forward bending at 2.4 x 10 000 rpm."""
-    return matched_rotor(0.05, 0.14, 0.3, "machine-flexible")
+    return matched_rotor(0.05, 0.14, 0.3, "machine-flexible", material=material)

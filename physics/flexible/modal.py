@@ -152,6 +152,32 @@ def whirl_direction(shape: np.ndarray, x_dofs: np.ndarray, y_dofs: np.ndarray) -
     return float((f - b) / (f + b))
 
 
+def whirl_directions(s: np.ndarray, V: np.ndarray, x_dofs: np.ndarray, y_dofs: np.ndarray,
+                     rtol: float = 1e-7) -> np.ndarray:
+    """whirl_direction of each mode, with repeated eigenvalues resolved: a cluster of modes
+    with equal frequency (e.g. the cylindrical mode of a symmetric rotor, which spin does not
+    split) spans a forward and a backward circular mode, but the eigen-solver returns arbitrary
+    mixtures. Within a cluster the directions are the eigenvalues of ``F - B`` relative to
+    ``F + B`` (``F = P^H P``, ``P = X + iY`` over the cluster's shapes; ``B`` with ``X - iY``),
+    the extreme whirl of the combinations of its shapes."""
+    d = np.array([whirl_direction(V[:, j], x_dofs, y_dofs) for j in range(len(s))])
+    i = 0
+    while i < len(s):
+        j = i + 1
+        while j < len(s) and abs(s[j] - s[i]) <= rtol * abs(s[i]):
+            j += 1
+        if j - i > 1:
+            Vc = V[:, i:j]
+            P = Vc[x_dofs] + 1j * Vc[y_dofs]
+            Q = Vc[x_dofs] - 1j * Vc[y_dofs]
+            F, B = P.conj().T @ P, Q.conj().T @ Q
+            L = np.linalg.cholesky(F + B)
+            Li = np.linalg.inv(L)
+            d[i:j] = np.sort(np.linalg.eigvalsh(Li @ (F - B) @ Li.conj().T))
+        i = j
+    return d
+
+
 def campbell(M: np.ndarray, G: np.ndarray, K: np.ndarray, speeds: np.ndarray, n_modes: int,
              x_dofs: np.ndarray, y_dofs: np.ndarray, C: np.ndarray | None = None,
              T: np.ndarray | None = None) -> dict:
@@ -173,7 +199,7 @@ def campbell(M: np.ndarray, G: np.ndarray, K: np.ndarray, speeds: np.ndarray, n_
         else:
             if T is not None:
                 V = T @ V
-            d = np.array([whirl_direction(V[:, j], x_dofs, y_dofs) for j in range(len(s))])
+            d = whirl_directions(s, V, x_dofs, y_dofs)
             f, b = s.imag[d > 0], s.imag[d <= 0]
         fw[i, :min(n_modes, len(f))] = f[:n_modes]
         bw[i, :min(n_modes, len(b))] = b[:n_modes]
