@@ -15,7 +15,8 @@ def build(**kw):
 
 @pytest.mark.parametrize("kw, message", [
     (dict(sections=()), r"sections: allowed at least one ShaftSection"),
-    (dict(sections=(asm.ShaftSection(0.0, 0.1),)), r"sections\[0\].length = 0.0: allowed \(0, 100\]"),
+    (dict(sections=(asm.ShaftSection(0.0, 0.1),)),
+     r"sections\[0\].length = 0.0: allowed \(0, 100\]"),
     (dict(sections=(asm.ShaftSection(0.5, 0.1), asm.ShaftSection(-0.1, 0.1))),
      r"sections\[1\].length = -0.1: allowed \(0, 100\]"),
     (dict(sections=(asm.ShaftSection(0.5, 0.1, 0.1),)),
@@ -25,8 +26,10 @@ def build(**kw):
     (dict(sections=(asm.ShaftSection(0.5, float("nan")),)),
      r"sections\[0\].outer_diameter = nan: allowed \(0, 10\]"),
     (dict(sections=("shaft",)), r"sections\[0\] = 'shaft': allowed a ShaftSection"),
-    (dict(disks=(asm.Disk(0.5, 10.0, 0.1, 0.2),)), r"disks\[0\].z = 0.5: allowed \[-0.4, 0.4\] \(on the shaft\)"),
-    (dict(disks=(asm.Disk(0.0, -1.0, 0.1, 0.2),)), r"disks\[0\].mass = -1.0: allowed \[0, 1e\+06\]"),
+    (dict(disks=(asm.Disk(0.5, 10.0, 0.1, 0.2),)),
+     r"disks\[0\].z = 0.5: allowed \[-0.4, 0.4\] \(on the shaft\)"),
+    (dict(disks=(asm.Disk(0.0, -1.0, 0.1, 0.2),)),
+     r"disks\[0\].mass = -1.0: allowed \[0, 1e\+06\]"),
     (dict(amb_planes=(-0.28,)), r"amb_planes = \(-0.28,\): allowed two stations \(or none\)"),
     (dict(retainer_planes=(-0.38, 0.45)),
      r"retainer_planes\[1\] = 0.45: allowed \[-0.4, 0.4\] \(on the shaft\)"),

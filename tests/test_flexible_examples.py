@@ -86,7 +86,8 @@ def test_the_flexible_campbell_example_writes_its_diagram(tmp_path):
     import sys
     from pathlib import Path
     root = Path(__file__).resolve().parent.parent
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(root), os.environ.get("PYTHONPATH", "")]))
+    env = dict(os.environ,
+               PYTHONPATH=os.pathsep.join([str(root), os.environ.get("PYTHONPATH", "")]))
     subprocess.run([sys.executable, str(root / "docs/examples/flexible_campbell.py"), "--out",
                     str(tmp_path), "--max-rpm", "30000"], check=True, capture_output=True,
                    cwd=root, env=env)

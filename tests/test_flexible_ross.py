@@ -1,5 +1,5 @@
-"""rotordrop's flexible rotor against ROSS 2.3.0 on the same rotor (tests/data/ross_sample_rotor.toml,
-saved by ROSS's Rotor.save).
+"""rotordrop's flexible rotor against ROSS 2.3.0 on the same rotor
+(tests/data/ross_sample_rotor.toml, saved by ROSS's Rotor.save).
 
 Reference numbers: tests/data/ross_reference.json, regenerated in a separate venv by
 
@@ -107,10 +107,7 @@ def variant(tmp_path, text):
 @pytest.mark.parametrize("edit, message", [
     (lambda t: t.replace("idr = 0.0\nodr = 0.05\nn = 3", "idr = 0.0\nodr = 0.06\nn = 3", 1),
      r"'ShaftElement_Shaft Element 3' is tapered .*only cylindrical elements"),
-    (lambda t: t.replace("axial_force = 0\ntorque = 0\nshear_effects = true\nrotary_inertia = true"
-                         "\ngyroscopic = true\nshear_method_calc = \"cowper\"\ntag = \"Shaft Element 1\"",
-                         "axial_force = 1000.0\ntorque = 0\nshear_effects = true\nrotary_inertia = true"
-                         "\ngyroscopic = true\nshear_method_calc = \"cowper\"\ntag = \"Shaft Element 1\"", 1),
+    (lambda t: t.replace("n = 1\naxial_force = 0", "n = 1\naxial_force = 1000.0", 1),
      r"'ShaftElement_Shaft Element 1' has axial_force = 1000.0: not supported"),
     (lambda t: t + '\n["GearElement_Gear 0"]\nn = 2\nm = 1.0\n',
      r"element 'GearElement_Gear 0' of type GearElement: not supported"),

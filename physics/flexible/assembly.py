@@ -79,7 +79,8 @@ class ShaftSection:
 
     @property
     def mass(self) -> float:
-        return self.material.rho * tim.section(self.outer_diameter, self.inner_diameter)[0] * self.length
+        A, _ = tim.section(self.outer_diameter, self.inner_diameter)
+        return self.material.rho * A * self.length
 
 
 @dataclass(frozen=True)
@@ -159,7 +160,7 @@ class FEModel:
     M: np.ndarray
     K: np.ndarray
     G: np.ndarray
-    planes: dict = field(default_factory=dict)  # plane name -> node index ("amb1", "rb2", "unb0")
+    planes: dict = field(default_factory=dict)  # plane name -> node ("amb1", "rb2", "unb1")
 
     @property
     def n_nodes(self) -> int:
@@ -220,25 +221,27 @@ def assemble(rotor: FlexibleRotor) -> FEModel:
     M, K, G = np.zeros((nd, nd)), np.zeros((nd, nd)), np.zeros((nd, nd))
     for e, k in enumerate(owner):
         s = rotor.sections[k]
-        L = z[e + 1] - z[e]
-        Me, Ke, Ge = tim.element_matrices(L, s.outer_diameter, s.inner_diameter, s.material.E,
-                                          s.material.G_s, s.material.rho, rotor.shear)
+        Me, Ke, Ge = tim.element_matrices(z[e + 1] - z[e], s.outer_diameter, s.inner_diameter,
+                                          s.material.E, s.material.G_s, s.material.rho,
+                                          rotor.shear)
         sl = slice(tim.DOF_PER_NODE * e, tim.DOF_PER_NODE * (e + 2))
         M[sl, sl] += Me
         K[sl, sl] += Ke
         G[sl, sl] += Ge
-    model = FEModel(rotor, z, M, K, G)
+
+    def node(zp: float) -> int:  # mesh() put a node at every disk and plane
+        return int(np.argmin(np.abs(z - zp)))
+
     for d in rotor.disks:
-        i = model.node_at(d.z)
         Md, Gd = tim.disk_matrices(d.mass, d.I_d, d.I_p)
-        sl = slice(tim.DOF_PER_NODE * i, tim.DOF_PER_NODE * (i + 1))
+        sl = slice(tim.DOF_PER_NODE * node(d.z), tim.DOF_PER_NODE * (node(d.z) + 1))
         M[sl, sl] += Md
         G[sl, sl] += Gd
-    for prefix, planes in (("amb", rotor.amb_planes), ("rb", rotor.retainer_planes),
-                           ("unb", rotor.unbalance_planes)):
-        for j, zp in enumerate(planes):
-            model.planes[f"{prefix}{j + 1}"] = model.node_at(zp)
-    return model
+    planes = {f"{prefix}{j + 1}": node(zp)
+              for prefix, stations in (("amb", rotor.amb_planes), ("rb", rotor.retainer_planes),
+                                       ("unb", rotor.unbalance_planes))
+              for j, zp in enumerate(stations)}
+    return FEModel(rotor, z, M, K, G, planes)
 
 
 def support_matrix(model: FEModel, supports) -> np.ndarray:

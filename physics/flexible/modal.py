@@ -103,7 +103,7 @@ def reduce(model: FEModel, omega_cut: float | None = None, n_bending: int | None
     E = np.zeros((nd, len(dofs)))
     E[dofs, range(len(dofs))] = 1.0
     F = E - MR @ np.linalg.solve(mR, R.T @ E)               # P e_j, self-equilibrated
-    Ks = K + MR @ np.linalg.solve(mR, MR.T)                  # regularised: K + M R (R^T M R)^-1 R^T M
+    Ks = K + MR @ np.linalg.solve(mR, MR.T)                  # K + M R (R^T M R)^-1 R^T M: regular
     Psi = np.linalg.solve(Ks, F)
     Psi -= R @ np.linalg.solve(mR, MR.T @ Psi)               # M-orthogonal to R
     Psi -= Phi @ (Phi.T @ (M @ Psi))                         # and to the retained modes
@@ -207,6 +207,6 @@ def campbell(M: np.ndarray, G: np.ndarray, K: np.ndarray, speeds: np.ndarray, n_
 
 
 def model_whirl_dofs(model: FEModel) -> tuple[np.ndarray, np.ndarray]:
-    """The x and y translational DOFs of every node (for whirl_direction/campbell on the full model)."""
+    """The x and y DOFs of every node (whirl_direction / campbell of the full model)."""
     n = np.arange(model.n_nodes) * 4
     return n + 0, n + 1

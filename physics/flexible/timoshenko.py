@@ -60,7 +60,7 @@ def shear_coefficient(outer_diameter: float, inner_diameter: float, nu: float,
 
 
 def shear_parameter(E: float, G_s: float, kappa: float, A: float, I: float, L: float) -> float:
-    """``Phi = 12 E I / (kappa G_s A L^2)``: the ratio of shear to bending flexibility (0 = Euler-Bernoulli)."""
+    """``Phi = 12 E I / (kappa G_s A L^2)``: shear over bending flexibility (0: Euler-Bernoulli)."""
     return 12.0 * E * I / (kappa * G_s * A * L * L)
 
 
