@@ -4,14 +4,21 @@
     /tmp/rossenv/bin/pip install "ross-rotordynamics==2.3.0" "plotly<6"
     /tmp/rossenv/bin/python benchmarks/ross_reference.py
 
-Builds the sample rotor (steel shaft 1.5 m x 50 mm in 6 Timoshenko elements with Cowper's shear
-coefficient, two 280 mm disks at nodes 2 and 4, linear isotropic bearings 1e6 N/m at nodes 0
-and 6), saves it with ``Rotor.save`` to tests/data/ross_sample_rotor.toml, and writes the first
-4 forward and 4 backward lateral whirl frequencies at 0 and 10 000 rpm (``run_modal``,
-``sparse=False``) to tests/data/ross_reference.json. ROSS's own whirl labels are "Mixed" for
-some modes; here a mode is forward when its forward circular component dominates over all
-nodes (the same measure as physics.flexible.modal.whirl_direction). ROSS is kept out of the
-shared environment (it pins numpy/scipy/plotly): run this only in its own venv.
+Builds two rotors in ROSS, saves each with ``Rotor.save`` to tests/data/<name>.toml, and writes
+the first 4 forward and 4 backward lateral whirl frequencies at 0 and 10 000 rpm (``run_modal``,
+``sparse=False``) to tests/data/ross_reference.json:
+
+* ``ross_sample_rotor``: steel shaft 1.5 m x 50 mm in 6 Timoshenko elements (Cowper's shear
+  coefficient), two 280 mm disks at nodes 2 and 4, linear isotropic bearings 1e6 N/m at nodes
+  0 and 6;
+* ``ross_thick_hollow_rotor``: a short thick hollow shaft (0.6 m, 120/60 mm, 8 elements with
+  a 160/60 mm middle) where shear and the hollow-section coefficient matter, one disk at node 6,
+  bearings 5e8 N/m at nodes 1 and 7.
+
+ROSS's own whirl labels are "Mixed" for some modes; here a mode is forward when its forward
+circular component dominates over all nodes (the measure of
+physics.flexible.modal.whirl_direction). ROSS is kept out of the shared environment (it pins
+numpy/scipy/plotly): run this only in its own venv.
 """
 from __future__ import annotations
 
@@ -23,23 +30,40 @@ from pathlib import Path
 import numpy as np
 
 DATA = Path(__file__).resolve().parents[1] / "tests" / "data"
-TOML = DATA / "ross_sample_rotor.toml"
 JSON = DATA / "ross_reference.json"
 SPEEDS = (0.0, 10_000 * 2 * math.pi / 60)  # rad/s
 N_MODES = 4
 
 
-def build_rotor():
-    """The sample rotor in ROSS."""
+def steel():
     import ross as rs
-    steel = rs.Material(name="Steel", rho=7810.0, E=211e9, G_s=81.2e9)
-    shaft = [rs.ShaftElement(L=0.25, idl=0.0, odl=0.05, material=steel, shear_effects=True,
+    return rs.Material(name="Steel", rho=7810.0, E=211e9, G_s=81.2e9)
+
+
+def build_sample():
+    """Slender solid shaft, two disks, soft bearings."""
+    import ross as rs
+    shaft = [rs.ShaftElement(L=0.25, idl=0.0, odl=0.05, material=steel(), shear_effects=True,
                              rotary_inertia=True, gyroscopic=True, shear_method_calc="cowper")
              for _ in range(6)]
-    disks = [rs.DiskElement.from_geometry(n=n, material=steel, width=0.07, i_d=0.05, o_d=0.28)
+    disks = [rs.DiskElement.from_geometry(n=n, material=steel(), width=0.07, i_d=0.05, o_d=0.28)
              for n in (2, 4)]
     bearings = [rs.BearingElement(n=n, kxx=1e6, kyy=1e6, cxx=0.0) for n in (0, 6)]
     return rs.Rotor(shaft, disks, bearings)
+
+
+def build_thick_hollow():
+    """Short thick hollow shaft (L/D ~ 5, elements L/D < 1): shear matters."""
+    import ross as rs
+    od = (0.12, 0.12, 0.12, 0.16, 0.16, 0.12, 0.12, 0.12)
+    shaft = [rs.ShaftElement(L=0.075, idl=0.06, odl=d, material=steel(),
+                             shear_method_calc="cowper") for d in od]
+    disks = [rs.DiskElement(n=6, m=15.0, Id=0.08, Ip=0.14)]
+    bearings = [rs.BearingElement(n=n, kxx=5e8, kyy=5e8, cxx=0.0) for n in (1, 7)]
+    return rs.Rotor(shaft, disks, bearings)
+
+
+ROTORS = {"ross_sample_rotor": build_sample, "ross_thick_hollow_rotor": build_thick_hollow}
 
 
 def whirl_frequencies(rotor, speed: float, n_modes: int = N_MODES) -> dict:
@@ -65,13 +89,15 @@ def whirl_frequencies(rotor, speed: float, n_modes: int = N_MODES) -> dict:
 
 def main() -> int:
     import ross
-    rotor = build_rotor()
-    TOML.unlink(missing_ok=True)
-    rotor.save(TOML)
-    ref = {"ross_version": ross.__version__, "rotor": TOML.name, "unit": "rad/s",
+    ref = {"ross_version": ross.__version__, "unit": "rad/s",
            "command": "/tmp/rossenv/bin/python benchmarks/ross_reference.py",
-           "speeds": list(SPEEDS),
-           "results": [whirl_frequencies(rotor, s) for s in SPEEDS]}
+           "speeds": list(SPEEDS), "rotors": {}}
+    for name, build in ROTORS.items():
+        rotor = build()
+        toml = DATA / f"{name}.toml"
+        toml.unlink(missing_ok=True)
+        rotor.save(toml)
+        ref["rotors"][name] = [whirl_frequencies(rotor, s) for s in SPEEDS]
     JSON.write_text(json.dumps(ref, indent=2) + "\n")
     print(json.dumps(ref, indent=2))
     return 0
