@@ -160,3 +160,12 @@ def test_point_mass_is_a_disk_without_inertia(tmp_path):
                                 retainer_planes=(-0.7, 0.7))
     assert imp.rotor.disks[-1] == asm.Disk(0.0, 2.5, 0.0, 0.0)
     assert imp.node_z[0] == -0.75 and imp.rotor.retainer_planes == (-0.7, 0.7)
+
+
+@pytest.mark.filterwarnings("ignore:.*skipped 2 bearing")
+def test_ross_hutchinson_option_is_read_with_the_published_formula_and_warns(tmp_path):
+    text = BASE.replace('shear_method_calc = "cowper"', 'shear_method_calc = "hutchinson"')
+    with pytest.warns(UserWarning, match=r"shear_method_calc = 'hutchinson': ROSS 2.3.0's kappa "
+                                         r"is Hutchinson's divided by \(1 \+ nu\)"):
+        imp = ross_io.read_ross(variant(tmp_path, text))
+    assert imp.rotor.shear == "hutchinson"

@@ -11,7 +11,8 @@ tapered element, axial force or torque prestress, Rayleigh damping alpha/beta, e
 main shaft line, an unknown element type) stops with one line naming it.
 
 ROSS's "hutchinson" shear option differs from Hutchinson's formula (see timoshenko.py); such
-elements are read with the published formula, so their shear flexibility differs from ROSS's.
+elements are read with the published formula, with a warning that their shear flexibility
+differs from ROSS's.
 """
 from __future__ import annotations
 
@@ -138,6 +139,11 @@ def read_ross(path: str | Path, z_start: float = 0.0, **rotor_kwargs) -> RossImp
         warnings.warn(f"{path}: skipped {len(supports)} bearing/seal element(s) "
                       f"({', '.join(s.tag for s in supports)}): rotordrop models its supports "
                       f"itself; their coefficients are in RossImport.supports", stacklevel=2)
+    method = shear.pop()
+    if method == "hutchinson":
+        warnings.warn(f"{path}: shear_method_calc = 'hutchinson': ROSS 2.3.0's kappa is "
+                      f"Hutchinson's divided by (1 + nu); read with Hutchinson's published "
+                      f"formula, so the frequencies differ slightly from ROSS's", stacklevel=2)
     rotor = FlexibleRotor(tuple(sections), tuple(disk_list), z_start=z_start,
-                          shear=shear.pop(), **rotor_kwargs)
+                          shear=method, **rotor_kwargs)
     return RossImport(rotor, tuple(supports), version, tuple(node_z))
