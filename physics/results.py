@@ -52,6 +52,13 @@ class Result:
     step_peaks: np.ndarray | None = None
     _derived: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
+    def until(self, t_end: float) -> "Result":
+        """The samples t < ``t_end`` as a new result (at least the first sample), without the
+        step-resolved peaks (they cover the whole run): the run up to a time, e.g. up to where
+        it left the contact law's validity (``physics.metrics``)."""
+        k = max(int(np.searchsorted(self.t, t_end, "left")), 1)
+        return Result(self.model, self.t[:k], self.Y[:k], self.aux[:k], self.stats, self.t_fault)
+
     # -- rotor ----------------------------------------------------------------------------
     def state(self, name: str) -> np.ndarray:
         """The time series of one state by name (``Model.names``, e.g. ``"x"``, ``"Omega"``)."""
