@@ -435,7 +435,8 @@ def validity_warning(m: dict, scene) -> str:
                                for v in where.values()}))
     return (f"the penetration passes the contact law's validity bound ({when}; bound {bounds}): "
             f"the contact laws (contact.law = {scene.contact.law!r}"
-            + (", stator contact" if m["stator_beyond_validity"] else "")
+            + (", stator contact: the rotor rolls on the stator, dry whip; read it as a destroyed "
+               "stator, not a motion" if m["stator_beyond_validity"] else "")
             + ") do not describe the run from then on; force and displacement metrics are n/a, "
             f"their values before t = {m['left_validity_at_s']:.4f} s are the *{BEFORE_INVALID} keys")
 
