@@ -84,7 +84,8 @@ def line_continuation(clearance):
 
 
 def effective_modulus(youngs_modulus: float, poisson: float) -> float:
-    """E* = E / (2 (1 - nu^2)) [Pa] of two bodies of the same material (1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2)."""
+    """E* = E / (2 (1 - nu^2)) [Pa] of two bodies of the same material
+    (1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2)."""
     return youngs_modulus / (2.0 * (1.0 - poisson ** 2))
 
 

@@ -195,7 +195,9 @@ def _checks_text(a: dict) -> str:
                     if study != "total" and any(counts.values()))
     return (f"{total[0].upper()}{total[1:]} (per study: {per}). These are the warnings `rotordrop drop` prints for the "
             "run's command; the drops are in the statistics, except those without a fault, which "
-            "count as failed.\n")
+            "count as failed, and those past a contact law's validity bound (penetration, "
+            "dry_whip), which count in the whirl probability but in no force or displacement "
+            "number.\n")
 
 
 def write_report(a: dict, out: Path, figures: dict[str, list[str]], meta: dict) -> Path:
