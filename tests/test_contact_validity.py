@@ -68,7 +68,7 @@ def test_bound_rejects_bad_input():
 def drops():
     """A 20 t rotor dropped at t = 0 passes the paper law's 553 µm (52 kN) on its first impact;
     the paper drop at mu = 0.25 stays far within it."""
-    heavy = simulate(load_scene("paper", {"amb.off_time": 0.0, "rotor.mass": 2e4}), t_end=0.05)
+    heavy = simulate(load_scene("paper", {"amb.off_time": 0.0, "rotor.mass": 2e4}), t_end=0.12)
     calm = simulate(load_scene("paper"), t_end=0.3)
     return {"heavy": (heavy, compute_metrics(heavy)), "calm": (calm, compute_metrics(calm))}
 
@@ -158,3 +158,22 @@ def test_terminate_on_failure_ends_the_episode_past_the_bound():
     assert term and last["beyond_validity"] and len(infos) < 51
     assert not last["kpi_stator_contact"] and not last["kpi_bearing_overload"]
     assert last["reward_failure"] < 0.0
+
+
+def test_paper_study_medians_and_claims_leave_drops_beyond_validity_out(drops):
+    """The friction-class medians take the calm drop alone and count the heavy one apart; a
+    support-stiffness claim whose nominal drop left validity says so instead of a ratio."""
+    from physics.study.claims import _stiff_ratio_base
+    from physics.study.observables import drop_observables
+    from physics.study.paper import _medians
+    outs = [Outcome(run=None, ok=True, metrics=drops[k][1], extra=drop_observables(drops[k][0]))
+            for k in ("calm", "heavy")]
+    med = _medians(outs)
+    assert med["runs"] == 2 and med["beyond_validity"] == 1
+    assert med["peak_contact_force_N"] == pytest.approx(
+        max(v["peak_contact_force_N"] for v in drops["calm"][1]["planes"].values()))
+    assert med["mean_late_force_N"] == pytest.approx(outs[0].extra["mean_late_force_N"])
+    rows = [dict(stiffness=5e7, peak_contact_force_N=3143.0),
+            dict(stiffness=5e8, beyond_validity_at_s=0.2, backward_whirl=True)]
+    with pytest.raises(ValueError, match="left the contact law's validity at t = 0.200 s"):
+        _stiff_ratio_base(dict(support_stiffness=rows), 300.0)
