@@ -177,3 +177,21 @@ def test_paper_study_medians_and_claims_leave_drops_beyond_validity_out(drops):
             dict(stiffness=5e8, beyond_validity_at_s=0.2, backward_whirl=True)]
     with pytest.raises(ValueError, match="left the contact law's validity at t = 0.200 s"):
         _stiff_ratio_base(dict(support_stiffness=rows), 300.0)
+
+
+def test_batched_env_reports_the_same_validity_as_the_single_env():
+    """The batched step (kernels.step_batch / step_rows) latches the same flag at the same step."""
+    import gymnasium as gym
+    from rotordrop_env import BatchedRotorDropVecEnv
+    kw = dict(overrides=STIFF, episode_time=0.006, terminate_on_failure=False)
+    venv = BatchedRotorDropVecEnv("RotorDrop-Passive-v0", 2, seed=3, **kw)
+    venv.reset()
+    batched = [venv.step(np.zeros((2,) + venv.action_space.shape, np.float32))[3]
+               for _ in range(6)]
+    env = gym.make("RotorDrop-Passive-v0", **kw)
+    env.reset(seed=3)
+    single = [env.step(np.zeros(env.action_space.shape, np.float32))[4]["beyond_validity"]
+              for _ in range(6)]
+    assert single[0] is False and single[-1] is True             # passed at 2.8 ms
+    for e in range(2):
+        assert [b[e]["beyond_validity"] for b in batched] == single
