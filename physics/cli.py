@@ -147,8 +147,9 @@ def _post_fault_tables(m: dict) -> list[str]:
               "paper slip law the contact can also return energy)"]
     if "max_temperature_rise_K" in next(iter(m["planes"].values())):       # effects.thermal
         lines.append("sleeve heating: " + ", ".join(
-            f"{p} +{v['max_temperature_rise_K']:.1f} K max, mu {v['min_friction_coefficient']:.3f}"
-            f"-{v['max_friction_coefficient']:.3f}" for p, v in m["planes"].items()))
+            f"{p} +{_cell(v, 'max_temperature_rise_K', '.1f')} K max, mu "
+            f"{_cell(v, 'min_friction_coefficient', '.3f')}-{_cell(v, 'max_friction_coefficient', '.3f')}"
+            for p, v in m["planes"].items()))
     return lines
 
 

@@ -36,7 +36,10 @@ STEP_PEAK_KEYS = {"peak_contact_force_N": P_FR, "peak_bearing_load_N": P_LOAD,
 # the force and displacement metrics that are None once a run left the validity of its laws
 INVALID_KEYS = ("max_displacement_um", "max_y_displacement_um", "peak_contact_force_N",
                 "peak_bearing_load_N", "static_safety_factor", "max_ball_load_N",
-                "max_contact_pressure_MPa", "friction_heat_J", "max_penetration_um")
+                "max_contact_pressure_MPa", "friction_heat_J", "max_penetration_um",
+                # effects.thermal: heated by that friction
+                "max_temperature_rise_K", "final_temperature_rise_K", "min_friction_coefficient",
+                "max_friction_coefficient")
 PRE_FAULT_KEYS = ("pre_fault_peak_contact_force_N",)    # invalid only if it left before the fault
 STATOR_INVALID_KEYS = ("max_displacement_um", "stator_peak_force_N", "stator_contact_time_s",
                        "stator_penetration_um")
@@ -351,7 +354,7 @@ def _null(table: dict, early: dict, keys: tuple[str, ...]) -> None:
     """table[p][key] -> None and table[p][key + BEFORE_INVALID] = early[p][key] (the same value
     over the samples before the run left validity), for every plane and key that has a value."""
     for p, v in table.items():
-        for key in (k for k in keys if v[k] is not None):
+        for key in (k for k in keys if v.get(k) is not None):
             v[key + BEFORE_INVALID] = early[p][key]
             v[key] = None
 
