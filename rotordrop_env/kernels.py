@@ -5,7 +5,9 @@ Everything an episode needs lives in flat arrays so that the single environment 
 VecEnv run the very same code (the batch owns (N, ...) stacks, each environment a row view):
 
 * ``C``  float64 configuration of the episode (indices ``C_*``), set at reset,
-* ``M``  float64 running monitor (time, step size, whirl revolutions, peaks, re-levitation...),
+* ``M``  float64 running monitor (time, step size, whirl revolutions, peaks, re-levitation,
+  whether and when a penetration passed its validity bound ``C_PEN_BOUND`` / ``C_STATOR_BOUND``
+  of :func:`physics.validity.validity_bound`...),
 * ``out`` float64 per-step results (reward and its terms, flags, status; indices ``O_*``).
 
 The physics is :func:`physics.integrate.integrate_segment` on :func:`physics.model.rhs`; the
@@ -20,10 +22,10 @@ import numba
 
 from physics._jit import njit, njit_parallel
 from physics.integrate import integrate_segment
-from physics.model import (A_DELTA, A_FR, A_QMAX, A_WS, I_AMB_FILT, I_AMB_INT, I_CS, N_AUX_PLANE, P_CLR,
-                           P_Z_AMB1, P_Z_RB1, S_W, U_AMB_DIRECT, U_AMB_GAIN, U_AMB_POWER, U_CS1,
-                           U_ICMD, U_REF0, U_REF_OFF, U_T_ON, amb_currents, axis_motion, rhs,
-                           sleeve_motion)
+from physics.model import (A_DELTA, A_FR, A_QMAX, A_WS, I_AMB_FILT, I_AMB_INT, I_CS, N_AUX_PLANE,
+                           P_CLR, P_Z_AMB1, P_Z_RB1, S_W, U_AMB_DIRECT, U_AMB_GAIN, U_AMB_POWER,
+                           U_CS1, U_ICMD, U_REF0, U_REF_OFF, U_T_ON, amb_currents, axis_motion,
+                           rhs, sleeve_motion)
 
 # ------------------------------------------------------------------------ configuration C --
 (C_DT, C_T_FAULT, C_T_END, C_T_POWER, C_DAMP, C_LEV,
