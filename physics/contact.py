@@ -106,7 +106,7 @@ def half_width_load(r: float, clearance: float, a: float,
     """F_b = a (limit r)^2 / (4 R_eff) [N]: the load at which :func:`line_half_width` reaches
     ``limit`` times the journal radius r.
 
-    Why b <= 0.3 r: Hertz's solution treats each body as an elastic half-space, valid while the
+    Why b <= 0.3 r (a chosen limit, stated by its geometry): Hertz's solution treats each body as an elastic half-space, valid while the
     contact is small against the radii. At b = 0.3 r the contact arc spans ±17.5° of the journal,
     the surface normal at its edges has turned by 17.5° (its radial share cos 17.5° = 0.954) and
     the arc is 1.6 % longer than its chord: still a nearly flat contact. Beyond it the conforming
