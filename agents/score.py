@@ -76,6 +76,9 @@ def summarize(episodes) -> dict:
                relevitation_success_rate=mean_finite(d.get("relevitated") for d in k),
                relevitation_time_s=mean_finite(d.get("relevitation_time_s") for d in k if d.get("relevitated")),
                control_effort=mean_finite(d.get("control_effort") for d in k),
+               # episodes whose contact passed its law's validity bound (their force and
+               # displacement KPIs are partly the laws' extrapolation; docs/environments.md)
+               beyond_validity_rate=mean_finite(d.get("beyond_validity") for d in k),
                mean_return=mean_finite(e.reward for e in episodes))
     return out
 

@@ -171,6 +171,11 @@ def score(o, ref) -> dict:
     return err
 
 
+def _na(x: float | None) -> str:
+    """A whole-run peak for the report, "n/a" where the drop left the contact laws' validity."""
+    return "n/a" if x is None else f"{x:.0f}"
+
+
 def _rel(a: float | None, b: float | None) -> float | None:
     """Relative error of ``a`` against ``b``; None where either is missing (no ball loads)."""
     if a is None or b is None:
@@ -381,8 +386,8 @@ def markdown(a: dict, meta: dict) -> str:
           "", "Reduced-fidelity rows run at the scene's own solver settings; their errors are model "
           "differences, not integration errors.", "", "Reference drops:", ""]
     for m in ref["members"]:
-        L.append(f"- drop {m['member']}: peak {m['peak_contact_force_N']:.0f} N, bearing load "
-                 f"{m['peak_bearing_load_N']:.0f} N, max displacement {m['max_displacement_um']:.0f} µm,"
+        L.append(f"- drop {m['member']}: peak {_na(m['peak_contact_force_N'])} N, bearing load "
+                 f"{_na(m['peak_bearing_load_N'])} N, max displacement {_na(m['max_displacement_um'])} µm,"
                  f" whirl {'yes' if m['backward_whirl'] else 'no'}"
                  f"{', chaotic' if m['chaotic'] else ''}: `{m['command']}`")
     return "\n".join(L) + "\n"

@@ -101,8 +101,13 @@ def summary_table(m: dict) -> str:
         lines += _post_fault_tables(m)
     lines.append(f"{'AMB plane':10}{'max disp [µm]':>15}{'stator':>8}{'contacts':>10}{'peak F [N]':>12}")
     for p, v in m["amb_planes"].items():
-        lines.append(f"{p:10}{v['max_displacement_um']:15.1f}{'yes' if v['stator_contact'] else 'no':>8}"
-                     f"{_fmt(v['stator_contacts'], 'd'):>10}{_fmt(v['stator_peak_force_N'], '.0f'):>12}")
+        lines.append(f"{p:10}{_cell(v, 'max_displacement_um', '.1f'):>15}"
+                     f"{'yes' if v['stator_contact'] else 'no':>8}"
+                     f"{_fmt(v['stator_contacts'], 'd'):>10}{_cell(v, 'stator_peak_force_N', '.0f'):>12}")
+    if m["left_validity_at_s"] is not None:
+        lines.append(f"n/a (beyond validity at t = {m['left_validity_at_s']:.4f} s): the penetration "
+                     "passed the contact law's validity bound, force and displacement metrics are not "
+                     "computable (metrics.json keeps their values up to then as *_before_invalid)")
     lines += [f"warning: {w}" for w in m["warnings"]]
     return "\n".join(lines)
 
@@ -124,15 +129,17 @@ def _post_fault_tables(m: dict) -> list[str]:
              f"{'sleeve [rpm]':>14}"]
     for p, v in m["planes"].items():
         f = v["whirl_frequency_hz"]
-        lines.append(f"{p:6}{v['max_displacement_um']:15.1f}{v['peak_contact_force_N']:14.0f}"
+        lines.append(f"{p:6}{_cell(v, 'max_displacement_um', '.1f'):>15}"
+                     f"{_cell(v, 'peak_contact_force_N', '.0f'):>14}"
                      f"{'yes' if v['backward_whirl'] else 'no':>7}{f'{f:.1f}' if f else '-':>14}"
                      f"{v['final_sleeve_speed_rpm']:14.0f}")
     lines.append(f"{'retainer':10}{'bearing load [N]':>17}{'s0':>7}{'worst ball [N]':>16}"
                  f"{'p_max [MPa]':>13}{'friction heat [J]':>19}")
     for p, v in m["planes"].items():
-        lines.append(f"{p:10}{v['peak_bearing_load_N']:17.0f}{_fmt(v['static_safety_factor'], '.1f'):>7}"
-                     f"{_fmt(v['max_ball_load_N'], '.0f'):>16}{_fmt(v['max_contact_pressure_MPa'], '.0f'):>13}"
-                     f"{_fmt(v['friction_heat_J'], '.0f'):>19}")
+        lines.append(f"{p:10}{_cell(v, 'peak_bearing_load_N', '.0f'):>17}"
+                     f"{_cell(v, 'static_safety_factor', '.1f'):>7}"
+                     f"{_cell(v, 'max_ball_load_N', '.0f'):>16}{_cell(v, 'max_contact_pressure_MPa', '.0f'):>13}"
+                     f"{_cell(v, 'friction_heat_J', '.0f'):>19}")
     p0 = m.get("rating_pressure_MPa")
     lines += ["s0: static safety factor C_0 / peak bearing load; p_max: Hertz pressure of the worst "
               "ball" + (f" (s0 = 1 at {p0:.0f} MPa for this bearing)" if p0 else ""),
@@ -143,9 +150,19 @@ def _post_fault_tables(m: dict) -> list[str]:
                  else "")]
     if "max_temperature_rise_K" in next(iter(m["planes"].values())):       # effects.thermal
         lines.append("sleeve heating: " + ", ".join(
-            f"{p} +{v['max_temperature_rise_K']:.1f} K max, mu {v['min_friction_coefficient']:.3f}"
-            f"-{v['max_friction_coefficient']:.3f}" for p, v in m["planes"].items()))
+            f"{p} +{_cell(v, 'max_temperature_rise_K', '.1f')} K max, mu "
+            f"{_cell(v, 'min_friction_coefficient', '.3f')}-{_cell(v, 'max_friction_coefficient', '.3f')}"
+            for p, v in m["planes"].items()))
     return lines
+
+
+def _cell(v: dict, key: str, spec: str) -> str:
+    """A per-plane metric for the tables: "n/a" where the run left validity before it could be
+    computed (``physics.metrics.mark_validity``), else :func:`_fmt`."""
+    from .metrics import BEFORE_INVALID
+    if v[key] is None and key + BEFORE_INVALID in v:
+        return "n/a"
+    return _fmt(v[key], spec)
 
 
 def _fmt(value, spec: str) -> str:

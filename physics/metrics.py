@@ -1,6 +1,11 @@
 """Drop KPIs per retainer plane (displacement, contact force, first contact, backward whirl) and
 the checks that say when they do not describe a clean drop (contact before the fault, stator
-contact, no fault in the run, output samples too coarse), listed as ``warnings``."""
+contact, no fault in the run, output samples too coarse), listed as ``warnings``.
+
+A run whose penetration passes a contact law's validity bound (:func:`physics.validity.validity_bound`)
+leaves the domain of its laws at ``left_validity_at_s``: its force and displacement metrics
+(:data:`INVALID_KEYS`, :data:`STATOR_INVALID_KEYS`) are then None, their values over the samples
+before that time kept as ``<key>_before_invalid``."""
 from __future__ import annotations
 
 import functools
@@ -10,11 +15,12 @@ import numpy as np
 
 from .amb import weight_shares
 from .ball_bearing import film_thickness, max_contact_pressure, static_max_ball_load
-from .contact import line_validity
+from .contact import effective_modulus
 from .dissipation import dissipation_check
 from .integrate import P_FR, P_LOAD, P_QMAX
 from .model import F_FILM, F_RB, F_STATOR, P_FILM, PLANES, RB_SM
 from .results import AMB_PLANES, Result
+from .validity import validity_bound
 
 WHIRL_MIN_REVOLUTIONS = 3.0     # net backward orbit revolutions that make a backward whirl
 WHIRL_RADIUS_FRACTION = 0.5     # only orbit samples beyond this fraction of the clearance count
@@ -28,6 +34,17 @@ PEAK_TOLERANCE = 1.0 - math.cos(math.pi / SAMPLES_PER_PERIOD)   # the same 5 %, 
                                 # sampled peak this far below the step-resolved one is missed
 STEP_PEAK_KEYS = {"peak_contact_force_N": P_FR, "peak_bearing_load_N": P_LOAD,
                   "max_ball_load_N": P_QMAX}      # metrics key -> physics.integrate peak column
+# the force and displacement metrics that are None once a run left the validity of its laws
+INVALID_KEYS = ("max_displacement_um", "max_y_displacement_um", "peak_contact_force_N",
+                "peak_bearing_load_N", "static_safety_factor", "max_ball_load_N",
+                "max_contact_pressure_MPa", "friction_heat_J", "max_penetration_um",
+                # effects.thermal: heated by that friction
+                "max_temperature_rise_K", "final_temperature_rise_K", "min_friction_coefficient",
+                "max_friction_coefficient")
+PRE_FAULT_KEYS = ("pre_fault_peak_contact_force_N",)    # invalid only if it left before the fault
+STATOR_INVALID_KEYS = ("max_displacement_um", "stator_peak_force_N", "stator_contact_time_s",
+                       "stator_penetration_um")
+BEFORE_INVALID = "_before_invalid"                 # suffix of their values up to that time
 
 
 def per_plane(result: Result, compute) -> dict:
@@ -40,20 +57,23 @@ def per_plane(result: Result, compute) -> dict:
             for k, p in enumerate(PLANES)}
 
 
+def first_crossing(t: np.ndarray, x: np.ndarray, level: float) -> float | None:
+    """First time [s] the series ``x`` passes above ``level`` (x > level), interpolated linearly
+    from the sample before it; None if it never does."""
+    hit = np.flatnonzero(x > level)
+    if hit.size == 0:
+        return None
+    k = hit[0]
+    if k > 0 and x[k - 1] < level:
+        return float(t[k - 1] + (t[k] - t[k - 1]) * (level - x[k - 1]) / (x[k] - x[k - 1]))
+    return float(t[k])
+
+
 def first_contact_time(result: Result) -> float | None:
     """Earliest time either plane's gap closes, interpolated between samples [s]."""
-    best = None
-    for p in PLANES[:1] if result.twin_planes() else PLANES:
-        d = result.penetration(p)
-        hit = np.flatnonzero(d > 0.0)
-        if hit.size == 0:
-            continue
-        k = hit[0]
-        t = result.t[k]
-        if k > 0 and d[k - 1] < 0.0:
-            t = result.t[k - 1] + (result.t[k] - result.t[k - 1]) * (-d[k - 1]) / (d[k] - d[k - 1])
-        best = t if best is None else min(best, t)
-    return best
+    times = [first_crossing(result.t, result.penetration(p), 0.0)
+             for p in (PLANES[:1] if result.twin_planes() else PLANES)]
+    return min((t for t in times if t is not None), default=None)
 
 
 def whirl(result: Result, plane: str, after: float) -> dict:
@@ -68,7 +88,7 @@ def whirl(result: Result, plane: str, after: float) -> dict:
     e = result.orbit_after(plane, after, relative=True)
     t = result.t[i:]
     c = result.model.scene.contact.clearance
-    spin = np.sign(result.rotor_speed[i:].mean()) or 1.0
+    spin = (np.sign(result.rotor_speed[i:].mean()) or 1.0) if i < len(result.t) else 1.0
     r = result.radius_after(plane, after, relative=True)
     ang = np.arctan2(e[:, 1], e[:, 0])
     far = r > WHIRL_RADIUS_FRACTION * c
@@ -173,8 +193,7 @@ def contact_period(scene, plane: str, load: float) -> float | None:
     m = abs(weight_shares(scene.rotor.mass, scene.positions.rb1, scene.positions.rb2)[
         PLANES.index(plane)])
     if c.law == "hertz_line":
-        b = scene.bearing
-        a = math.pi * c.length * b.youngs_modulus / (2.0 * (1.0 - b.poisson ** 2))
+        a = math.pi * c.length * effective_modulus(scene.bearing.youngs_modulus, scene.bearing.poisson)
         lg = math.log(4.0 * a * c.clearance / load) if load > 0.0 else math.inf
         k = a / (lg - 2.0) if lg > 3.0 else a
     else:
@@ -202,7 +221,8 @@ def min_output_rate(result: Result, planes: dict) -> tuple[float, str]:
     best, source = 0.0, "nothing"
     for p, weight in zip(PLANES, weights):
         v = planes[p]                   # the peaks before and after the fault cover the run
-        load = max(abs(weight), v["peak_contact_force_N"], v["pre_fault_peak_contact_force_N"])
+        load = max(abs(weight), valid_or_before(v, "peak_contact_force_N"),
+                   valid_or_before(v, "pre_fault_peak_contact_force_N"))
         periods = {"contact": contact_period(scene, p, load)}
         f_whirl = v["whirl_frequency_hz"]
         periods["backward-whirl"] = 1.0 / f_whirl if f_whirl else None
@@ -231,9 +251,9 @@ def amb_plane_metrics(result: Result) -> dict:
         out[p] = dict(max_displacement_um=math.sqrt(r2) * 1e6, stator_contact=r2 >= gap * gap)
         out[p].update(stator_contact_events(result, p) if modelled else
                       dict(stator_contacts=None, stator_peak_force_N=None, stator_contact_time_s=None))
+        pen = result.stator_penetration(p)
+        out[p]["stator_penetration_um"] = max(float(pen.max()) if len(pen) else 0.0, 0.0) * 1e6
         q = result.stator(p)                    # the stator's own motion on its mount
-        rel = np.hypot(o[:, 0] - q[:, 0], o[:, 1] - q[:, 1]) if len(o) else np.zeros(1)
-        out[p]["stator_penetration_um"] = max(float(rel.max()) - gap, 0.0) * 1e6
         out[p]["max_stator_displacement_um"] = float(np.hypot(q[:, 0], q[:, 1]).max() * 1e6) \
             if len(q) else 0.0
     return out
@@ -251,12 +271,10 @@ def stator_contact_events(result: Result, plane: str) -> dict:
 
 
 def contact_validity(result: Result) -> dict:
-    """Per retainer plane: the largest rotor-sleeve penetration over the run [µm] and, with the
-    EHL film, the film at the highest sleeve speed [µm]; with the bounds they are checked
-    against: ``penetration_validity_um`` (:func:`physics.contact.line_validity`, 0.40 c: the
-    steel-on-steel line contact has no elastic approach much beyond it) and the bearing's radial
-    internal play P_d / 2 (a thicker film preloads the balls at the centre, outside the film
-    model's calibration)."""
+    """Per retainer plane: the largest rotor-sleeve penetration over the run [µm] (checked
+    against the law's bound by :func:`left_validity`) and, with the EHL film, the film at the
+    highest sleeve speed [µm], checked against the bearing's radial internal play P_d / 2 (a
+    thicker film preloads the balls at the centre, outside the film model's calibration)."""
     scene = result.model.scene
     film = bool(result.model.I[F_FILM])
 
@@ -267,11 +285,8 @@ def contact_validity(result: Result) -> dict:
         return dict(max_penetration_um=max(float(pen.max()), 0.0) * 1e6 if len(pen) else 0.0,
                     max_film_thickness_um=h * 1e6 if h is not None else None)
     planes = per_plane(result, plane)
-    bound = line_validity(scene.contact.clearance) * 1e6
     play = scene.bearing.clearance / 2.0 * 1e6
-    return dict(planes=planes, penetration_validity_um=bound, bearing_radial_play_um=play,
-                penetration_beyond_validity=[p for p, v in planes.items()
-                                             if v["max_penetration_um"] > bound],
+    return dict(planes=planes, bearing_radial_play_um=play,
                 film_exceeds_play=[p for p, v in planes.items()
                                    if v["max_film_thickness_um"] is not None
                                    and v["max_film_thickness_um"] > play])
@@ -288,20 +303,79 @@ def check_metrics(result: Result, m: dict) -> dict:
     out["amb_planes"] = amb_plane_metrics(result)
     out["stator_contact"] = any(v["stator_contact"] for v in out["amb_planes"].values())
     out["stator_contact_modelled"] = bool(result.model.I[F_STATOR])
-    out["stator_penetration_validity_um"] = bound = line_validity(result.model.scene.amb.air_gap) * 1e6
-    out["stator_beyond_validity"] = [p for p, v in out["amb_planes"].items() if
-                                     out["stator_contact_modelled"] and v["stator_penetration_um"] > bound]
     validity = contact_validity(result)
     for p, v in validity.pop("planes").items():
         m["planes"][p].update(v)
     out.update(validity)
+    out.update(mark_validity(result, m["planes"], out["amb_planes"]))
     rate = result.model.scene.solver.output_rate
     need, source = min_output_rate(result, m["planes"])
     out.update(output_rate_hz=rate, min_output_rate_hz=need, min_output_rate_source=source,
                output_rate_too_coarse=rate < need)
-    out["step_resolved_peaks"] = step_resolved_peaks(result)
+    # the step maxima cover the whole post-fault run: not computable once it left validity
+    out["step_resolved_peaks"] = (step_resolved_peaks(result) if out["left_validity_at_s"] is None
+                                  else None)
     out["sampled_peaks_missed"] = sampled_peaks_missed(m["planes"], out["step_resolved_peaks"])
     return out
+
+
+def left_validity(result: Result) -> dict:
+    """Per plane: the first time its penetration passes the contact law's validity bound
+    (``left_validity_at_s``, interpolated between samples; None if never) and the bound
+    (:meth:`physics.validity.Bound.to_dict`): the retainer planes always, the AMB planes with
+    ``effects.stator_contact`` (without it the stator contact check warns instead)."""
+    scene = result.model.scene
+    rb = validity_bound(scene, "retainer")
+    out = {p: dict(left_validity_at_s=first_crossing(result.t, result.penetration(p), rb.penetration),
+                   **rb.to_dict()) for p in PLANES}
+    if result.model.I[F_STATOR]:
+        st = validity_bound(scene, "stator")
+        for p in AMB_PLANES:
+            pen = result.stator_penetration(p)
+            out[p] = dict(left_validity_at_s=first_crossing(result.t, pen, st.penetration),
+                          **st.to_dict())
+    return out
+
+
+def mark_validity(result: Result, planes: dict, amb_planes: dict) -> dict:
+    """Adds :func:`left_validity` to the per-plane metrics ``planes`` and ``amb_planes`` and, when
+    the run left validity at t_inv (the earliest plane), replaces their :data:`INVALID_KEYS` /
+    :data:`STATOR_INVALID_KEYS` by None, keeping the values over the samples t < t_inv as
+    ``<key>_before_invalid``. Returns the run-level keys: ``left_validity_at_s`` and the planes
+    past their bound (``penetration_beyond_validity``, ``stator_beyond_validity``)."""
+    validity = left_validity(result)
+    times = [v["left_validity_at_s"] for v in validity.values() if v["left_validity_at_s"] is not None]
+    t_inv = min(times, default=None)
+    for table in (planes, amb_planes):
+        for p, v in table.items():
+            v.update(validity.get(p, dict(left_validity_at_s=None)))
+    if t_inv is not None:
+        early = result.until(t_inv)
+        keys = INVALID_KEYS + (PRE_FAULT_KEYS if result.t_fault is None or t_inv < result.t_fault
+                               else ())
+        table = _plane_table(early)
+        for p, v in contact_validity(early)["planes"].items():
+            table[p].update(v)
+        _null(planes, table, keys)
+        _null(amb_planes, amb_plane_metrics(early), STATOR_INVALID_KEYS)
+    left = [p for p, v in validity.items() if v["left_validity_at_s"] is not None]
+    return dict(left_validity_at_s=t_inv,
+                penetration_beyond_validity=[p for p in left if p in PLANES],
+                stator_beyond_validity=[p for p in left if p in AMB_PLANES])
+
+
+def _null(table: dict, early: dict, keys: tuple[str, ...]) -> None:
+    """table[p][key] -> None and table[p][key + BEFORE_INVALID] = early[p][key] (the same value
+    over the samples before the run left validity), for every plane and key that has a value."""
+    for p, v in table.items():
+        for key in (k for k in keys if v.get(k) is not None):
+            v[key + BEFORE_INVALID] = early[p][key]
+            v[key] = None
+
+
+def valid_or_before(v: dict, key: str):
+    """A per-plane metric, or its value before the run left validity where it is None."""
+    return v[key] if v.get(key) is not None else v.get(key + BEFORE_INVALID)
 
 
 def step_resolved_peaks(result: Result) -> dict | None:
@@ -332,28 +406,19 @@ def warnings_of(m: dict, scene) -> list[str]:
                    "happened, the per-plane and retainer numbers are the levitated rotor's at the "
                    "last sample (raise --t-end / solver.t_end above amb.off_time)")
     if m["contact_before_fault"]:
-        peaks = ", ".join(f"{p} {v['pre_fault_peak_contact_force_N']:.0f} N"
+        peaks = ", ".join(f"{p} {valid_or_before(v, 'pre_fault_peak_contact_force_N'):.0f} N"
                           for p, v in m["planes"].items())
         out.append(f"the rotor touches the retainer bearings before the fault, while levitated "
                    f"(peak contact force {peaks}); the post-fault metrics exclude it (check "
                    "contact.clearance, support.stiffness, unbalance)")
     if m["stator_contact"] and not m["stator_contact_modelled"]:
-        disp = ", ".join(f"{p} {v['max_displacement_um']:.0f} µm" for p, v in m["amb_planes"].items())
+        disp = ", ".join(f"{p} {valid_or_before(v, 'max_displacement_um'):.0f} µm"
+                         for p, v in m["amb_planes"].items())
         out.append(f"the rotor reaches the AMB stator (amb.air_gap = {scene.amb.air_gap * 1e6:.0f} µm; "
                    f"max displacement {disp}): the model has no stator contact, the motion "
                    "beyond it is not physical (set effects.stator_contact = true)")
-    if m["stator_beyond_validity"]:
-        out.append("rotor-stator penetration " + ", ".join(
-            f"{p} {m['amb_planes'][p]['stator_penetration_um']:.0f} µm" for p in m["stator_beyond_validity"])
-                   + f" passes {m['stator_penetration_validity_um']:.0f} µm (0.40 x amb.air_gap): "
-                   "the stator stack cannot deform that far, the rotor rolls on the stator (dry "
-                   "whip, see stator_peak_force_N); read it as a destroyed stator, not a motion")
-    if m["penetration_beyond_validity"]:
-        pen = _per_plane(m, m["penetration_beyond_validity"], "max_penetration_um", ".0f")
-        out.append(f"rotor-sleeve penetration {pen} passes the contact law's validity bound "
-                   f"{m['penetration_validity_um']:.0f} µm (0.40 x contact.clearance, where a steel "
-                   "line contact stops having an elastic approach): the forces beyond it are the "
-                   f"contact.law = {scene.contact.law!r} law's extrapolation, not a deformation")
+    if m["left_validity_at_s"] is not None:
+        out.append(validity_warning(m, scene))
     if m["film_exceeds_play"]:
         film = _per_plane(m, m["film_exceeds_play"], "max_film_thickness_um", ".1f")
         out.append(f"the EHL film at the highest sleeve speed ({film}) exceeds the retainer "
@@ -387,6 +452,21 @@ def warnings_of(m: dict, scene) -> list[str]:
     return out
 
 
+def validity_warning(m: dict, scene) -> str:
+    """The warning of a run that left the validity of its contact laws (:func:`mark_validity`)."""
+    where = {p: v for table in ("planes", "amb_planes") for p, v in m[table].items()
+             if v.get("left_validity_at_s") is not None}
+    when = ", ".join(f"{p} at t = {v['left_validity_at_s']:.4f} s" for p, v in where.items())
+    bounds = "; ".join(sorted({f"{v['validity_bound_um']:.1f} µm ({v['validity_criterion']})"
+                               for v in where.values()}))
+    return (f"the penetration passes the contact law's validity bound ({when}; bound {bounds}): "
+            f"the contact laws (contact.law = {scene.contact.law!r}"
+            + (", stator contact: the rotor rolls on the stator, dry whip; read it as a destroyed "
+               "stator, not a motion" if m["stator_beyond_validity"] else "")
+            + ") do not describe the run from then on; force and displacement metrics are n/a, "
+            f"their values before t = {m['left_validity_at_s']:.4f} s are the *{BEFORE_INVALID} keys")
+
+
 def _per_plane(m: dict, planes: list[str], key: str, spec: str) -> str:
     """"RB1 179 µm, RB2 179 µm": a per-plane µm metric of ``planes`` for a warning."""
     return ", ".join(f"{p} {m['planes'][p][key]:{spec}} µm" for p in planes)
@@ -395,7 +475,6 @@ def _per_plane(m: dict, planes: list[str], key: str, spec: str) -> str:
 def compute_metrics(result: Result) -> dict:
     """The numbers written to metrics.json (SI, with µm and rpm at the edges)."""
     t_fault = result.t_fault if result.t_fault is not None else result.t[-1]
-    post = after(result, t_fault)
     t_fc = first_contact_time(result)
     out = dict(scene=result.model.scene.name, t_end=float(result.t[-1]), t_fault_s=result.t_fault,
                first_contact_time_s=t_fc,
@@ -404,8 +483,7 @@ def compute_metrics(result: Result) -> dict:
                wall_time_s=result.stats.wall_time_s, compile_time_s=result.stats.compile_time_s,
                rhs_evaluations=result.stats.rhs_evaluations, steps=result.stats.steps,
                rejected_steps=result.stats.rejected_steps, n_state=result.model.n_state, planes={})
-    pre = pre_fault(result)
-    out["planes"] = per_plane(result, lambda p: plane_metrics(result, p, t_fault, post, pre))
+    out["planes"] = _plane_table(result)
     out["backward_whirl"] = any(out["planes"][p]["backward_whirl"] for p in PLANES)
     balls = result.model.I[F_RB] == RB_SM
     out["rating_pressure_MPa"] = rating_pressure(result.model.scene.bearing) * 1e-6 if balls else None
@@ -413,6 +491,13 @@ def compute_metrics(result: Result) -> dict:
     out["dissipation"] = dissipation_check(result)
     out["warnings"] = warnings_of(out, result.model.scene)
     return out
+
+
+def _plane_table(result: Result) -> dict:
+    """{plane: :func:`plane_metrics`} of a run (its fault, or its end without one)."""
+    t_fault = result.t_fault if result.t_fault is not None else result.t[-1]
+    post, pre = after(result, t_fault), pre_fault(result)
+    return per_plane(result, lambda p: plane_metrics(result, p, t_fault, post, pre))
 
 
 def plane_metrics(result: Result, p: str, t_fault: float, post: slice, pre: slice) -> dict:

@@ -52,6 +52,13 @@ class Result:
     step_peaks: np.ndarray | None = None
     _derived: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
+    def until(self, t_end: float) -> "Result":
+        """The samples t < ``t_end`` as a new result (at least the first sample), without the
+        step-resolved peaks (they cover the whole run): the run up to a time, e.g. up to where
+        it left the contact law's validity (``physics.metrics``)."""
+        k = max(int(np.searchsorted(self.t, t_end, "left")), 1)
+        return Result(self.model, self.t[:k], self.Y[:k], self.aux[:k], self.stats, self.t_fault)
+
     # -- rotor ----------------------------------------------------------------------------
     def state(self, name: str) -> np.ndarray:
         """The time series of one state by name (``Model.names``, e.g. ``"x"``, ``"Omega"``)."""
@@ -93,6 +100,12 @@ class Result:
             return np.zeros((len(self.t), 2))
         i += 4 * self._plane(plane, AMB_PLANES)
         return self.Y[:, i:i + 2]
+
+    def stator_penetration(self, plane: str) -> np.ndarray:
+        """Rotor-stator penetration |p - q| - g_0 at AMB plane ``AMB1``/``AMB2`` [m] (negative
+        inside the air gap): rotor axis p relative to the stator centre q (on its mount)."""
+        d = self.amb_orbit(plane) - self.stator(plane)
+        return np.hypot(d[:, 0], d[:, 1]) - self.model.scene.amb.air_gap
 
     def orbit_after(self, plane: str, t0: float, relative: bool = False) -> np.ndarray:
         """:meth:`orbit` at the samples t >= ``t0`` (``relative``: minus :meth:`sleeve`, the

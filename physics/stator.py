@@ -18,7 +18,7 @@ from __future__ import annotations
 import math
 
 from ._jit import njit
-from .contact import geometry, smooth_sign
+from .contact import geometry, half_width_approach, smooth_sign
 from .roots import bisect_decreasing
 
 
@@ -44,6 +44,20 @@ def damping_ratio(e: float) -> float:
 def damping_coefficient(stiffness: float, mass: float, e: float) -> float:
     """Dashpot c = 2 ζ √(k m) [N s/m] giving restitution ``e`` for ``mass`` on ``stiffness``."""
     return 2.0 * damping_ratio(e) * math.sqrt(stiffness * mass)
+
+
+def penetration_bound(rotor_radius: float, gap: float) -> float:
+    """δ_b [m]: the stator penetration at which the law leaves its assumptions.
+
+    ``stator.stiffness`` is the secant of Johnson's internal line contact of the rotor (radius
+    R_a) in the stator bore (radial gap g_0), so the spring's penetration stands for that
+    contact's approach; the same half-width criterion as the retainer's hertz_line law, b <= 0.3 R_a
+    (:func:`physics.contact.half_width_load`), is reached at the approach
+    :func:`physics.contact.half_width_approach` (R_a, g_0), which depends on the geometry only
+    (55.9 µm = 0.093 g_0 for R_a = 45 mm, g_0 = 600 µm; the stack's length and modulus are not
+    scene parameters, the load bound would need them). A fraction of the air gap would not
+    measure the contact's deformation, so it is not used."""
+    return half_width_approach(rotor_radius, gap)
 
 
 @njit

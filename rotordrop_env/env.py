@@ -17,6 +17,7 @@ from physics.ball_bearing import max_contact_pressure
 from physics.model import F_RB, I_CS, P_Z_RB1, RB_SM, S_A, S_B, S_W, S_X, S_Y
 from physics.scene import Scene, SceneError, load_scene
 from physics.simulate import IntegrationError, _explain
+from physics.validity import validity_bound
 
 from . import kernels as K
 from .buffers import Buffers
@@ -98,7 +99,8 @@ class RotorDropEnv(gym.Env):
     power_return_time           0.05        re-levitation envs: power returns [s after fault]
     samples_per_step            5           monitor samples per control step (dense output)
     relevitation_hold           0.02        re-levitated after this long in the success region [s]
-    terminate_on_failure        True        end at the stator or at a bearing overload
+    terminate_on_failure        True        end at the stator, at a bearing overload or when
+                                            a contact leaves its law's validity bound
     w_whirl, w_contact,         10, 0.1,    reward weights (see Reward)
     w_displacement, w_effort,   0.1, 0.01,
     w_success, w_failure        10, 10
@@ -122,8 +124,10 @@ class RotorDropEnv(gym.Env):
     =============  ========================================================================
 
     Episode end: ``terminated`` when the rotor reaches the AMB stator (radial displacement
-    ``amb.air_gap`` = 600 µm at an AMB plane) or a contact force exceeds the retainer
-    bearing's static load rating C_0; ``truncated`` only at the time limit.
+    ``amb.air_gap`` = 600 µm at an AMB plane), a contact force exceeds the retainer bearing's
+    static load rating C_0 or a penetration passes its contact law's validity bound
+    (:func:`physics.validity.validity_bound`; ``info["beyond_validity"]``, latched, at reset and
+    every step); ``truncated`` only at the time limit.
     """
 
     metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 30}
@@ -331,6 +335,9 @@ class RotorDropEnv(gym.Env):
         C[K.C_CS_MIN], C[K.C_CS_MAX] = scene.support.damping_min, scene.support.damping_max
         C[K.C_ILIM] = scene.amb.current_limit
         C[K.C_RELEV_RADIUS] = 0.5 * scene.contact.clearance
+        C[K.C_PEN_BOUND] = validity_bound(scene, "retainer").penetration
+        C[K.C_STATOR_BOUND] = (validity_bound(scene, "stator").penetration
+                               if scene.effects.stator_contact else math.inf)
 
     # ------------------------------------------------------------------------ episode --
     def reset(self, *, seed: int | None = None, options: dict | None = None):
@@ -375,7 +382,7 @@ class RotorDropEnv(gym.Env):
         if self.render_mode is not None:            # record from the first step of the episode
             self._reset_view()
             self._record(step=False)
-        info = {"scenario": dict(self._scenario), "time_s": 0.0}
+        info = {"scenario": dict(self._scenario), "time_s": 0.0, "beyond_validity": False}
         if not self._sensing.active:
             return b.obs.astype(np.float32), info
         obs = self._sensing.reset(b.obs, self.np_random)
@@ -490,6 +497,9 @@ class RotorDropEnv(gym.Env):
                 "kpi_control_effort": float(M[K.M_EFFORT]),
                 "kpi_stator_contact": bool(M[K.M_STATOR]),
                 "kpi_bearing_overload": bool(M[K.M_OVERLOAD]),
+                "kpi_beyond_validity": bool(M[K.M_BEYOND]),
+                "kpi_time_within_validity_s": (float(M[K.M_LEFT_T] - self._b.C[K.C_T_FAULT])
+                                               if M[K.M_BEYOND] else self.time),
                 **ball_kpis(self.model, self.scene, float(M[K.M_PEAK_Q])),
                 "kpi_episode_time_s": self.time}
 
@@ -575,7 +585,7 @@ def step_info(out: list, M: list, t_fault: float, relevitate: bool) -> dict:
     """The per-step ``info`` of one environment from its kernel outputs and monitor (as lists:
     indexing Python lists is the cheapest way to build the dict every step)."""
     info = dict(zip(_INFO_KEYS, _info_values(out)), time_s=M[K.M_T] - t_fault,
-                backward_whirl=M[K.M_WHIRL] > 0.0)
+                backward_whirl=M[K.M_WHIRL] > 0.0, beyond_validity=M[K.M_BEYOND] > 0.0)
     if relevitate:
         info["relevitated"] = M[K.M_RELEV] > 0.0
     return info

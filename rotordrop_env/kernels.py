@@ -5,7 +5,9 @@ Everything an episode needs lives in flat arrays so that the single environment 
 VecEnv run the very same code (the batch owns (N, ...) stacks, each environment a row view):
 
 * ``C``  float64 configuration of the episode (indices ``C_*``), set at reset,
-* ``M``  float64 running monitor (time, step size, whirl revolutions, peaks, re-levitation...),
+* ``M``  float64 running monitor (time, step size, whirl revolutions, peaks, re-levitation,
+  whether and when a penetration passed its validity bound ``C_PEN_BOUND`` / ``C_STATOR_BOUND``
+  of :func:`physics.validity.validity_bound`...),
 * ``out`` float64 per-step results (reward and its terms, flags, status; indices ``O_*``).
 
 The physics is :func:`physics.integrate.integrate_segment` on :func:`physics.model.rhs`; the
@@ -20,17 +22,18 @@ import numba
 
 from physics._jit import njit, njit_parallel
 from physics.integrate import integrate_segment
-from physics.model import (A_FR, A_QMAX, A_WS, I_AMB_FILT, I_AMB_INT, I_CS, N_AUX_PLANE, P_CLR,
-                           P_Z_AMB1, P_Z_RB1, S_W, U_AMB_DIRECT, U_AMB_GAIN, U_AMB_POWER, U_CS1,
-                           U_ICMD, U_REF0, U_REF_OFF, U_T_ON, amb_currents, axis_motion, rhs,
-                           sleeve_motion)
+from physics.model import (A_DELTA, A_FR, A_QMAX, A_WS, I_AMB_FILT, I_AMB_INT, I_CS, N_AUX_PLANE,
+                           P_CLR, P_Z_AMB1, P_Z_RB1, S_W, U_AMB_DIRECT, U_AMB_GAIN, U_AMB_POWER,
+                           U_CS1, U_ICMD, U_REF0, U_REF_OFF, U_T_ON, amb_currents, axis_motion,
+                           rhs, sleeve_motion, stator_motion)
 
 # ------------------------------------------------------------------------ configuration C --
 (C_DT, C_T_FAULT, C_T_END, C_T_POWER, C_DAMP, C_LEV,
  C_RTOL, C_HMAX, C_HMIN, C_FIXED, C_MAXSTEPS,
  C_W_WHIRL, C_W_CONTACT, C_W_DISP, C_W_EFFORT, C_W_SUCCESS, C_W_FAILURE,
  C_F_REF, C_GAP, C_LOAD_RATING, C_HOLD, C_TERMINATE, C_FULL, C_CS_MIN, C_CS_MAX, C_ILIM,
- C_RELEV_RADIUS, C_WHIRL_RADIUS, C_WHIRL_REVS, C_SUP_OFFSET, C_SUP_OCTAVES, N_C) = range(32)
+ C_RELEV_RADIUS, C_WHIRL_RADIUS, C_WHIRL_REVS, C_SUP_OFFSET, C_SUP_OCTAVES,
+ C_PEN_BOUND, C_STATOR_BOUND, N_C) = range(34)
 LEV_NONE, LEV_DISCRETE, LEV_CONTINUOUS, LEV_SUPERVISOR = 0, 1, 2, 3
 #: C[C_DAMP]: no damper commands, or the damper action's map (env kwarg ``damping_action``)
 DAMP_NONE, DAMP_LINEAR, DAMP_FROM_MAX = 0.0, 1.0, 2.0
@@ -40,11 +43,11 @@ SUP_MIN_RADIUS = 0.05
 # ------------------------------------------------------------------------------ monitor M --
 (M_T, M_H, M_REV1, M_REV2, M_WHIRL, M_PEAK_F, M_MAX_DISP, M_OK_START, M_RELEV,
  M_RELEV_T, M_EFFORT, M_CTRL_ON, M_POWER, M_REV_PEAK, M_PEAK_Q, M_STATOR, M_OVERLOAD,
- N_M) = range(18)
+ M_BEYOND, M_LEFT_T, N_M) = range(20)
 
 # ------------------------------------------------------------------------------ outputs --
 (O_REWARD, O_R_WHIRL, O_R_CONTACT, O_R_DISP, O_R_EFFORT, O_R_SUCCESS, O_R_FAILURE, O_FORCE,
- O_TERM, O_TRUNC, O_STATUS, O_ERR, O_STATOR, O_OVERLOAD, N_O) = range(15)
+ O_TERM, O_TRUNC, O_STATUS, O_ERR, O_STATOR, O_OVERLOAD, O_BEYOND, N_O) = range(16)
 ERR_NONE, ERR_NAN, ERR_RANGE = 0, 1, 2
 ACTION_TOL = 1e-6            # actions may exceed [-1, 1] by this much (float32 round-off)
 TWO_PI = 2.0 * math.pi
@@ -255,6 +258,7 @@ def step_one(a, y, P, I, U, atol, work, t_sub, Y_sub, aux, cur, C, M, scale, obs
     disp_step = 0.0
     back = 0.0
     stator = False
+    beyond = False
     lev = int(C[C_LEV])
     for s in range(n_sub):
         ys = Y_sub[s]
@@ -279,8 +283,19 @@ def step_one(a, y, P, I, U, atol, work, t_sub, Y_sub, aux, cur, C, M, scale, obs
             if fr > 0.0 or r_abs >= C[C_RELEV_RADIUS]:
                 ok = False
             ax, ay, _, _ = axis_motion(ys, I, P[P_Z_AMB1 + k])
-            if ax * ax + ay * ay >= C[C_GAP] * C[C_GAP]:
+            a2 = ax * ax + ay * ay
+            if a2 >= C[C_GAP] * C[C_GAP]:
                 stator = True
+                # validity bounds (physics.validity): stator penetration, only past the gap,
+                # relative to the stator (on its mount with effects.stator_mount)
+                qx, qy, _, _ = stator_motion(ys, I, k)
+                if math.hypot(ax - qx, ay - qy) - C[C_GAP] > C[C_STATOR_BOUND]:
+                    beyond = True
+            if aux[k * N_AUX_PLANE + A_DELTA] > C[C_PEN_BOUND]:
+                beyond = True
+        if beyond and M[M_BEYOND] == 0.0:
+            M[M_BEYOND] = 1.0
+            M[M_LEFT_T] = ts
         if lev != LEV_NONE and M[M_RELEV] == 0.0:
             if ok:
                 if M[M_OK_START] < 0.0:
@@ -317,9 +332,10 @@ def step_one(a, y, P, I, U, atol, work, t_sub, Y_sub, aux, cur, C, M, scale, obs
     overload = f_step > C[C_LOAD_RATING]
     out[O_STATOR] = 1.0 if stator else 0.0
     out[O_OVERLOAD] = 1.0 if overload else 0.0
+    out[O_BEYOND] = 1.0 if beyond else 0.0
     M[M_STATOR] = max(M[M_STATOR], out[O_STATOR])          # latched: "it happened this episode"
     M[M_OVERLOAD] = max(M[M_OVERLOAD], out[O_OVERLOAD])
-    if (stator or overload) and C[C_TERMINATE] > 0.0:
+    if (stator or overload or beyond) and C[C_TERMINATE] > 0.0:
         out[O_TERM] = 1.0
         remaining = max(round((C[C_T_END] - t1) / dt), 0.0)
         out[O_R_FAILURE] = -C[C_W_FAILURE] * remaining

@@ -227,7 +227,7 @@ def test_parametric_sweep_reports_failed_drops(tmp_path):
     assert "solver.max_steps" in cell["errors"][0]
     assert len(r["runs"]) == 2 and not any(run["ok"] for run in r["runs"])
     assert all("--set solver.max_steps=100" in run["command"] for run in r["runs"])
-    assert (out / "sweep.csv").read_text().splitlines()[1] == ("0.2,2,2" + "," * (1 + 3 * len(PLANE_KPIS))
+    assert (out / "sweep.csv").read_text().splitlines()[1] == ("0.2,2,2,0" + "," * (1 + 3 * len(PLANE_KPIS))
                                                            + ",0" * len(WARNING_KINDS))  # no metrics
     assert (out / "sweep.png").is_file()
 

@@ -32,6 +32,22 @@ WARNING_KINDS: dict[str, tuple[Callable[[dict], bool], str]] = {
 NO_FAULT = "NoFault"
 
 
+def beyond_validity(metrics: dict | None) -> bool:
+    """The drop's penetration passed a contact law's validity bound (``left_validity_at_s``,
+    :func:`physics.metrics.mark_validity`): its force and displacement numbers are None, so a
+    study counts it apart and keeps it out of every ratio, median and peak table. Its whirl
+    decision still counts: the backward revolutions are counted on the orbit, and a whirl that
+    drives the contact past its bound is a whirl."""
+    return bool(metrics) and metrics.get("left_validity_at_s") is not None
+
+
+def split_valid(outcomes: Iterable[Outcome]) -> tuple[list[Outcome], int]:
+    """The outcomes within validity, and how many others left it (:func:`beyond_validity`)."""
+    outcomes = list(outcomes)
+    valid = [o for o in outcomes if not beyond_validity(o.metrics)]
+    return valid, len(outcomes) - len(valid)
+
+
 def warning_kinds(metrics: dict) -> list[str]:
     """The kinds of :data:`WARNING_KINDS` whose check this drop's metrics fail."""
     return [k for k, (failed, _) in WARNING_KINDS.items() if failed(metrics)]

@@ -114,7 +114,7 @@ def _late_peak(a, _c):
 def _leaves_circle(a, c_um):
     rows = [r for r in _obs(a) for k in ("whirl", "no_whirl") if r[k] is not None]
     smallest = min(r[k]["max_displacement_um"] for r in _obs(a) for k in ("whirl", "no_whirl")
-                   if r[k] is not None)
+                   if r[k] is not None and r[k]["max_displacement_um"] is not None)
     ok = bool(rows) and smallest > c_um
     return _row("The orbit leaves the static clearance circle (elastic support, bearing "
                 "compression)", f"orbit beyond the {c_um:.0f} µm circle",
@@ -162,8 +162,18 @@ def _bounces(a, _c):
 
 
 # -- support stiffness ------------------------------------------------------------------------
-def _stiff(a, k):
+def _support_row(a, k):
     return next(r for r in a["support_stiffness"] if r["stiffness"] == k)
+
+
+def _stiff(a, k):
+    """The nominal drop's row at support stiffness ``k``; a ValueError (the claim is then not
+    computable) when it left the contact laws' validity: its forces and displacements are None."""
+    r = _support_row(a, k)
+    if r.get("beyond_validity_at_s") is not None:
+        raise ValueError(f"the K_s = {k:g} drop left the contact law's validity at t = "
+                         f"{r['beyond_validity_at_s']:.3f} s: its forces and displacements are n/a")
+    return r
 
 
 def _soft_600(a, _c):
@@ -187,7 +197,7 @@ def _same_regime(e1: dict, e2: dict, key: str) -> tuple[float, float, str]:
 
 
 def _soft_settles(a, _c):
-    s, h = _stiff(a, SOFT)["ensemble"], _stiff(a, STIFF)["ensemble"]
+    s, h = _support_row(a, SOFT)["ensemble"], _support_row(a, STIFF)["ensemble"]
     ss, hs, note = _same_regime(s, h, "force_settling_s")
     ok = ss < hs
     return _row("K_s = 5e6 settles quickly, unlike the stiffly supported rotor",
@@ -198,7 +208,7 @@ def _soft_settles(a, _c):
 
 
 def _ratio_note(a):
-    h = _stiff(a, STIFF)
+    h = _support_row(a, STIFF)
     pw = h.get("ensemble", {}).get("whirl_probability")
     b = FIRST_IMPACT_BOUND_N
     return (f"at K_s = 5e8 our rotor whirls (probability {_fmt(pw)}) and whirl forces dwarf impact "

@@ -20,7 +20,7 @@ from ..scene import Scene, SceneError, load_scene
 from ..simulate import IntegrationError, simulate
 from ..backend import Backend, Dispatch, run_drops
 from ..sweep import Outcome, Run, changes, outcome_of, reproduce_command
-from .checks import as_drop, warning_counts
+from .checks import as_drop, beyond_validity, split_valid, warning_counts
 from .ensemble import ENSEMBLE_KEYS, onset, perturbations, probability_curve
 from .observables import drop_observables
 
@@ -284,11 +284,16 @@ def _per_friction(ok: list[Outcome]) -> list[dict]:
 
 
 def _medians(grp: list[Outcome]) -> dict:
+    """Medians over the drops of ``grp`` within the contact laws' validity; ``runs`` counts them
+    all, ``beyond_validity`` those left out."""
+    runs = len(grp)
+    grp, beyond = split_valid(grp)
+
     def med(vals):
         vals = [v for v in vals if v is not None]
         return float(np.median(vals)) if vals else None
     return dict(
-        runs=len(grp),
+        runs=runs, beyond_validity=beyond,
         max_displacement_um=med([worst_plane(o.metrics, "max_displacement_um") for o in grp]),
         max_y_displacement_um=med([worst_plane(o.metrics, "max_y_displacement_um") for o in grp]),
         max_x_um=med([o.extra["max_x_um"] for o in grp]),
@@ -304,14 +309,21 @@ def _medians(grp: list[Outcome]) -> dict:
 
 
 def _support(outs: list[Outcome], what: str) -> list[dict]:
-    """Nominal run and ensemble statistics for each support stiffness / damping value."""
+    """Nominal run and ensemble statistics for each support stiffness / damping value. A nominal
+    drop beyond the contact laws' validity keeps only its whirl decision and
+    ``beyond_validity_at_s``; ensemble statistics are over the drops within it (``beyond_validity``
+    counts the others, which the whirl probability includes)."""
     rows = []
     for v in sorted({o.run.label["value"] for o in outs}):
         grp = [o for o in outs if o.run.label["value"] == v]
         nominal = next((o for o in grp if o.run.label["member"] == -1), None)
         ens = [o for o in grp if o.run.label["member"] >= 0 and o.ok]
         row: dict = {what: v}
-        if nominal is not None and nominal.ok:
+        if nominal is not None and nominal.ok and beyond_validity(nominal.metrics):
+            row.update(beyond_validity_at_s=nominal.metrics["left_validity_at_s"],
+                       backward_whirl=bool(nominal.metrics["backward_whirl"]),
+                       command=nominal.run.to_dict()["command"])
+        elif nominal is not None and nominal.ok:
             m, x = nominal.metrics, nominal.extra
             row.update(
                 max_displacement_um=worst_plane(nominal.metrics, "max_displacement_um"),
@@ -325,12 +337,15 @@ def _support(outs: list[Outcome], what: str) -> list[dict]:
         else:
             row.update(error=nominal.error if nominal is not None else "missing")
         if ens:
-            row["ensemble"] = dict(members=len(ens),
+            valid, beyond = split_valid(ens)
+            row["ensemble"] = dict(members=len(ens), beyond_validity=beyond,
                                    whirl_probability=sum(map(_whirl, ens)) / len(ens),
-                                   **_ensemble_stats(ens))
+                                   **_ensemble_stats(valid))
             for tag, sel in (("whirl", True), ("no_whirl", False)):
-                grp_ = [o for o in ens if _whirl(o) == sel]
-                row["ensemble"][tag] = dict(members=len(grp_), **_ensemble_stats(grp_))
+                grp_ = [o for o in valid if _whirl(o) == sel]
+                row["ensemble"][tag] = dict(
+                    members=len(grp_), beyond_validity=sum(_whirl(o) == sel for o in ens) - len(grp_),
+                    **_ensemble_stats(grp_))
         rows.append(row)
     return rows
 
@@ -354,7 +369,7 @@ def _sensitivity(outs: list[Outcome], settings: list[tuple[str, str, dict]]) -> 
     for factor, setting, overrides in settings:
         grp = [o for o in outs if (o.run.label["factor"], o.run.label["setting"]) == (factor, setting)]
         sweep = [o for o in grp if o.run.label["friction"] != "soft" and o.ok]
-        soft = [o for o in grp if o.run.label["friction"] == "soft" and o.ok]
+        soft, soft_beyond = split_valid(o for o in grp if o.run.label["friction"] == "soft" and o.ok)
         mus = [o.run.label["friction"] for o in sweep]
         whirls = [_whirl(o) for o in sweep]
         curve = probability_curve(mus, whirls)
@@ -366,6 +381,7 @@ def _sensitivity(outs: list[Outcome], settings: list[tuple[str, str, dict]]) -> 
                                          runs=c["runs"]) for c in curve],
             soft_max_y_displacement_um=_median_worst(soft, "max_y_displacement_um"),
             soft_peak_contact_force_N=_median_worst(soft, "peak_contact_force_N"),
+            soft_beyond_validity=soft_beyond,
             failed=sum(not o.ok for o in grp)))
     return rows
 

@@ -31,7 +31,8 @@ from ..metrics import worst_plane
 from ..scene import SceneError, load_scene
 from ..backend import Backend, plan_threads, run_drops
 from ..sweep import Outcome, Run
-from .checks import WARNING_KINDS, as_drop, counts_text, warning_counts, warnings_note
+from .checks import (WARNING_KINDS, as_drop, counts_text, split_valid, warning_counts,
+                     warnings_note)
 from .ensemble import ENSEMBLE_KEYS, perturbations
 from .labels import PLANE_KPIS, value_label
 
@@ -125,14 +126,16 @@ def summarize_cell(outcomes: list[Outcome]) -> dict:
     """Whirl probability and the median / min / max of each plane KPI over the members that ran
     and have it (None where none has it, e.g. the ball-race pressure of a linear mount), and the
     drops per failed drop check (``warnings``, :mod:`physics.study.checks`). A run without a
-    fault is a failed drop (:func:`~physics.study.checks.as_drop`)."""
+    fault is a failed drop (:func:`~physics.study.checks.as_drop`). Drops beyond the contact
+    laws' validity count in ``beyond_validity`` and in the whirl probability, never in the KPIs."""
     ok = [o for o in outcomes if o.ok]
-    out = dict(members=len(outcomes), failed=len(outcomes) - len(ok),
+    valid, beyond = split_valid(ok)
+    out = dict(members=len(outcomes), failed=len(outcomes) - len(ok), beyond_validity=beyond,
                errors=sorted({o.error.splitlines()[0] for o in outcomes if not o.ok}),
                warnings=warning_counts(outcomes),
                whirl_probability=float(np.mean([o.metrics["backward_whirl"] for o in ok])) if ok else None)
     for key in PLANE_KPIS:
-        vals = np.array([v for v in (worst_plane(o.metrics, key) for o in ok) if v is not None])
+        vals = np.array([v for v in (worst_plane(o.metrics, key) for o in valid) if v is not None])
         out[key] = dict(median=float(np.median(vals)), min=float(vals.min()),
                         max=float(vals.max())) if len(vals) else None
     return out
@@ -195,14 +198,15 @@ def plot_files(report: dict, axes: list[Axis], out: Path) -> list[str]:
 
 def write_csv(report: dict, path: Path) -> None:
     keys = list(report["axes"])
-    fields = keys + ["members", "failed", "whirl_probability"] + [
+    fields = keys + ["members", "failed", "beyond_validity", "whirl_probability"] + [
         f"{k}_{s}" for k in PLANE_KPIS for s in ("median", "min", "max")] + [
         f"warnings_{k}" for k in WARNING_KINDS]
     with open(path, "w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(fields)
         for c in report["cells"]:
-            w.writerow([c[k] for k in keys] + [c["members"], c["failed"], c["whirl_probability"]]
+            w.writerow([c[k] for k in keys] + [c["members"], c["failed"], c["beyond_validity"],
+                                               c["whirl_probability"]]
                        + [None if c[k] is None else c[k][s] for k in PLANE_KPIS
                           for s in ("median", "min", "max")]
                        + [c["warnings"][k] for k in WARNING_KINDS])
@@ -212,7 +216,8 @@ def summary_table(report: dict) -> str:
     """Markdown: one row per cell; the last column counts the drops per failed drop check."""
     keys = list(report["axes"])
     head = ("| " + " | ".join(keys) + " | whirl prob. | peak force median (max) [N] | "
-            "max disp. median (max) [µm] | failed | warnings |\n|" + "---|" * (len(keys) + 5) + "\n")
+            "max disp. median (max) [µm] | failed | beyond validity | warnings |\n|"
+            + "---|" * (len(keys) + 6) + "\n")
     rows = []
     for c in report["cells"]:
         f, d = c["peak_contact_force_N"], c["max_displacement_um"]
@@ -220,7 +225,7 @@ def summary_table(report: dict) -> str:
         rows.append("| " + " | ".join(value_label(c[k]) for k in keys)
                     + (f" | {c['whirl_probability']:.2f} | {f['median']:.0f} ({f['max']:.0f}) | "
                        f"{d['median']:.0f} ({d['max']:.0f})" if f else " | - | - | -")
-                    + f" | {c['failed']} | {flagged} |")
+                    + f" | {c['failed']} | {c['beyond_validity']} | {flagged} |")
     return head + "\n".join(rows) + "\n"
 
 
@@ -236,6 +241,11 @@ def notes(report: dict, members: int) -> list[str]:
         out.append(f"{report['failed']} drops failed (column 'failed'; the statistics are over the "
                    "drops that ran; a run that ended before the fault is a failed drop); their errors "
                    "are in sweep.json (cells[].errors, runs[].error)")
+    beyond = sum(c["beyond_validity"] for c in report["cells"])
+    if beyond:
+        out.append(f"{beyond} drops left the contact laws' validity (column 'beyond validity'): "
+                   "they count in the whirl probability but not in the force and displacement "
+                   "statistics")
     flagged = warnings_note(report["warnings"])
     if flagged:
         out.append(f"{flagged}; see column 'warnings', and runs[].metrics.warnings in sweep.json "

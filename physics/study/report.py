@@ -95,9 +95,10 @@ def plot_friction_response(a: dict, out: Path) -> str:
         if not pts:
             continue
         mu = [p[0] for p in pts]
-        axes[0].plot(mu, [p[1]["max_displacement_um"] for p in pts], st, ms=3,
+        nan = lambda v: np.nan if v is None else v  # noqa: E731
+        axes[0].plot(mu, [nan(p[1]["max_displacement_um"]) for p in pts], st, ms=3,
                      label=tag.replace("_", " "))
-        axes[1].plot(mu, [p[1]["peak_contact_force_N"] for p in pts], st, ms=3,
+        axes[1].plot(mu, [nan(p[1]["peak_contact_force_N"]) for p in pts], st, ms=3,
                      label=tag.replace("_", " "))
     axes[0].set_ylabel("median max displacement [µm]")
     axes[1].set_ylabel("median peak contact force [N]")
@@ -163,6 +164,13 @@ def _f(x, spec=".2f"):
     return "–" if x is None else format(x, spec)
 
 
+def _nominal(r: dict, key: str, spec: str = ".0f") -> str:
+    """A nominal drop's number, or "n/a (beyond validity at t = …)" when the drop left the contact
+    laws' validity (``physics.study.checks.beyond_validity``)."""
+    t = r.get("beyond_validity_at_s")
+    return f"n/a (beyond validity at t = {t:.3f} s)" if t is not None else _f(r.get(key), spec)
+
+
 def _num(x: float) -> str:
     """A scene value as the report writes it: 0.25, 5000, 5e7."""
     mantissa, _, exp = f"{x:g}".partition("e")
@@ -187,7 +195,9 @@ def _checks_text(a: dict) -> str:
                     if study != "total" and any(counts.values()))
     return (f"{total[0].upper()}{total[1:]} (per study: {per}). These are the warnings `rotordrop drop` prints for the "
             "run's command; the drops are in the statistics, except those without a fault, which "
-            "count as failed.\n")
+            "count as failed, and those past a contact law's validity bound (penetration, "
+            "dry_whip), which count in the whirl probability but in no force or displacement "
+            "number.\n")
 
 
 def write_report(a: dict, out: Path, figures: dict[str, list[str]], meta: dict) -> Path:
@@ -249,16 +259,18 @@ def write_report(a: dict, out: Path, figures: dict[str, list[str]], meta: dict) 
                    if r["stiffness"] == BASE), None)
     soft_f = soft.get("peak_contact_force_N")
     w("| K_s [N/m] | max Y [µm] | max radial [µm] | peak F_r [N] | ÷ base | ÷ soft | whirl | "
-      "ensemble: whirl prob., peak F_r median (min–max) |\n|---|---|---|---|---|---|---|---|")
+      "ensemble: whirl prob., peak F_r median (min–max), beyond validity |\n"
+      "|---|---|---|---|---|---|---|---|")
     for r in a["support_stiffness"]:
         e = r.get("ensemble", {})
         pf = e.get("peak_contact_force_N", {})
         f = r.get("peak_contact_force_N")
-        w(f"| {r['stiffness']:.0e} | {_f(r.get('max_y_displacement_um'), '.0f')} | "
-          f"{_f(r.get('max_displacement_um'), '.0f')} | {_f(f, '.0f')} | "
+        w(f"| {r['stiffness']:.0e} | {_nominal(r, 'max_y_displacement_um')} | "
+          f"{_nominal(r, 'max_displacement_um')} | {_nominal(r, 'peak_contact_force_N')} | "
           f"{_f(f / base_f if f and base_f else None)} | {_f(f / soft_f if f and soft_f else None)} | "
           f"{'yes' if r.get('backward_whirl') else 'no'} | {_f(e.get('whirl_probability'))}, "
-          f"{_f(pf.get('median'), '.0f')} ({_f(pf.get('min'), '.0f')}–{_f(pf.get('max'), '.0f')}) |")
+          f"{_f(pf.get('median'), '.0f')} ({_f(pf.get('min'), '.0f')}–{_f(pf.get('max'), '.0f')}), "
+          f"{e.get('beyond_validity', 0)} |")
     w("\nPaper: K_s = 5e8 gives 2× the base-case contact force and ≈ 5× the soft case; the soft "
       "case peaks near 600 µm just after the drop.\n")
     w(f"![stiffness orbits]({figures['stiffness'][0]})\n")
@@ -271,8 +283,8 @@ def write_report(a: dict, out: Path, figures: dict[str, list[str]], meta: dict) 
     for r in a["support_damping"]:
         e = r.get("ensemble", {})
         med = lambda k: e.get(k, {}).get("median")  # noqa: E731
-        w(f"| {r['damping']:g} | {_f(r.get('peak_contact_force_N'), '.0f')} | "
-          f"{_f(r.get('max_displacement_um'), '.0f')} | {_f(e.get('whirl_probability'))} | "
+        w(f"| {r['damping']:g} | {_nominal(r, 'peak_contact_force_N')} | "
+          f"{_nominal(r, 'max_displacement_um')} | {_f(e.get('whirl_probability'))} | "
           f"{_f(med('force_settling_s'), '.3f')} | {_f(med('radial_speed_rms_mm_s'), '.1f')} | "
           f"{_f(med('separations'), '.0f')} |")
     w("\nNominal drop for peak force and displacement; ensemble medians for the rest. Force "

@@ -1,0 +1,64 @@
+"""Validity bounds of the contact laws: the penetration past which a law leaves its own
+assumptions (docs/physics.md "Validity bounds"). One piece serves the metrics, the studies and
+the environments.
+
+* retainer, ``contact.law = "hertz_line"``: Johnson's approach when the Hertz half-width reaches
+  0.3 r (:func:`physics.contact.half_width_approach`);
+* retainer, ``contact.law = "paper"`` (K δ^e): K lumps the journal-sleeve contact, so its δ is not
+  a steel approach; the bound is the load at which a steel line contact of the same geometry
+  (``contact.length``, ``rotor.journal_radius``, ``contact.clearance``, E* of the bearing steel)
+  reaches the same half-width (:func:`physics.contact.half_width_load`), converted to δ through
+  K δ^e (:func:`physics.contact.power_law_approach`);
+* stator (``effects.stator_contact``): :func:`physics.stator.penetration_bound`.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from .contact import (HALF_WIDTH_LIMIT, effective_modulus, half_width_approach, half_width_load,
+                      line_elastic_force, power_law_approach)
+from .stator import penetration_bound
+
+WHERE = ("retainer", "stator")
+
+
+@dataclass(frozen=True)
+class Bound:
+    """A validity bound: the penetration [m], the law's elastic force there [N], the criterion."""
+    penetration: float
+    load: float
+    criterion: str
+
+    def to_dict(self) -> dict:
+        return dict(validity_bound_um=self.penetration * 1e6, validity_bound_load_N=self.load,
+                    validity_criterion=self.criterion)
+
+
+def line_stiffness(scene) -> float:
+    """a = π L E* [N/m] of the retainer's steel line contact (``contact.length``, the bearing
+    steel's E and ν)."""
+    b = scene.bearing
+    return math.pi * scene.contact.length * effective_modulus(b.youngs_modulus, b.poisson)
+
+
+def validity_bound(scene, where: str = "retainer") -> Bound:
+    """The penetration bound of the rotor-sleeve law (``where = "retainer"``) or of the stator
+    contact (``"stator"``) in ``scene`` (module docstring)."""
+    if where not in WHERE:
+        raise ValueError(f"where must be one of {WHERE}; got {where!r}")
+    lim = f"Hertz half-width b = {HALF_WIDTH_LIMIT:g} x"
+    if where == "stator":
+        st, g0 = scene.stator, scene.amb.air_gap
+        d = penetration_bound(st.rotor_radius, g0)
+        return Bound(d, st.stiffness * d, f"{lim} stator.rotor_radius (line-contact approach)")
+    c, r = scene.contact, scene.rotor.journal_radius
+    if c.law == "hertz_line":
+        d = half_width_approach(r, c.clearance)
+        a = line_stiffness(scene)
+        return Bound(d, float(line_elastic_force(d, a, c.clearance)),
+                     f"{lim} rotor.journal_radius (line-contact approach)")
+    load = half_width_load(r, c.clearance, line_stiffness(scene))
+    return Bound(power_law_approach(load, c.stiffness, c.exponent), load,
+                 f"load at which a steel line contact reaches {lim} rotor.journal_radius, "
+                 "through K delta^e")
