@@ -43,7 +43,7 @@ INVALID_KEYS = ("max_displacement_um", "max_y_displacement_um", "peak_contact_fo
                 "max_friction_coefficient")
 PRE_FAULT_KEYS = ("pre_fault_peak_contact_force_N",)    # invalid only if it left before the fault
 STATOR_INVALID_KEYS = ("max_displacement_um", "stator_peak_force_N", "stator_contact_time_s",
-                       "stator_penetration_um")
+                       "stator_penetration_um", "max_stator_displacement_um")
 BEFORE_INVALID = "_before_invalid"                 # suffix of their values up to that time
 
 
