@@ -51,7 +51,7 @@ def dissipation_powers(result: Result) -> dict[str, np.ndarray]:
 def _created(t: np.ndarray, power: np.ndarray) -> float:
     """Energy [J] an element created: the trapezoidal integral of its negative power."""
     neg = np.minimum(power, 0.0)
-    return float(-np.sum(0.5 * (neg[1:] + neg[:-1]) * np.diff(t))) if len(t) > 1 else 0.0
+    return 0.0 - float(np.sum(0.5 * (neg[1:] + neg[:-1]) * np.diff(t))) if len(t) > 1 else 0.0
 
 
 def dissipation_check(result: Result) -> dict:

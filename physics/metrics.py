@@ -120,7 +120,7 @@ def friction_energy_created(result: Result, plane: str, post: slice) -> float:
     it pushes along the sliding (``friction_heat_J`` is then a net figure)."""
     p, t = result.friction_power(plane)[post], result.t[post]
     neg = np.minimum(p, 0.0)
-    return float(-np.sum(0.5 * (neg[1:] + neg[:-1]) * np.diff(t))) if len(t) > 1 else 0.0
+    return 0.0 - float(np.sum(0.5 * (neg[1:] + neg[:-1]) * np.diff(t))) if len(t) > 1 else 0.0
 
 
 @functools.lru_cache(maxsize=64)
