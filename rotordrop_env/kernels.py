@@ -30,7 +30,10 @@ from physics.model import (A_FR, A_QMAX, A_WS, I_AMB_FILT, I_AMB_INT, I_CS, N_AU
  C_RTOL, C_HMAX, C_HMIN, C_FIXED, C_MAXSTEPS,
  C_W_WHIRL, C_W_CONTACT, C_W_DISP, C_W_EFFORT, C_W_SUCCESS, C_W_FAILURE,
  C_F_REF, C_GAP, C_LOAD_RATING, C_HOLD, C_TERMINATE, C_FULL, C_CS_MIN, C_CS_MAX, C_ILIM,
- C_RELEV_RADIUS, C_WHIRL_RADIUS, C_WHIRL_REVS, C_SUP_OFFSET, C_SUP_OCTAVES, N_C) = range(32)
+ C_RELEV_RADIUS, C_WHIRL_RADIUS, C_WHIRL_REVS, C_SUP_OFFSET, C_SUP_OCTAVES, C_P_COEF,
+ N_C) = range(33)
+#: C[C_P_COEF]: Hertz contact pressure [Pa] = C_P_COEF x cbrt(ball load [N]), < 0 without
+#: Sopanen-Mikkola balls (read by the info builder, not by the kernels)
 LEV_NONE, LEV_DISCRETE, LEV_CONTINUOUS, LEV_SUPERVISOR = 0, 1, 2, 3
 #: C[C_DAMP]: no damper commands, or the damper action's map (env kwarg ``damping_action``)
 DAMP_NONE, DAMP_LINEAR, DAMP_FROM_MAX = 0.0, 1.0, 2.0
@@ -40,11 +43,13 @@ SUP_MIN_RADIUS = 0.05
 # ------------------------------------------------------------------------------ monitor M --
 (M_T, M_H, M_REV1, M_REV2, M_WHIRL, M_PEAK_F, M_MAX_DISP, M_OK_START, M_RELEV,
  M_RELEV_T, M_EFFORT, M_CTRL_ON, M_POWER, M_REV_PEAK, M_PEAK_Q, M_STATOR, M_OVERLOAD,
- N_M) = range(18)
+ M_PHI, N_M) = range(19)
+#: M[M_PHI]: the KPI reward's potential after the last step (rotordrop_env.reward; 0 at reset)
 
 # ------------------------------------------------------------------------------ outputs --
 (O_REWARD, O_R_WHIRL, O_R_CONTACT, O_R_DISP, O_R_EFFORT, O_R_SUCCESS, O_R_FAILURE, O_FORCE,
- O_TERM, O_TRUNC, O_STATUS, O_ERR, O_STATOR, O_OVERLOAD, N_O) = range(15)
+ O_TERM, O_TRUNC, O_STATUS, O_ERR, O_STATOR, O_OVERLOAD, O_RELEV, N_O) = range(16)
+#: out[O_RELEV]: 1 in the step in which re-levitation is achieved
 ERR_NONE, ERR_NAN, ERR_RANGE = 0, 1, 2
 ACTION_TOL = 1e-6            # actions may exceed [-1, 1] by this much (float32 round-off)
 TWO_PI = 2.0 * math.pi
@@ -289,6 +294,7 @@ def step_one(a, y, P, I, U, atol, work, t_sub, Y_sub, aux, cur, C, M, scale, obs
                     M[M_RELEV] = 1.0
                     M[M_RELEV_T] = M[M_OK_START] - C[C_T_FAULT]
                     out[O_R_SUCCESS] = C[C_W_SUCCESS]
+                    out[O_RELEV] = 1.0
             else:
                 M[M_OK_START] = -1.0
     # aux now holds the diagnostics at t1 (last sub-sample)
