@@ -6,6 +6,7 @@ and the config's ``reward_kwargs`` to its batched environments (:mod:`agents.tra
 :class:`KpiReward` is the same reward as an SB3 ``VecEnvWrapper`` over environments made with
 the default reward (rl-zoo3: ``vec_env_wrapper: agents.reward.KpiReward``), computed by the
 same functions from the running KPIs every step's ``info`` carries.
+"""
 from __future__ import annotations
 
 import numpy as np
