@@ -34,7 +34,7 @@ import numpy as np
 from . import kernels as K
 from .buffers import Buffers
 from .env import RotorDropEnv, real_action
-from .info import info_columns
+from .info import info_dict
 from .reward import kpi_step
 
 
@@ -109,6 +109,7 @@ class Batch:
         self.sensed = any(env._sensing.active for env in envs)
         self.rendering = first.render_mode is not None
         self.latency = np.zeros(n, dtype=np.int64)        # each env's observation latency
+        self.values = np.zeros((n, K.N_V))                # the info numbers (rotordrop_env.info)
         if n_threads is not None and not 1 <= int(n_threads) <= numba.config.NUMBA_NUM_THREADS:
             raise ValueError(f"n_threads = {n_threads!r} must be in [1, "
                              f"{numba.config.NUMBA_NUM_THREADS}] (numba's NUMBA_NUM_THREADS)")
@@ -135,7 +136,7 @@ class Batch:
     def step(self, actions):
         """All environments one control step (no reset): observations (float32), rewards
         (float64), terminated, truncated (bool arrays) and the info columns
-        (:func:`rotordrop_env.info.info_columns`, one entry per environment)."""
+        (:func:`rotordrop_env.info.info_dict`, one array entry per environment)."""
         self.check_steppable()
         stack = self.stack
         act = stack.act
@@ -167,7 +168,8 @@ class Batch:
             rewards = kpi_step(out, stack.M, stack.C, self.kpi_weights, self.relevitate)
         terminated = out[:, K.O_TERM] > 0.0
         truncated = out[:, K.O_TRUNC] > 0.0
-        info = info_columns(out, stack.M, stack.C, self.latency, self.relevitate)
+        K.info_rows(out, stack.M, stack.C, self.values)
+        info = info_dict(self.values, self.latency, self.relevitate)
         if self.rendering:                        # before the auto-resets clear the views
             for env in self.envs:
                 env._show_step()

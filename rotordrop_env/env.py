@@ -19,7 +19,7 @@ from physics.simulate import IntegrationError, _explain
 
 from . import kernels as K
 from .buffers import Buffers
-from .info import MISSING, REWARD_TERMS, info_columns, kpi_keys
+from .info import MISSING, REWARD_TERMS, info_dict, kpi_keys
 from .layout import COMMANDS, action_layout, observation_layout
 from .reward import REWARDS, check_kpi_weights, kpi_step
 from .scenario import (POWER_RETURN, POWER_RETURN_LIMITS, fault_state, layout_base, resolve_ranges,
@@ -214,6 +214,7 @@ class RotorDropEnv(gym.Env):
         self._bind(Buffers(model.n_state, n_obs, n_act, int(samples_per_step)))
         self._configure_static(relevitation_hold, _flag("terminate_on_failure", terminate_on_failure))
         self._renderer = None
+        self._values = np.zeros(K.N_V)          # the info numbers (rotordrop_env.info)
         self._scenario: dict = {}
         self._needs_reset = True
         self._closed = False
@@ -512,9 +513,10 @@ class RotorDropEnv(gym.Env):
                 self.render()
 
     def _info(self) -> dict:
-        """The ``info`` of the reset or step just taken (:func:`rotordrop_env.info.info_columns`)."""
+        """The ``info`` of the reset or step just taken (:mod:`rotordrop_env.info`)."""
         b = self._b
-        return info_columns(b.out, b.M, b.C, self._sensing.k, self._relevitate)
+        K.info_values(b.out, b.M, b.C, self._values)
+        return info_dict(self._values, self._sensing.k, self._relevitate)
 
     def kpis(self) -> dict:
         """Episode KPIs so far (numpy scalars; every step's ``info`` carries them, the final

@@ -1,6 +1,6 @@
 """The ``info`` of the environments, built from the kernel arrays of one environment or of a
 batch (the single environment, the Gymnasium vector environment and the SB3 VecEnv all use
-:func:`info_columns`).
+:func:`info_dict` on the numbers of :func:`rotordrop_env.kernels.info_values`).
 
 The contract, which any RL library can rely on:
 
@@ -19,60 +19,46 @@ from __future__ import annotations
 import numpy as np
 
 from . import kernels as K
+from .kernels import MISSING  # noqa: F401  (re-exported: the documented sentinel)
 
-#: the value of an info entry that does not exist (no re-levitation, no ball model)
-MISSING = -1.0
 REWARD_TERMS = ("whirl", "contact", "displacement", "effort", "success", "failure")
-_O_TERMS = (K.O_R_WHIRL, K.O_R_CONTACT, K.O_R_DISP, K.O_R_EFFORT, K.O_R_SUCCESS, K.O_R_FAILURE)
-#: the running KPIs the KPI reward's potential is built from (rotordrop_env.reward)
-PEAK_KEYS = ("kpi_peak_whirl_revolutions", "kpi_peak_contact_force_N", "kpi_max_displacement_um")
 #: the components of ``info["cost"]`` (Safety-Gymnasium convention: a cost >= 0 per step);
 #: ``cost_contact_validity`` is reserved for the contact law's validity and 0 for now
 COST_TERMS = ("cost_stator_contact", "cost_bearing_overload", "cost_contact_validity")
+#: the running KPIs the KPI reward's potential is built from (rotordrop_env.reward)
+PEAK_KEYS = ("kpi_peak_whirl_revolutions", "kpi_peak_contact_force_N", "kpi_max_displacement_um")
+
+#: the float entries, in the order of the kernel's V_* values
+FLOAT_KEYS = ("contact_force_N", *("reward_" + t for t in REWARD_TERMS), "time_s", "cost",
+              *COST_TERMS, "kpi_whirl_revolutions", "kpi_peak_whirl_revolutions",
+              "kpi_peak_contact_force_N", "kpi_max_displacement_um", "kpi_relevitation_time_s",
+              "kpi_control_effort", "kpi_max_ball_load_N", "kpi_max_contact_pressure_MPa")
+assert len(FLOAT_KEYS) == K.N_V_FLOAT
+#: the bool entries and their V_* values ("relevitated": re-levitation environments only)
+_BOOLS = (("backward_whirl", K.V_WHIRL), ("relevitated", K.V_RELEV),
+          ("kpi_backward_whirl", K.V_WHIRL), ("kpi_relevitated", K.V_RELEV),
+          ("kpi_stator_contact", K.V_STATOR), ("kpi_bearing_overload", K.V_OVERLOAD))
+_BOOL_KEYS = {r: tuple(k for k, _ in _BOOLS if r or k != "relevitated") for r in (False, True)}
+_BOOL_IDX = {r: np.array([i for k, i in _BOOLS if r or k != "relevitated"]) for r in (False, True)}
+_NF = K.N_V_FLOAT
 
 
-def info_columns(out: np.ndarray, M: np.ndarray, C: np.ndarray, latency, relevitate: bool) -> dict:
-    """The info entries from kernel outputs ``out``, monitor ``M`` and configuration ``C`` of
-    one environment (1-D arrays: numpy scalars) or of N (2-D arrays, one row per environment:
-    arrays of N). ``latency``: the observation latency of the episode (int or int array)."""
-    col = lambda A, j: A[..., j]                                      # noqa: E731
-    t = col(M, K.M_T) - col(C, K.C_T_FAULT)
-    info = {"contact_force_N": col(out, K.O_FORCE)}
-    for name, j in zip(REWARD_TERMS, _O_TERMS):
-        info["reward_" + name] = col(out, j)
-    info["time_s"] = t
-    info["backward_whirl"] = col(M, K.M_WHIRL) > 0.0
-    relev = col(M, K.M_RELEV) > 0.0
-    if relevitate:
-        info["relevitated"] = relev
-    stator, overload = col(out, K.O_STATOR), col(out, K.O_OVERLOAD)
-    validity = np.zeros_like(stator)
-    info["cost"] = stator + overload + validity
-    info["cost_stator_contact"] = stator
-    info["cost_bearing_overload"] = overload
-    info["cost_contact_validity"] = validity
-    info["obs_latency_steps"] = np.asarray(latency, dtype=np.int64)
-    coef = col(C, K.C_P_COEF)
-    balls = coef >= 0.0
-    q = col(M, K.M_PEAK_Q)
-    info.update(
-        kpi_backward_whirl=col(M, K.M_WHIRL) > 0.0,
-        kpi_whirl_revolutions=np.maximum(col(M, K.M_REV1), col(M, K.M_REV2)),
-        kpi_peak_whirl_revolutions=col(M, K.M_REV_PEAK),
-        kpi_peak_contact_force_N=col(M, K.M_PEAK_F),
-        kpi_max_displacement_um=col(M, K.M_MAX_DISP) * 1e6,
-        kpi_relevitated=relev,
-        kpi_relevitation_time_s=np.where(relev, col(M, K.M_RELEV_T), MISSING),
-        kpi_control_effort=col(M, K.M_EFFORT),
-        kpi_stator_contact=col(M, K.M_STATOR) > 0.0,
-        kpi_bearing_overload=col(M, K.M_OVERLOAD) > 0.0,
-        kpi_max_ball_load_N=np.where(balls, q, MISSING),
-        kpi_max_contact_pressure_MPa=np.where(balls, np.abs(coef) * np.cbrt(q) * 1e-6, MISSING),
-        kpi_episode_time_s=t.copy(),
-    )
-    if out.ndim == 1:                                 # one environment: numpy scalars
-        return {k: v[()] if isinstance(v, np.ndarray) else v for k, v in info.items()}
-    return {k: np.array(v, copy=True) if v.base is not None else v for k, v in info.items()}
+def info_dict(v: np.ndarray, latency, relevitate: bool) -> dict:
+    """The ``info`` from the numbers ``v`` of one environment (``(N_V,)``: numpy scalars) or of
+    N (``(N, N_V)``: arrays of N, one fresh array each); ``latency``: the episode's observation
+    latency (int, or int array of N)."""
+    bidx = _BOOL_IDX[relevitate]
+    if v.ndim == 1:
+        info = dict(zip(FLOAT_KEYS, list(v[:_NF])))
+        info.update(zip(_BOOL_KEYS[relevitate], list(v[bidx] > 0.0)))
+        info["obs_latency_steps"] = np.int64(latency)
+    else:
+        cols = v.T.copy()                        # fresh: nothing a caller holds is reused
+        info = dict(zip(FLOAT_KEYS, cols[:_NF]))
+        info.update(zip(_BOOL_KEYS[relevitate], cols[bidx] > 0.0))
+        info["obs_latency_steps"] = np.array(latency, dtype=np.int64)
+    info["kpi_episode_time_s"] = info["time_s"].copy()
+    return info
 
 
 def kpi_keys(info: dict) -> dict:
