@@ -139,10 +139,11 @@ class RotorDropVectorEnv(VectorEnv):
 
 def _masked(info: dict, n: int, mask: np.ndarray | None = None) -> dict:
     """Gymnasium's vector info: every key with its ``_key`` mask (all True unless ``mask``)."""
+    masks = np.ones((len(info), n), dtype=bool) if mask is None else np.tile(mask, (len(info), 1))
     out = {}
-    for k, v in info.items():
+    for (k, v), m in zip(info.items(), masks):           # one fresh array, a row per key
         out[k] = v
-        out["_" + k] = np.ones(n, dtype=bool) if mask is None else mask.copy()
+        out["_" + k] = m
     return out
 
 
