@@ -19,7 +19,7 @@ from physics.simulate import IntegrationError, _explain
 
 from . import kernels as K
 from .buffers import Buffers
-from .info import MISSING, REWARD_TERMS, info_dict, kpi_keys
+from .info import MISSING, REWARD_TERMS, info_dict, kpi_keys  # noqa: F401 (REWARD_TERMS re-exported)
 from .layout import COMMANDS, action_layout, observation_layout
 from .reward import REWARDS, check_kpi_weights, kpi_step
 from .scenario import (POWER_RETURN, POWER_RETURN_LIMITS, fault_state, layout_base, resolve_ranges,
