@@ -133,10 +133,14 @@ class Batch:
                 env._check_open("step")
             raise gym.error.ResetNeeded("call reset() on the vector environment before step()")
 
-    def step(self, actions):
+    def step(self, actions, active: np.ndarray | None = None):
         """All environments one control step (no reset): observations (float32), rewards
         (float64), terminated, truncated (bool arrays) and the info columns
-        (:func:`rotordrop_env.info.info_dict`, one array entry per environment)."""
+        (:func:`rotordrop_env.info.info_dict`, one array entry per environment).
+
+        ``active``: advance only these rows (bool mask); the others are left as they are (just
+        reset: their observation is the kernel's reset one, their reward 0 and their info the
+        reset info)."""
         self.check_steppable()
         stack = self.stack
         act = stack.act
@@ -152,27 +156,34 @@ class Batch:
         e, err = K.first_bad_action(act, stack.C)
         if e >= 0:                                # before any env advances; single env's message
             self.envs[e]._action_error(err, a[e])
-        self._step_kernel()
+        if active is None:
+            self._step_kernel()
+        else:                                     # a few steps per episode: row by row
+            for e in np.flatnonzero(active):
+                K.step_one(*self.envs[e]._args)
         out = stack.out
         failed = np.flatnonzero(out[:, K.O_STATUS])
         if failed.size:                           # the single env's clear IntegrationError
             e = failed[0]
             self.envs[e]._finish(a[e])
         obs = stack.obs.astype(np.float32)
+        rows = range(self.num_envs) if active is None else np.flatnonzero(active)
         if self.sensed:                           # noise / latency (rotordrop_env.sensors)
-            for e, env in enumerate(self.envs):
-                obs[e] = env.observed()
+            for e in rows:
+                obs[e] = self.envs[e].observed()
         if self.kpi_weights is None:
             rewards = out[:, K.O_REWARD].copy()
         else:
             rewards = kpi_step(out, stack.M, stack.C, self.kpi_weights, self.relevitate)
+        if active is not None:
+            rewards[~active] = 0.0
         terminated = out[:, K.O_TERM] > 0.0
         truncated = out[:, K.O_TRUNC] > 0.0
         K.info_rows(out, stack.M, stack.C, self.values)
         info = info_dict(self.values, self.latency, self.relevitate)
         if self.rendering:                        # before the auto-resets clear the views
-            for env in self.envs:
-                env._show_step()
+            for e in rows:
+                self.envs[e]._show_step()
         return obs, rewards, terminated, truncated, info
 
     def _step_kernel(self) -> None:

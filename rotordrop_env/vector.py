@@ -8,12 +8,18 @@ It is the Gymnasium face of the batch core :class:`rotordrop_env.batch.Batch` (t
 ``gym.make(id, **kwargs)`` would make, seeded ``seed + i`` by ``reset(seed=seed)``, and steps
 to the same numbers.
 
-Autoreset: ``AutoresetMode.SAME_STEP``. A finished environment is reset within the step that
-ends its episode: ``obs[i]`` and ``info`` entry i belong to the new episode, the final
-observation is ``info["final_obs"][i]`` and the final step's info (with the episode's
-``kpi_*``) is ``info["final_info"]`` (entries where ``info["_final_info"]`` is True). So every
-step advances every rotor (no step whose action is ignored) and the final info is at hand in the
-step the episode ends, as in the SB3 ``VecEnv``.
+Autoreset (kwarg ``autoreset_mode``, in ``metadata["autoreset_mode"]``):
+
+* ``AutoresetMode.SAME_STEP`` (default): a finished environment is reset within the step that
+  ends its episode: ``obs[i]`` and ``info`` entry i belong to the new episode, the final
+  observation is ``info["final_obs"][i]`` and the final step's info (with the episode's
+  ``kpi_*``) is ``info["final_info"]`` (entries where ``info["_final_info"]`` is True). Every
+  step advances every rotor (no step whose action is ignored, no zero-reward transition to mask
+  out) and the final info is at hand in the step the episode ends, as in the SB3 ``VecEnv``.
+* ``AutoresetMode.NEXT_STEP`` (Gymnasium's default, the only mode its vector observation
+  wrappers such as ``NormalizeObservation`` accept): the step after an episode's end resets
+  that environment (its action is ignored, reward 0, flags False, the reset observation and
+  info); the final step's info is the ordinary step info.
 
 Info: a dict of arrays, one entry per environment, with Gymnasium's ``_key`` masks (all True:
 every environment has every key at every step, see :mod:`rotordrop_env.info`).
@@ -40,9 +46,17 @@ class RotorDropVectorEnv(VectorEnv):
                 "autoreset_mode": AutoresetMode.SAME_STEP}
     env_class: type = _env.RotorDropEnv
 
-    def __init__(self, num_envs: int = 1, *, n_threads: int | None = None, **kwargs: Any):
+    def __init__(self, num_envs: int = 1, *, n_threads: int | None = None,
+                 autoreset_mode: AutoresetMode | str = AutoresetMode.SAME_STEP, **kwargs: Any):
         if isinstance(num_envs, bool) or int(num_envs) != num_envs or num_envs < 1:
             raise ValueError(f"num_envs = {num_envs!r} must be a positive integer")
+        try:
+            mode = AutoresetMode(autoreset_mode)
+        except ValueError:
+            mode = None
+        if mode not in (AutoresetMode.SAME_STEP, AutoresetMode.NEXT_STEP):
+            raise ValueError(f"autoreset_mode = {autoreset_mode!r} must be AutoresetMode.SAME_STEP "
+                             "or AutoresetMode.NEXT_STEP")
         if "max_episode_steps" in kwargs:
             raise ValueError("max_episode_steps does not apply to the rotor-drop vector "
                              "environment; set the episode length with episode_time "
@@ -57,7 +71,8 @@ class RotorDropVectorEnv(VectorEnv):
         self.action_space = batch_space(first.action_space, self.num_envs)
         self.render_mode = first.render_mode
         self.metadata = dict(self.metadata)
-        self.metadata["autoreset_mode"] = AutoresetMode.SAME_STEP
+        self.metadata["autoreset_mode"] = self.autoreset_mode = mode
+        self._ended = np.zeros(self.num_envs, dtype=bool)       # NEXT_STEP: reset at the next step
 
     def reset(self, *, seed: int | list[int | None] | None = None,
               options: dict[str, Any] | None = None):
@@ -73,6 +88,7 @@ class RotorDropVectorEnv(VectorEnv):
                 raise ValueError(f"{len(seeds)} seeds for {self.num_envs} environments")
         if seed is not None:
             self._np_random, self._np_random_seed = gym.utils.seeding.np_random(seeds[0])
+        self._ended[:] = False
         obs = np.empty((self.num_envs, *self.single_observation_space.shape), dtype=np.float32)
         infos: dict = {}
         for e in range(self.num_envs):
@@ -85,6 +101,8 @@ class RotorDropVectorEnv(VectorEnv):
         return obs, _masked(infos, self.num_envs)
 
     def step(self, actions):
+        if self.autoreset_mode is AutoresetMode.NEXT_STEP:
+            return self._step_next(actions)
         obs, rewards, terminated, truncated, info = self.batch.step(actions)
         dones = terminated | truncated
         if dones.any():
@@ -99,6 +117,20 @@ class RotorDropVectorEnv(VectorEnv):
             info.update(final_obs=final_obs, _final_obs=dones.copy(), final_info=final_info,
                         _final_info=dones.copy())
             return obs, rewards, terminated, truncated, info
+        return obs, rewards, terminated, truncated, _masked(info, self.num_envs)
+
+    def _step_next(self, actions):
+        """NEXT_STEP autoreset: the environments that ended at the last step are reset instead
+        of stepped (reward 0, flags False, their reset observation and info)."""
+        if not self._ended.any():
+            obs, rewards, terminated, truncated, info = self.batch.step(actions)
+        else:
+            self.batch.check_steppable()
+            rows = np.flatnonzero(self._ended)
+            reset_obs = [self.batch.reset_env(e)[0] for e in rows]
+            obs, rewards, terminated, truncated, info = self.batch.step(actions, ~self._ended)
+            obs[rows] = reset_obs                     # the info's rows are the reset infos
+        self._ended = terminated | truncated
         return obs, rewards, terminated, truncated, _masked(info, self.num_envs)
 
     def render(self) -> tuple | None:

@@ -89,13 +89,16 @@ def test_the_vector_env_steps_as_single_envs_episode_by_episode(extra):
     assert ends["truncated"] >= n and ends["terminated"] >= 1   # both kinds of end were seen
 
 
-def test_the_vector_env_matches_gymnasiums_same_step_sync_vector_env():
-    """Gymnasium's own SAME_STEP SyncVectorEnv of the same id: same observations, rewards,
-    flags and infos (Gymnasium stores bool infos as object arrays: compared by value)."""
-    n, kw = 3, dict(episode_time=0.005, randomize=True)
-    ours = make_vec("RotorDrop-Damping-v0", n, **kw)
+@pytest.mark.parametrize("mode", [AutoresetMode.SAME_STEP, AutoresetMode.NEXT_STEP])
+def test_the_vector_env_matches_gymnasiums_sync_vector_env_in_both_autoreset_modes(mode):
+    """Gymnasium's own SyncVectorEnv of the same id and autoreset mode: same observations,
+    rewards, flags and infos (Gymnasium stores bool infos as object arrays: compared by value),
+    also with sensor noise and a drawn latency (each env's random stream)."""
+    n, kw = 3, dict(episode_time=0.005, randomize=True, sensor_noise=2e-6, obs_latency_steps=(0, 2))
+    ours = make_vec("RotorDrop-Damping-v0", n, autoreset_mode=mode, **kw)
+    assert ours.metadata["autoreset_mode"] is mode
     ref = gym.make_vec("RotorDrop-Damping-v0", num_envs=n, vectorization_mode="sync",
-                       vector_kwargs={"autoreset_mode": AutoresetMode.SAME_STEP}, **kw)
+                       vector_kwargs={"autoreset_mode": mode}, **kw)
     outs = [v.reset(seed=3) for v in (ours, ref)]
     ours.action_space.seed(0)
     finals = 0
@@ -118,7 +121,30 @@ def test_the_vector_env_matches_gymnasiums_same_step_sync_vector_env():
                     assert (x is None and y is None) or np.array_equal(x, y)
             else:
                 assert np.array_equal(i1[key], i2[key].astype(i1[key].dtype)), key
-    assert finals == 2                                  # two auto-resets (5-step episodes)
+    # two episode ends (5-step episodes): SAME_STEP reports them with final infos
+    assert finals == (2 if mode is AutoresetMode.SAME_STEP else 0)
+
+
+def test_gymnasiums_observation_wrappers_take_the_next_step_mode():
+    """Gymnasium's vector observation wrappers (NormalizeObservation...) accept NEXT_STEP only;
+    its RecordEpisodeStatistics takes both."""
+    from gymnasium.wrappers.vector import NormalizeObservation, RecordEpisodeStatistics
+    with pytest.raises(ValueError, match="NEXT_STEP"):
+        NormalizeObservation(make_vec("RotorDrop-Damping-v0", 2, episode_time=0.003))
+    for mode in ("NextStep", "SameStep"):
+        envs = RecordEpisodeStatistics(make_vec("RotorDrop-Damping-v0", 2, episode_time=0.003,
+                                                autoreset_mode=mode))
+        if mode == "NextStep":
+            envs = NormalizeObservation(envs)
+        envs.reset(seed=0)
+        lengths = []
+        for _ in range(8):
+            *_, info = envs.step(envs.action_space.sample())
+            if "episode" in info:
+                lengths += list(info["episode"]["l"][info["_episode"]])
+        assert lengths == [3, 3, 3, 3]                  # two episodes of each env
+    with pytest.raises(ValueError, match="autoreset_mode"):
+        make_vec("RotorDrop-Damping-v0", 2, autoreset_mode="Disabled")
 
 
 def test_sync_and_async_make_vec_still_work():
