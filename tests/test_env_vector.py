@@ -158,6 +158,29 @@ def test_sync_and_async_make_vec_still_work():
         envs.close()
 
 
+def test_a_copied_vector_env_steps_like_the_original_and_renders():
+    import copy
+    import pickle
+    envs = make_vec("RotorDrop-Full-v0", 2, episode_time=0.003, render_mode="rgb_array",
+                    command="continuous", autoreset_mode="NextStep")
+    envs.reset(seed=0)
+    envs.action_space.seed(0)
+    acts = [envs.action_space.sample() for _ in range(8)]
+    envs.step(acts[0])
+    for twin in (copy.deepcopy(envs), pickle.loads(pickle.dumps(envs))):
+        assert twin.unwrapped.envs[0]._b.y is not envs.unwrapped.envs[0]._b.y
+    twin = copy.deepcopy(envs)
+    for a in acts[1:]:                                  # through the episode ends
+        (o1, r1, t1, u1, _), (o2, r2, t2, u2, _) = envs.step(a), twin.step(a)
+        assert np.array_equal(o1, o2) and np.array_equal(r1, r2)
+        assert np.array_equal(t1 | u1, t2 | u2)
+        f1, f2 = envs.render(), twin.render()
+        assert len(f1) == 2 and all(np.array_equal(x, y) for x, y in zip(f1, f2))
+    envs.close()
+    with pytest.raises(gym.error.ClosedEnvironmentError):
+        envs.step(acts[0])
+
+
 def test_the_vector_env_set_attr_call_and_errors():
     envs = make_vec("RotorDrop-Damping-v0", 2, episode_time=0.003)
     with pytest.raises(gym.error.ResetNeeded):
