@@ -110,7 +110,11 @@ def draw_scenarios(n: int, seed: int = SCENARIO_SEED,
     ranges = oracle_ranges(friction)
     env = make_env(ENV_ID, randomize=True, randomization=ranges, episode_time=0.01)
     try:
-        return [on_grid(env.reset(seed=seed + i)[1]["scenario"]) for i in range(n)]
+        scenarios = []
+        for i in range(n):
+            env.reset(seed=seed + i)
+            scenarios.append(on_grid(env.unwrapped.scenario))
+        return scenarios
     finally:
         env.close()
 

@@ -32,12 +32,23 @@ class Episode:
     contact_force: np.ndarray | None = None     # per step, (steps, n) [N]
     obs_names: tuple[str, ...] = ()             # + x1, y1, x2, y2 for a full_state env
     action_names: tuple[str, ...] = ()
-    scenario: dict | None = None                # the scenario drawn at reset (info["scenario"])
+    scenario: dict | None = None                # the scenario drawn at reset (env.unwrapped.scenario)
+
+
+#: KPIs whose info value is the sentinel ``rotordrop_env.info.MISSING`` when they do not exist
+#: (no re-levitation, no ball model): None in an Episode's KPIs (JSON null, skipped by means)
+OPTIONAL_KPIS = ("relevitation_time_s", "max_ball_load_N", "max_contact_pressure_MPa")
 
 
 def final_kpis(info: dict) -> dict:
-    return {k[4:]: (v.item() if isinstance(v, np.generic) else v)
+    """The ``kpi_*`` entries of a final step's ``info`` as Python values, prefix removed; the
+    sentinel of a KPI that does not exist becomes None."""
+    kpis = {k[4:]: (v.item() if isinstance(v, np.generic) else v)
             for k, v in info.items() if k.startswith("kpi_")}
+    for k in OPTIONAL_KPIS:
+        if k in kpis and (kpis[k] < 0.0 or (k == "relevitation_time_s" and not kpis["relevitated"])):
+            kpis[k] = None
+    return kpis
 
 
 def run_episodes(env_id: str, make_actor: Callable[[Plant], object], seeds, env_kwargs=None,
@@ -76,7 +87,7 @@ def _episode(env, plant: Plant, actor, seed: int, record: bool, frames: list | N
     obs, info = env.reset(seed=seed)
     if frames is not None:
         frames.append(env.render())
-    scenario = info.get("scenario")
+    scenario = env.unwrapped.scenario
     total, steps = 0.0, 0
     rec_obs, rec_act, rec_f = [], [], []
     start, running = np.ones(1, dtype=bool), np.zeros(1, dtype=bool)

@@ -105,7 +105,8 @@ def _callbacks():
         def _log_success_callback(self, locals_, globals_):
             super()._log_success_callback(locals_, globals_)
             if locals_["done"]:
-                kpis = {k: float(v) for k, v in final_kpis(locals_["info"]).items()}
+                kpis = {k: None if v is None else float(v)      # None: the KPI does not exist
+                        for k, v in final_kpis(locals_["info"]).items()}
                 kpis["failure"] = float(any(kpis.get(k, 0.0) for k in
                                             ("backward_whirl", "stator_contact", "bearing_overload")))
                 self._kpis.append(kpis)
@@ -122,7 +123,7 @@ def _callbacks():
                              std_reward=float(np.std(rewards)),
                              wall_time_s=time.perf_counter() - self.t0)
                 for key in sorted({k for d in self._kpis for k in d}):
-                    mean = mean_finite(d.get(key) for d in self._kpis)      # NaN (no value) skipped
+                    mean = mean_finite(d.get(key) for d in self._kpis)      # None (no value) skipped
                     if mean is not None:
                         entry[f"mean_{key}"] = mean
                         self.logger.record(f"eval/{key}", mean)

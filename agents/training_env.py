@@ -10,17 +10,19 @@ def make_vec_env(env_id: str, n_envs: int, seed: int, env_kwargs: dict, monitor_
                  reward: str = "env", reward_kwargs: dict | None = None,
                  residual: str | None = None, residual_scale: float | None = None):
     """The batched SB3 VecEnv of ``rotordrop_env`` with episode statistics (``VecMonitor``);
-    ``reward="kpi"`` replaces the reward by :mod:`agents.reward`'s KPI-aligned one, ``residual``
-    makes the agent's action a correction of that baseline controller's."""
+    ``reward="kpi"`` makes the environments' reward the KPI-aligned one (env kwarg
+    ``reward="kpi"``, :mod:`rotordrop_env.reward`), ``residual`` makes the agent's action a
+    correction of that baseline controller's."""
     from stable_baselines3.common.vec_env import VecMonitor
     from rotordrop_env import BatchedRotorDropVecEnv
+    if reward == "kpi":
+        from .reward import check_reward_kwargs
+        check_reward_kwargs(reward_kwargs or {})
+        env_kwargs = dict(env_kwargs, reward="kpi", reward_kwargs=dict(reward_kwargs or {}))
     venv = BatchedRotorDropVecEnv(env_id, n_envs, seed=seed, **env_kwargs)
     if residual:
         from .residual import make_residual
         venv = make_residual(venv, residual, **({} if residual_scale is None else
                                                 {"scale": residual_scale}))
-    if reward == "kpi":
-        from .reward import make_kpi_reward
-        venv = make_kpi_reward(venv, **(reward_kwargs or {}))
     return VecMonitor(venv, filename=str(monitor_file) if monitor_file else None,
                       info_keywords=("kpi_backward_whirl", "kpi_peak_contact_force_N"))

@@ -2,12 +2,16 @@
 
     import gymnasium as gym, rotordrop_env
     env = gym.make("RotorDrop-Damping-v0", overrides={"contact.friction": 0.4})
+    envs = gym.make_vec("RotorDrop-Damping-v0", num_envs=16, vectorization_mode="vector_entry_point")
 
 Ids: ``RotorDrop-Passive-v0``, ``RotorDrop-Damping-v0``, ``RotorDrop-Relevitate-v0``,
-``RotorDrop-Full-v0`` (see docs/environments.md). ``BatchedRotorDropVecEnv`` / ``make_batched``
-step N rotors in one parallel numba call as a Stable-Baselines3 ``VecEnv``.
+``RotorDrop-Full-v0`` (see docs/environments.md). Each id's ``vector_entry_point`` is the
+batched Gymnasium vector environment (:mod:`rotordrop_env.vector`); ``BatchedRotorDropVecEnv`` /
+``make_batched`` are the same batch as a Stable-Baselines3 ``VecEnv``. In a process that has not
+imported ``rotordrop_env`` (e.g. a spawned worker) write the id as
+``"rotordrop_env:RotorDrop-Damping-v0"``: Gymnasium imports the module first.
 """
-from gymnasium.envs.registration import WrapperSpec, register, registry
+from gymnasium.envs.registration import register, registry
 
 ENV_IDS = {
     "RotorDrop-Passive-v0": "rotordrop_env.env:PassiveEnv",
@@ -16,15 +20,24 @@ ENV_IDS = {
     "RotorDrop-Full-v0": "rotordrop_env.env:FullEnv",
 }
 
-#: outermost wrapper of every gym.make: KPIs also when a TimeLimit ends the episode early
-_WRAPPERS = (WrapperSpec("EpisodeKPIs", "rotordrop_env.wrappers:EpisodeKPIs", {}),)
+
+
+def vector_entry_point(entry_point: str) -> str:
+    """The vector environment of a single environment's entry point
+    (``rotordrop_env.env:DampingEnv`` -> ``rotordrop_env.vector:DampingVectorEnv``)."""
+    return "rotordrop_env.vector:" + entry_point.rsplit(":", 1)[1].replace("Env", "VectorEnv")
+
 
 for _id, _entry in ENV_IDS.items():
     if _id not in registry:
-        register(id=_id, entry_point=_entry, additional_wrappers=_WRAPPERS)
+        register(id=_id, entry_point=_entry, vector_entry_point=vector_entry_point(_entry))
 
 
 def __getattr__(name):
+    if name in ("RotorDropVectorEnv", "PassiveVectorEnv", "DampingVectorEnv",
+                "RelevitateVectorEnv", "FullVectorEnv"):
+        from . import vector
+        return getattr(vector, name)
     if name in ("BatchedRotorDropVecEnv", "make_batched"):
         from . import vec_env
         return getattr(vec_env, name)
@@ -34,5 +47,5 @@ def __getattr__(name):
     raise AttributeError(f"module 'rotordrop_env' has no attribute {name!r}")
 
 
-__all__ = ["ENV_IDS", "BatchedRotorDropVecEnv", "make_batched", "RotorDropEnv", "PassiveEnv",
+__all__ = ["ENV_IDS", "RotorDropVectorEnv", "BatchedRotorDropVecEnv", "make_batched", "RotorDropEnv", "PassiveEnv",
            "DampingEnv", "RelevitateEnv", "FullEnv"]

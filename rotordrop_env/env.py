@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import math
 import numbers
-import operator
 from os import PathLike
 from typing import Mapping
 
@@ -21,7 +20,9 @@ from physics.validity import validity_bound
 
 from . import kernels as K
 from .buffers import Buffers
+from .info import MISSING, REWARD_TERMS, info_dict, kpi_keys  # noqa: F401 (REWARD_TERMS re-exported)
 from .layout import COMMANDS, action_layout, observation_layout
+from .reward import REWARDS, check_kpi_weights, kpi_step
 from .scenario import (POWER_RETURN, POWER_RETURN_LIMITS, fault_state, layout_base, resolve_ranges,
                        sample, scenario_scene)
 from .sensors import Sensing, check_latency, check_noise
@@ -35,8 +36,6 @@ DAMPING_ACTIONS = {"linear": K.DAMP_LINEAR, "from_max": K.DAMP_FROM_MAX}
 #: [2^-SUPERVISOR_OCTAVES, 2^SUPERVISOR_OCTAVES]
 SUPERVISOR_OFFSET = 1.0
 SUPERVISOR_OCTAVES = 1.0
-REWARD_TERMS = ("whirl", "contact", "displacement", "effort", "success", "failure")
-_O_TERMS = (K.O_R_WHIRL, K.O_R_CONTACT, K.O_R_DISP, K.O_R_EFFORT, K.O_R_SUCCESS, K.O_R_FAILURE)
 DEFAULT_POWER_RETURN = 0.05
 _AXIS = np.array([S_X, S_Y, S_A, S_B])     # the rotor's centre and tilt, for the episode view
 #: reward weight -> its slot in the kernel configuration: settable at any time, used from the
@@ -50,7 +49,7 @@ FIXED_SETTINGS = frozenset(("control_dt", "dt", "episode_time", "n_steps", "rand
                             "terminate_on_failure", "render_mode", "base_scene", "overrides",
                             "obs_names", "obs_scale", "action_names", "weights",
                             "sensor_noise", "obs_latency_steps", "supervisor_authority",
-                            "damping_action"))
+                            "damping_action", "reward", "reward_kwargs"))
 
 
 def _weight(name: str, doc: str) -> property:
@@ -101,6 +100,9 @@ class RotorDropEnv(gym.Env):
     relevitation_hold           0.02        re-levitated after this long in the success region [s]
     terminate_on_failure        True        end at the stator, at a bearing overload or when
                                             a contact leaves its law's validity bound
+    reward                      "default"   "default" (the terms below) or "kpi" (the KPI
+                                            reward of :mod:`rotordrop_env.reward`)
+    reward_kwargs               None        reward="kpi": its weights (``KPI_WEIGHTS``)
     w_whirl, w_contact,         10, 0.1,    reward weights (see Reward)
     w_displacement, w_effort,   0.1, 0.01,
     w_success, w_failure        10, 10
@@ -123,6 +125,11 @@ class RotorDropEnv(gym.Env):
                    10 per step is above the per-step cost of riding out a whirl, about 3)
     =============  ========================================================================
 
+    ``info`` (see :mod:`rotordrop_env.info`): the same keys at reset and at every step, numpy
+    values, no NaN; the reward terms, ``cost`` (Safety-Gymnasium convention) and its
+    components, and the episode's ``kpi_*`` so far. The scenario of the episode is
+    ``env.unwrapped.scenario``.
+
     Episode end: ``terminated`` when the rotor reaches the AMB stator (radial displacement
     ``amb.air_gap`` = 600 µm at an AMB plane), a contact force exceeds the retainer bearing's
     static load rating C_0 or a penetration passes its contact law's validity bound
@@ -144,8 +151,20 @@ class RotorDropEnv(gym.Env):
                  obs_latency_steps: int | tuple[int, int] = 0, w_whirl: float = 10.0,
                  w_contact: float = 0.1, w_displacement: float = 0.1, w_effort: float = 0.01,
                  w_success: float = 10.0, w_failure: float = 10.0, render_mode: str | None = None,
-                 supervisor_authority: float = 1.0, damping_action: str = "linear"):
+                 supervisor_authority: float = 1.0, damping_action: str = "linear",
+                 reward: str = "default", reward_kwargs: dict | None = None):
         self._check_options(command, power_return_time, render_mode)
+        if reward not in REWARDS:
+            raise ValueError(f"reward = {reward!r} is not a reward; the rewards are "
+                             + ", ".join(repr(r) for r in REWARDS))
+        if reward_kwargs and reward != "kpi":
+            raise ValueError("reward_kwargs are the weights of reward='kpi'; pass reward='kpi' "
+                             "or leave them out")
+        if reward_kwargs is not None and not isinstance(reward_kwargs, Mapping):
+            raise ValueError(f"reward_kwargs = {reward_kwargs!r} must be a dict")
+        self.reward = reward
+        self.reward_kwargs = dict(reward_kwargs or {})
+        self._kpi_weights = check_kpi_weights(reward_kwargs) if reward == "kpi" else None
         self.supervisor_authority = _check_authority(supervisor_authority, command)
         self.damping_action = self._check_damping_action(damping_action)
         _positive("control_dt", control_dt, 1e-6, 0.1)
@@ -199,6 +218,7 @@ class RotorDropEnv(gym.Env):
         self._bind(Buffers(model.n_state, n_obs, n_act, int(samples_per_step)))
         self._configure_static(relevitation_hold, _flag("terminate_on_failure", terminate_on_failure))
         self._renderer = None
+        self._values = np.zeros(K.N_V)          # the info numbers (rotordrop_env.info)
         self._scenario: dict = {}
         self._needs_reset = True
         self._closed = False
@@ -216,6 +236,16 @@ class RotorDropEnv(gym.Env):
             raise AttributeError(f"{name!r} is not a reward weight; the weights are "
                                  f"{', '.join(WEIGHT_SLOTS)}")
         super().__setattr__(name, value)
+
+    def set_wrapper_attr(self, name: str, value, *, force: bool = True) -> bool:
+        """Gymnasium's way to set an attribute through ``gym.make``'s wrappers
+        (``env.set_wrapper_attr("w_whirl", 5.0)``): a reward weight, a construction setting or a
+        misspelt ``w_*`` name always reaches the environment, to be validated or refused there
+        (never left on a wrapper, where the environment would not see it)."""
+        if name in FIXED_SETTINGS or name.startswith("w_"):
+            setattr(self, name, value)
+            return True
+        return super().set_wrapper_attr(name, value, force=force)
 
     def _set_weight(self, name: str, value) -> None:
         _positive(name, value, 0.0, 1e9)
@@ -338,6 +368,7 @@ class RotorDropEnv(gym.Env):
         C[K.C_PEN_BOUND] = validity_bound(scene, "retainer").penetration
         C[K.C_STATOR_BOUND] = (validity_bound(scene, "stator").penetration
                                if scene.effects.stator_contact else math.inf)
+        C[K.C_P_COEF] = pressure_coef(fs.model, scene)
 
     # ------------------------------------------------------------------------ episode --
     def reset(self, *, seed: int | None = None, options: dict | None = None):
@@ -375,6 +406,7 @@ class RotorDropEnv(gym.Env):
         b.M[K.M_H] = fs.integrator.h
         b.M[K.M_OK_START] = -1.0
         b.M[K.M_RELEV_T] = math.nan
+        b.out[:] = 0.0                              # the reset info: nothing has happened yet
         K.observe_now(b.y, b.P, b.I, b.U, b.C, b.M, b.work, b.aux, b.cur, b.scale, b.obs)
         self._scenario = self._scenario_report(values, pr is not None)
         self._needs_reset = False
@@ -382,12 +414,18 @@ class RotorDropEnv(gym.Env):
         if self.render_mode is not None:            # record from the first step of the episode
             self._reset_view()
             self._record(step=False)
-        info = {"scenario": dict(self._scenario), "time_s": 0.0, "beyond_validity": False}
-        if not self._sensing.active:
-            return b.obs.astype(np.float32), info
-        obs = self._sensing.reset(b.obs, self.np_random)
-        info["obs_latency_steps"] = self._sensing.k
-        return obs, info
+        if self._sensing.active:
+            obs = self._sensing.reset(b.obs, self.np_random)
+        else:
+            obs = b.obs.astype(np.float32)
+        return obs, self._info()
+
+    @property
+    def scenario(self) -> dict:
+        """The machine of the current episode (a copy): every randomisation key's value (drawn,
+        fixed by the user, or the scene's without ``randomize``), every key fixed by ``reset``
+        options, and ``power_return_time`` as applied (re-levitation environments)."""
+        return dict(self._scenario)
 
     def _scenario_report(self, values: dict, power: bool) -> dict:
         """The machine of this episode: the value of every randomisation key (drawn, fixed by
@@ -449,9 +487,13 @@ class RotorDropEnv(gym.Env):
         terminated = bool(out[K.O_TERM])
         truncated = bool(out[K.O_TRUNC])
         self._ended |= terminated or truncated
-        info = self._step_info(terminated or truncated)
+        if self._kpi_weights is None:
+            reward = float(out[K.O_REWARD])
+        else:
+            reward = float(kpi_step(out, b.M, b.C, self._kpi_weights, self._relevitate))
+        info = self._info()
         self._show_step()
-        return self.observed(), float(out[K.O_REWARD]), terminated, truncated, info
+        return self.observed(), reward, terminated, truncated, info
 
     def observed(self) -> np.ndarray:
         """The float32 observation the agent gets after the step just taken: the kernel's, or
@@ -477,31 +519,16 @@ class RotorDropEnv(gym.Env):
             if self.render_mode == "human":
                 self.render()
 
-    def _step_info(self, done: bool) -> dict:
+    def _info(self) -> dict:
+        """The ``info`` of the reset or step just taken (:mod:`rotordrop_env.info`)."""
         b = self._b
-        info = step_info(b.out.tolist(), b.M.tolist(), b.C[K.C_T_FAULT].item(), self._relevitate)
-        if done:
-            info.update(self.kpis())
-        return info
+        K.info_values(b.out, b.M, b.C, self._values)
+        return info_dict(self._values, self._sensing.k, self._relevitate)
 
     def kpis(self) -> dict:
-        """Episode KPIs so far (the final step's ``info`` carries them)."""
-        b = self._b
-        M = b.M
-        relev = bool(M[K.M_RELEV])
-        return {"kpi_backward_whirl": bool(M[K.M_WHIRL]),
-                "kpi_whirl_revolutions": float(max(M[K.M_REV1], M[K.M_REV2])),
-                **{k: float(v) for k, v in peak_kpis(M).items()},
-                "kpi_relevitated": relev,
-                "kpi_relevitation_time_s": float(M[K.M_RELEV_T]) if relev else math.nan,
-                "kpi_control_effort": float(M[K.M_EFFORT]),
-                "kpi_stator_contact": bool(M[K.M_STATOR]),
-                "kpi_bearing_overload": bool(M[K.M_OVERLOAD]),
-                "kpi_beyond_validity": bool(M[K.M_BEYOND]),
-                "kpi_time_within_validity_s": (float(M[K.M_LEFT_T] - self._b.C[K.C_T_FAULT])
-                                               if M[K.M_BEYOND] else self.time),
-                **ball_kpis(self.model, self.scene, float(M[K.M_PEAK_Q])),
-                "kpi_episode_time_s": self.time}
+        """Episode KPIs so far (numpy scalars; every step's ``info`` carries them, the final
+        step's are the episode's)."""
+        return kpi_keys(self._info())
 
     # ---------------------------------------------------------------------- rendering --
     def _record(self, step: bool = True) -> None:
@@ -559,42 +586,13 @@ class RotorDropEnv(gym.Env):
         return self._b.y.copy()
 
 
-_INFO_KEYS = ("contact_force_N",) + tuple("reward_" + n for n in REWARD_TERMS)
-_INFO_COLS = [K.O_FORCE, *_O_TERMS]
-_info_values = operator.itemgetter(*_INFO_COLS)
-
-
-def ball_kpis(model, scene, q_max: float) -> dict:
-    """The worst ball's peak load and its Hertz contact pressure (``physics.metrics``'
-    retainer numbers, sampled at the KPI monitor's rate); NaN without Sopanen-Mikkola balls."""
+def pressure_coef(model, scene) -> float:
+    """c of the worst ball's Hertz contact pressure c x cbrt(ball load) [Pa]
+    (:func:`physics.ball_bearing.max_contact_pressure`); ``MISSING`` without Sopanen-Mikkola
+    balls (then the ball KPIs are ``MISSING``)."""
     if model.I[F_RB] != RB_SM:
-        return {"kpi_max_ball_load_N": math.nan, "kpi_max_contact_pressure_MPa": math.nan}
-    return {"kpi_max_ball_load_N": q_max,
-            "kpi_max_contact_pressure_MPa": float(max_contact_pressure(scene.bearing, q_max)) * 1e-6}
-
-
-def peak_kpis(M: np.ndarray) -> dict:
-    """The KPIs that are running episode maxima, from a monitor ``M`` (one env) or a stack
-    (N, ...) of them: the KPI reward of ``agents.reward`` reads these every step."""
-    return {"kpi_peak_whirl_revolutions": M[..., K.M_REV_PEAK],
-            "kpi_peak_contact_force_N": M[..., K.M_PEAK_F],
-            "kpi_max_displacement_um": M[..., K.M_MAX_DISP] * 1e6}
-
-
-def step_info(out: list, M: list, t_fault: float, relevitate: bool) -> dict:
-    """The per-step ``info`` of one environment from its kernel outputs and monitor (as lists:
-    indexing Python lists is the cheapest way to build the dict every step)."""
-    info = dict(zip(_INFO_KEYS, _info_values(out)), time_s=M[K.M_T] - t_fault,
-                backward_whirl=M[K.M_WHIRL] > 0.0, beyond_validity=M[K.M_BEYOND] > 0.0)
-    if relevitate:
-        info["relevitated"] = M[K.M_RELEV] > 0.0
-    return info
-
-
-def step_infos(out: np.ndarray, M: np.ndarray, C: np.ndarray, relevitate: bool) -> list[dict]:
-    """:func:`step_info` of N environments from their (N, ...) kernel arrays."""
-    return [step_info(o, m, tf, relevitate)
-            for o, m, tf in zip(out.tolist(), M.tolist(), C[:, K.C_T_FAULT].tolist())]
+        return MISSING
+    return float(max_contact_pressure(scene.bearing, 1.0))
 
 
 def real_action(action, space: gym.Space, names) -> np.ndarray:

@@ -19,6 +19,7 @@ from __future__ import annotations
 import math
 
 import numba
+import numpy as np
 
 from physics._jit import njit, njit_parallel
 from physics.integrate import integrate_segment
@@ -32,8 +33,10 @@ from physics.model import (A_DELTA, A_FR, A_QMAX, A_WS, I_AMB_FILT, I_AMB_INT, I
  C_RTOL, C_HMAX, C_HMIN, C_FIXED, C_MAXSTEPS,
  C_W_WHIRL, C_W_CONTACT, C_W_DISP, C_W_EFFORT, C_W_SUCCESS, C_W_FAILURE,
  C_F_REF, C_GAP, C_LOAD_RATING, C_HOLD, C_TERMINATE, C_FULL, C_CS_MIN, C_CS_MAX, C_ILIM,
- C_RELEV_RADIUS, C_WHIRL_RADIUS, C_WHIRL_REVS, C_SUP_OFFSET, C_SUP_OCTAVES,
- C_PEN_BOUND, C_STATOR_BOUND, N_C) = range(34)
+ C_RELEV_RADIUS, C_WHIRL_RADIUS, C_WHIRL_REVS, C_SUP_OFFSET, C_SUP_OCTAVES, C_P_COEF,
+ C_PEN_BOUND, C_STATOR_BOUND, N_C) = range(35)
+#: C[C_P_COEF]: Hertz contact pressure [Pa] = C_P_COEF x cbrt(ball load [N]), < 0 without
+#: Sopanen-Mikkola balls (read by the info builder, not by the kernels)
 LEV_NONE, LEV_DISCRETE, LEV_CONTINUOUS, LEV_SUPERVISOR = 0, 1, 2, 3
 #: C[C_DAMP]: no damper commands, or the damper action's map (env kwarg ``damping_action``)
 DAMP_NONE, DAMP_LINEAR, DAMP_FROM_MAX = 0.0, 1.0, 2.0
@@ -43,12 +46,24 @@ SUP_MIN_RADIUS = 0.05
 # ------------------------------------------------------------------------------ monitor M --
 (M_T, M_H, M_REV1, M_REV2, M_WHIRL, M_PEAK_F, M_MAX_DISP, M_OK_START, M_RELEV,
  M_RELEV_T, M_EFFORT, M_CTRL_ON, M_POWER, M_REV_PEAK, M_PEAK_Q, M_STATOR, M_OVERLOAD,
- M_BEYOND, M_LEFT_T, N_M) = range(20)
+ M_BEYOND, M_LEFT_T, M_PHI, N_M) = range(21)
+#: M[M_PHI]: the KPI reward's potential after the last step (rotordrop_env.reward; 0 at reset)
 
 # ------------------------------------------------------------------------------ outputs --
 (O_REWARD, O_R_WHIRL, O_R_CONTACT, O_R_DISP, O_R_EFFORT, O_R_SUCCESS, O_R_FAILURE, O_FORCE,
- O_TERM, O_TRUNC, O_STATUS, O_ERR, O_STATOR, O_OVERLOAD, O_BEYOND, N_O) = range(16)
+ O_TERM, O_TRUNC, O_STATUS, O_ERR, O_STATOR, O_OVERLOAD, O_RELEV, O_BEYOND, N_O) = range(17)
+#: out[O_RELEV]: 1 in the step in which re-levitation is achieved
 ERR_NONE, ERR_NAN, ERR_RANGE = 0, 1, 2
+# ------------------------------------------------------------------ info values (V_*) --
+#: the numbers of ``info`` (rotordrop_env.info names them): floats first, then flags (> 0: True)
+(V_FORCE, V_R_WHIRL, V_R_CONTACT, V_R_DISP, V_R_EFFORT, V_R_SUCCESS, V_R_FAILURE, V_TIME,
+ V_COST, V_COST_STATOR, V_COST_OVERLOAD, V_COST_VALIDITY, V_WHIRL_REVS, V_PEAK_REVS, V_PEAK_F,
+ V_MAX_DISP_UM, V_RELEV_T, V_EFFORT, V_BALL_Q, V_PRESSURE_MPA, V_TIME_VALID,
+ V_WHIRL, V_RELEV, V_STATOR, V_OVERLOAD, V_BEYOND, N_V) = range(27)
+N_V_FLOAT = V_WHIRL
+#: the value of an info entry that does not exist (no re-levitation, no ball model)
+MISSING = -1.0
+
 ACTION_TOL = 1e-6            # actions may exceed [-1, 1] by this much (float32 round-off)
 TWO_PI = 2.0 * math.pi
 
@@ -304,6 +319,7 @@ def step_one(a, y, P, I, U, atol, work, t_sub, Y_sub, aux, cur, C, M, scale, obs
                     M[M_RELEV] = 1.0
                     M[M_RELEV_T] = M[M_OK_START] - C[C_T_FAULT]
                     out[O_R_SUCCESS] = C[C_W_SUCCESS]
+                    out[O_RELEV] = 1.0
             else:
                 M[M_OK_START] = -1.0
     # aux now holds the diagnostics at t1 (last sub-sample)
@@ -362,3 +378,48 @@ def step_batch(A, Y, P, I, U, ATOL, WORK, TSUB, YSUB, AUX, CUR, C, M, SCALE, OBS
         step_one(A[e], Y[e], P[e], I[e], U[e], ATOL[e], WORK[e], TSUB[e], YSUB[e], AUX[e], CUR[e],
                  C[e], M[e], SCALE[e], OBS[e], OUT[e])
 
+
+
+@njit
+def info_values(out, M, C, v):
+    """The ``info`` numbers of one environment (``V_*`` layout) from its kernel outputs, monitor
+    and configuration: the step's, and the episode's KPIs so far. No NaN: ``MISSING`` for a
+    re-levitation time before re-levitation and for ball KPIs without Sopanen-Mikkola balls."""
+    v[V_FORCE] = out[O_FORCE]
+    v[V_R_WHIRL] = out[O_R_WHIRL]
+    v[V_R_CONTACT] = out[O_R_CONTACT]
+    v[V_R_DISP] = out[O_R_DISP]
+    v[V_R_EFFORT] = out[O_R_EFFORT]
+    v[V_R_SUCCESS] = out[O_R_SUCCESS]
+    v[V_R_FAILURE] = out[O_R_FAILURE]
+    v[V_TIME] = M[M_T] - C[C_T_FAULT]
+    v[V_COST_STATOR] = out[O_STATOR]
+    v[V_COST_OVERLOAD] = out[O_OVERLOAD]
+    v[V_COST_VALIDITY] = out[O_BEYOND]       # a penetration past its contact law's validity
+    v[V_COST] = v[V_COST_STATOR] + v[V_COST_OVERLOAD] + v[V_COST_VALIDITY]
+    v[V_WHIRL_REVS] = max(M[M_REV1], M[M_REV2])
+    v[V_PEAK_REVS] = M[M_REV_PEAK]
+    v[V_PEAK_F] = M[M_PEAK_F]
+    v[V_MAX_DISP_UM] = M[M_MAX_DISP] * 1e6
+    v[V_RELEV_T] = M[M_RELEV_T] if M[M_RELEV] > 0.0 else MISSING
+    v[V_EFFORT] = M[M_EFFORT]
+    if C[C_P_COEF] >= 0.0:
+        v[V_BALL_Q] = M[M_PEAK_Q]
+        v[V_PRESSURE_MPA] = C[C_P_COEF] * np.cbrt(M[M_PEAK_Q]) * 1e-6
+    else:
+        v[V_BALL_Q] = MISSING
+        v[V_PRESSURE_MPA] = MISSING
+    # time after the fault within the contact laws' validity (all of it until a bound is passed)
+    v[V_TIME_VALID] = (M[M_LEFT_T] if M[M_BEYOND] > 0.0 else M[M_T]) - C[C_T_FAULT]
+    v[V_WHIRL] = M[M_WHIRL]
+    v[V_RELEV] = M[M_RELEV]
+    v[V_STATOR] = M[M_STATOR]
+    v[V_OVERLOAD] = M[M_OVERLOAD]
+    v[V_BEYOND] = M[M_BEYOND]
+
+
+@njit
+def info_rows(OUT, M, C, V):
+    """:func:`info_values` of N environments (rows)."""
+    for e in range(OUT.shape[0]):
+        info_values(OUT[e], M[e], C[e], V[e])

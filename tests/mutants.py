@@ -103,7 +103,10 @@ def run(mutant: Mutant, tests=TESTS) -> tuple[bool, str]:
                                "-p", "no:cacheprovider", "-o", "addopts=", *tests],
                               cwd=root, capture_output=True, text=True)
         failed = [ln for ln in proc.stdout.splitlines() if ln.startswith("FAILED")]
-        return proc.returncode == 1, (failed[0] if failed else proc.stdout.strip().splitlines()[-1])
+        # killed: a test failed (exit 1 with a FAILED line); an error collecting or running the
+        # copy (exit 2 or 1 with ERROR lines only) says nothing about the checks
+        killed = proc.returncode == 1 and bool(failed)
+        return killed, (failed[0] if failed else proc.stdout.strip().splitlines()[-1])
 
 
 def main(argv: list[str]) -> int:

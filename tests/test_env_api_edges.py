@@ -32,7 +32,7 @@ def test_a_reward_weight_set_on_the_env_counts_from_the_next_step():
         e.reset(seed=0)
     a = np.zeros(2, np.float32)
     infos = [[e.step(a)[4] for _ in range(40)] for e in envs]
-    envs[1].w_whirl = 25.0                       # on gym.make's outermost wrapper
+    envs[1].set_wrapper_attr("w_whirl", 25.0)    # through gym.make's wrappers
     assert envs[1].unwrapped.w_whirl == 25.0 == envs[1].get_wrapper_attr("w_whirl")
     after = [[e.step(a) for _ in range(15)] for e in envs]
     assert [i["reward_whirl"] for i in infos[0]] == [i["reward_whirl"] for i in infos[1]]
@@ -70,8 +70,9 @@ def test_settings_fixed_at_construction_and_misspelt_weights_raise(target):
         setter = lambda name, value: venv.set_attr(name, value)
     else:
         env = gym.make("RotorDrop-Damping-v0")
-        obj = env.unwrapped if target == "env" else env
-        setter = lambda name, value: setattr(obj, name, value)
+        # through gym.make's wrappers: Gymnasium's set_wrapper_attr reaches the environment
+        setter = (lambda name, value: setattr(env.unwrapped, name, value)) if target == "env" \
+            else env.set_wrapper_attr
     for name in ("control_dt", "episode_time", "terminate_on_failure", "randomize"):
         with pytest.raises(AttributeError, match=f"{name} is fixed when the environment is made"):
             setter(name, 1)

@@ -49,7 +49,7 @@ def test_a_copied_env_steps_and_renders_like_the_original(env_id, render_mode, c
         if k == 3:                          # after the episode end (5 steps)
             o1, i1 = env.reset(seed=11)
             o2, i2 = twin.reset(seed=11)
-            assert np.array_equal(o1, o2) and i1["scenario"] == i2["scenario"]
+            assert np.array_equal(o1, o2) and env.unwrapped.scenario == twin.unwrapped.scenario
         _same_step(env.step(a), twin.step(a))
         if render_mode:
             f1, f2 = env.render(), twin.render()
@@ -84,7 +84,7 @@ def _trajectory(env, seed, n=6):
     for a in _actions(env.action_space, n, seed=seed):
         obs, r, *_ = env.step(a)
         out += [obs, np.array([r])]
-    return np.concatenate(out), info["scenario"]
+    return np.concatenate(out), env.unwrapped.scenario
 
 
 def test_a_json_env_spec_makes_the_same_environment():

@@ -24,7 +24,7 @@ RELEV_SEED0 = {"contact.friction": 0.3547846749285818, "rotor.speed_rpm": 8163.8
 def scenario(env_id, seed=0, **kw):
     env = gym.make(env_id, **{**KW, **kw})
     _, info = env.reset(seed=seed)
-    return info["scenario"], env.unwrapped.scene
+    return env.unwrapped.scenario, env.unwrapped.scene
 
 
 def test_draws_without_fixed_keys_are_unchanged():
@@ -75,8 +75,8 @@ def test_batched_envs_keep_the_fixed_keys():
     vec = make_batched("RotorDrop-Damping-v0", 2, seed=0, n_threads=1,
                        overrides={"contact.friction": 0.45}, **KW)
     vec.reset()
-    assert [info["scenario"]["contact.friction"] for info in vec.reset_infos] == [0.45, 0.45]
-    assert vec.reset_infos[0]["scenario"]["unbalance.mass"] == DAMPING_SEED0["unbalance.mass"]
+    assert [s["contact.friction"] for s in vec.get_attr("scenario")] == [0.45, 0.45]
+    assert vec.get_attr("scenario")[0]["unbalance.mass"] == DAMPING_SEED0["unbalance.mass"]
 
 
 def test_default_ranges_are_valid():
@@ -183,8 +183,8 @@ def test_power_return_is_reported_without_round_off(seconds):
     _, info = env.reset(seed=0)
     steps = math.ceil(seconds / 1e-3 - 1e-9)
     on_grid = round(steps * 1e-3, 12)
-    assert info["scenario"]["power_return_time"] == on_grid
-    assert repr(info["scenario"]["power_return_time"]) == repr(round(on_grid, 6))
+    assert env.unwrapped.scenario["power_return_time"] == on_grid
+    assert repr(env.unwrapped.scenario["power_return_time"]) == repr(round(on_grid, 6))
     C = env.unwrapped._b.C
     t_fault = C[K.C_T_FAULT]
     assert C[K.C_T_POWER] == t_fault + steps * 1e-3
@@ -194,5 +194,5 @@ def test_drawn_power_returns_are_reported_cleanly():
     env = gym.make("RotorDrop-Relevitate-v0", **KW)
     for seed in range(5):
         _, info = env.reset(seed=seed)
-        value = info["scenario"]["power_return_time"]
+        value = env.unwrapped.scenario["power_return_time"]
         assert value == round(value, 12) and len(repr(value)) <= 6     # e.g. 0.073

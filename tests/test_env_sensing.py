@@ -112,7 +112,7 @@ def test_a_range_that_switches_on_the_coil_lag_gives_the_base_scene_the_coil_sta
     env = gym.make(FULL, **SUP, randomize=True, randomization={"amb.coil_time_constant": (2e-4, 1e-3)})
     assert env.unwrapped.base_scene.amb.coil_time_constant == 2e-4
     _, info = env.reset(seed=0)
-    assert 2e-4 <= info["scenario"]["amb.coil_time_constant"] <= 1e-3
+    assert 2e-4 <= env.unwrapped.scenario["amb.coil_time_constant"] <= 1e-3
     with pytest.raises(SceneError, match="changes the state layout within its range"):
         gym.make(FULL, randomize=True, randomization={"amb.coil_time_constant": (0.0, 1e-3)})
 

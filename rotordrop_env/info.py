@@ -1,0 +1,74 @@
+"""The ``info`` of the environments, built from the kernel arrays of one environment or of a
+batch (the single environment, the Gymnasium vector environment and the SB3 VecEnv all use
+:func:`info_dict` on the numbers of :func:`rotordrop_env.kernels.info_values`).
+
+The contract, which any RL library can rely on:
+
+* the same keys at reset and at every step (for a given environment and its settings);
+* every value a numpy scalar (single environment) or a numpy array with one entry per
+  environment (batches): ``np.float64``, ``np.bool_`` or ``np.int64``, never a Python object;
+* no NaN anywhere: a value that does not exist is the sentinel ``MISSING`` (-1.0), next to a
+  boolean that says whether it exists (``kpi_relevitated`` for ``kpi_relevitation_time_s``),
+  or a fixed property of the scene (``kpi_max_ball_load_N`` without Sopanen-Mikkola balls).
+
+The ``kpi_*`` entries are the episode's KPIs so far: at the final step (terminated or
+truncated, also by a ``TimeLimit``) they are the episode's KPIs.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from . import kernels as K
+from .kernels import MISSING  # noqa: F401  (re-exported: the documented sentinel)
+
+REWARD_TERMS = ("whirl", "contact", "displacement", "effort", "success", "failure")
+#: the components of ``info["cost"]`` (Safety-Gymnasium convention: a cost >= 0 per step): 1 in
+#: a step in which the rotor reaches the AMB stator, a contact force exceeds the retainer
+#: bearing's static load rating, a penetration is past its contact law's validity bound
+COST_TERMS = ("cost_stator_contact", "cost_bearing_overload", "cost_contact_validity")
+#: the running KPIs the KPI reward's potential is built from (rotordrop_env.reward)
+PEAK_KEYS = ("kpi_peak_whirl_revolutions", "kpi_peak_contact_force_N", "kpi_max_displacement_um")
+
+#: the float entries, in the order of the kernel's V_* values
+FLOAT_KEYS = ("contact_force_N", *("reward_" + t for t in REWARD_TERMS), "time_s", "cost",
+              *COST_TERMS, "kpi_whirl_revolutions", "kpi_peak_whirl_revolutions",
+              "kpi_peak_contact_force_N", "kpi_max_displacement_um", "kpi_relevitation_time_s",
+              "kpi_control_effort", "kpi_max_ball_load_N", "kpi_max_contact_pressure_MPa",
+              "kpi_time_within_validity_s")
+assert len(FLOAT_KEYS) == K.N_V_FLOAT
+#: the bool entries and their V_* values ("relevitated": re-levitation environments only)
+_BOOLS = (("backward_whirl", K.V_WHIRL), ("relevitated", K.V_RELEV),
+          ("kpi_backward_whirl", K.V_WHIRL), ("kpi_relevitated", K.V_RELEV),
+          ("kpi_stator_contact", K.V_STATOR), ("kpi_bearing_overload", K.V_OVERLOAD),
+          ("beyond_validity", K.V_BEYOND), ("kpi_beyond_validity", K.V_BEYOND))
+_BOOL_KEYS = {r: tuple(k for k, _ in _BOOLS if r or k != "relevitated") for r in (False, True)}
+_BOOL_IDX = {r: np.array([i for k, i in _BOOLS if r or k != "relevitated"]) for r in (False, True)}
+_NF = K.N_V_FLOAT
+
+
+def info_dict(v: np.ndarray, latency, relevitate: bool) -> dict:
+    """The ``info`` from the numbers ``v`` of one environment (``(N_V,)``: numpy scalars) or of
+    N (``(N, N_V)``: arrays of N, one fresh array each); ``latency``: the episode's observation
+    latency (int, or int array of N)."""
+    bidx = _BOOL_IDX[relevitate]
+    if v.ndim == 1:
+        info = dict(zip(FLOAT_KEYS, list(v[:_NF])))
+        info.update(zip(_BOOL_KEYS[relevitate], list(v[bidx] > 0.0)))
+        info["obs_latency_steps"] = np.int64(latency)
+    else:
+        cols = v.T.copy()                        # fresh: nothing a caller holds is reused
+        info = dict(zip(FLOAT_KEYS, cols[:_NF]))
+        info.update(zip(_BOOL_KEYS[relevitate], cols[bidx] > 0.0))
+        info["obs_latency_steps"] = np.array(latency, dtype=np.int64)
+    info["kpi_episode_time_s"] = info["time_s"].copy()
+    return info
+
+
+def kpi_keys(info: dict) -> dict:
+    """The ``kpi_*`` entries of ``info``."""
+    return {k: v for k, v in info.items() if k.startswith("kpi_")}
+
+
+def row_info(columns: dict, e: int) -> dict:
+    """Environment ``e``'s info (numpy scalars) from the columns of a batch."""
+    return {k: v[e] for k, v in columns.items()}
