@@ -140,8 +140,8 @@ def test_env_info_reports_validity_every_step(overrides, beyond):
     infos, term = _episode(overrides, terminate=False)
     assert not term and len(infos) == 51
     flags = [i["beyond_validity"] for i in infos]
-    assert all(isinstance(f, bool) for f in flags) and flags[0] is False
-    assert flags[-1] is beyond and flags == sorted(flags)            # latched once passed
+    assert all(isinstance(f, np.bool_) for f in flags) and not flags[0]   # numpy, as all of info
+    assert bool(flags[-1]) == beyond and flags == sorted(flags)      # latched once passed
     kpi = infos[-1]
     assert bool(kpi["kpi_beyond_validity"]) == beyond
     t_valid = kpi["kpi_time_within_validity_s"]
@@ -193,6 +193,6 @@ def test_batched_env_reports_the_same_validity_as_the_single_env():
     env.reset(seed=3)
     single = [env.step(np.zeros(env.action_space.shape, np.float32))[4]["beyond_validity"]
               for _ in range(6)]
-    assert single[0] is False and single[-1] is True             # passed at 2.8 ms
+    assert not single[0] and single[-1]                          # passed at 2.8 ms
     for e in range(2):
         assert [b[e]["beyond_validity"] for b in batched] == single
