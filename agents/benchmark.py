@@ -1,6 +1,6 @@
 """``rotordrop benchmark``: every baseline and every shipped policy on a fixed, seeded suite.
 
-1. **Passive threshold.** The passive drop (``RotorDrop-Passive-v0``, paper scene) is run on a
+1. **Passive threshold.** The passive drop (``RotorDrop-Passive-v1``, paper scene) is run on a
    friction grid (``THRESHOLD_GRID``) for each unbalance phase of the suite; the threshold μ* is
    the lowest grid friction from which on the passive drop whirls in at least half of the phases
    at every grid point. Between the first whirl and μ* the outcome depends on the phase
@@ -12,8 +12,8 @@
    scenario is in-distribution when all its values lie inside the environments' default
    randomisation ranges (the training distribution of the shipped policies), else out of it.
    Each scenario runs once per unbalance phase (``PHASES``): the episodes are deterministic.
-3. **Tasks.** ``damping`` (``RotorDrop-Damping-v0``), ``relevitate``
-   (``RotorDrop-Relevitate-v0``) and ``full`` (``RotorDrop-Full-v0``, both channels): every
+3. **Tasks.** ``damping`` (``RotorDrop-Damping-v1``), ``relevitate``
+   (``RotorDrop-Relevitate-v1``) and ``full`` (``RotorDrop-Full-v1``, both channels): every
    baseline (and user controller, ``--policy module:Class``) that has its channels in the task
    (:func:`controller_env_kwargs` picks the re-levitation command its channels need), the passive reference with the AMBs left off, learned policies with the command
    they were trained with.
@@ -46,8 +46,8 @@ PHASES = (0.0, 90.0, 180.0, 270.0)
 QUICK_PHASES = (0.0, 180.0)
 THRESHOLD_GRID = tuple(round(0.10 + 0.02 * i, 2) for i in range(21))     # 0.10 ... 0.50
 WHIRL_MARGINS = (0.05, 0.10, 0.15)
-TASKS = {"damping": "RotorDrop-Damping-v0", "relevitate": "RotorDrop-Relevitate-v0",
-         "full": "RotorDrop-Full-v0"}
+TASKS = {"damping": "RotorDrop-Damping-v1", "relevitate": "RotorDrop-Relevitate-v1",
+         "full": "RotorDrop-Full-v1"}
 RELEVITATION_ENVS = (TASKS["relevitate"], TASKS["full"])
 #: ``--suite``: the fixed nominal suite, or the robust one (:mod:`agents.robust`)
 SUITES = ("nominal", "robust")
@@ -120,7 +120,7 @@ def passive_whirls(mu: float, phases, progress=None) -> list[bool]:
     """Whether the passive drop at friction ``mu`` whirls, per unbalance phase."""
     whirls = []
     for ph in phases:
-        ep = run_episodes("RotorDrop-Passive-v0", Passive, [0], dict(
+        ep = run_episodes("RotorDrop-Passive-v1", Passive, [0], dict(
             EVAL_KWARGS, overrides={"contact.friction": mu, "unbalance.angle_deg": ph},
             **monitor_kwargs({})))[0]
         whirls.append(bool(ep.kpis["backward_whirl"]))

@@ -206,7 +206,7 @@ def cmd_oracle(args) -> int:
 
 def register(sub) -> None:
     p = sub.add_parser("train", help="train an SB3 agent on a rotor-drop environment")
-    p.add_argument("--env", required=True, help="environment id, e.g. RotorDrop-Damping-v0")
+    p.add_argument("--env", required=True, help="environment id, e.g. RotorDrop-Damping-v1")
     p.add_argument("--algo", required=True, choices=ALGOS)
     p.add_argument("--timesteps", type=int, default=None, help="override n_timesteps of the config")
     p.add_argument("--n-envs", type=int, default=None, help="override n_envs of the config")
@@ -338,8 +338,8 @@ def register(sub) -> None:
     p.add_argument("--policy", required=True,
                    help="controller class: a baseline name, package.module:Class or file.py:Class; "
                         "its constructor takes the gains as keyword arguments")
-    p.add_argument("--env", required=True, help="RotorDrop-Damping-v0, RotorDrop-Relevitate-v0 "
-                                                "or RotorDrop-Full-v0")
+    p.add_argument("--env", required=True, help="RotorDrop-Damping-v1, RotorDrop-Relevitate-v1 "
+                                                "or RotorDrop-Full-v1")
     p.add_argument("--gain", action="append", default=[], metavar="NAME=LO:HI",
                    help="a gain and its search range (repeatable), e.g. --gain kp=0:30")
     p.add_argument("--iterations", type=int, default=12, help="generations (default 12)")
@@ -355,8 +355,8 @@ def register(sub) -> None:
 
     p = sub.add_parser("ride-through", help="how late the AMB power may return for a controller "
                                             "to stop the whirl: friction x power-return map")
-    p.add_argument("--env", default="RotorDrop-Relevitate-v0",
-                   help="RotorDrop-Relevitate-v0 (damper at the scene's C_s) or RotorDrop-Full-v0")
+    p.add_argument("--env", default="RotorDrop-Relevitate-v1",
+                   help="RotorDrop-Relevitate-v1 (damper at the scene's C_s) or RotorDrop-Full-v1")
     p.add_argument("--policy", action="append", default=None,
                    help="a re-levitating controller (one that sets the levitate or currents "
                         "channel): baseline or shipped policy name, a path, or a controller class "

@@ -6,7 +6,7 @@ For each of ``--scenarios`` drops drawn where whirl is decided (``ORACLE_RANGES`
 environments' default ranges for the rest; seeds from ``SCENARIO_SEED``, disjoint from training
 and evaluation seeds) a
 cross-entropy search (:mod:`agents.search`) optimises an open-loop command sequence of
-``RotorDrop-Full-v0`` with ``command="supervisor"``: piecewise constant over the segments
+``RotorDrop-Full-v1`` with ``command="supervisor"``: piecewise constant over the segments
 ``SEGMENT_EDGES_MS`` after the fault, per segment both damper commands, the PID gain scale and
 the four orbit-frame reference offsets, plus one delay after the power return before the
 built-in PID is switched on. The search knows the scenario in advance, which no controller
@@ -549,7 +549,7 @@ def plot_oracle(report: dict, path: Path) -> Path:
     axes[0].barh(y, [e["score"] for e in summary], color=colors)
     suite = report["settings"].get("suite", "full")
     axes[0].set(yticks=y, yticklabels=names, xlabel="score (benchmark formula)",
-                title=f"{len(report['per_scenario'])} scenarios, RotorDrop-Full-v0"
+                title=f"{len(report['per_scenario'])} scenarios, RotorDrop-Full-v1"
                       + (", robust suite" if suite == "robust" else ""))
     axes[1].barh(y, [e["whirl_rate"] for e in summary], color=colors)
     axes[1].set(yticks=y, yticklabels=[], xlabel="backward-whirl rate", xlim=(0, 1))

@@ -48,9 +48,9 @@ START, END = "<!-- leaderboard:start -->", "<!-- leaderboard:end -->"
 DROPPED_KEYS = ("rows",)
 #: the kpis.json keys kept for the hard benchmark (the passive comparison is left out)
 HARD_KEYS = ("policy", "env_id", "env_kwargs", "seeds", "summary", "episodes")
-TASK_TITLES = {"damping": "Damping (`RotorDrop-Damping-v0`)",
-               "relevitate": "Re-levitation (`RotorDrop-Relevitate-v0`)",
-               "full": "Damping and re-levitation (`RotorDrop-Full-v0`)"}
+TASK_TITLES = {"damping": "Damping (`RotorDrop-Damping-v1`)",
+               "relevitate": "Re-levitation (`RotorDrop-Relevitate-v1`)",
+               "full": "Damping and re-levitation (`RotorDrop-Full-v1`)"}
 
 
 # -- formatting --------------------------------------------------------------------------------
@@ -103,7 +103,7 @@ def robust_section(report: dict, source: str) -> list[str]:
     seeds = d.get("scenario_seeds", [None, None])
     out = ["## Robust suite", "",
            f"`rotordrop benchmark --suite robust{' --quick' if report.get('quick') else ''}` "
-           f"(data: `{source}`): {len(report['scenarios'])} drops of `RotorDrop-Full-v0` "
+           f"(data: `{source}`): {len(report['scenarios'])} drops of `RotorDrop-Full-v1` "
            f"(scenario seeds {seeds[0]}–{seeds[1]}) with {_f(1e6 * d.get('sensor_noise_m', 0), 'g')} µm "
            f"sensor noise, {'–'.join(str(x) for x in d.get('latency_ms', []))} ms observation "
            "latency, actuator spread and plant variation "
@@ -286,7 +286,7 @@ def readme_block(root: Path = ROOT) -> str:
         return "No benchmark data committed yet: see docs/results.md."
     full = [e for e in nominal["leaderboard"] if e["task"] == "full"]
     return "\n".join([f"`rotordrop benchmark`, damping and re-levitation together "
-                      f"(`RotorDrop-Full-v0`, passive threshold μ\\* = {_f(nominal['passive_threshold'], 'g')}); "
+                      f"(`RotorDrop-Full-v1`, passive threshold μ\\* = {_f(nominal['passive_threshold'], 'g')}); "
                       "every table: [docs/results.md](docs/results.md).", ""]
                      + leaderboard_table(full))
 

@@ -103,7 +103,7 @@ def ride_through_times(peak_revs: np.ndarray, relevitated: np.ndarray, delays, t
     return out
 
 
-def ride_through(out: str | Path, env_id: str = "RotorDrop-Relevitate-v0",
+def ride_through(out: str | Path, env_id: str = "RotorDrop-Relevitate-v1",
                  policies: list[str] | None = None, frictions=FRICTIONS, delays=DELAYS,
                  phases=PHASES, progress: bool = True, plots: bool = True) -> dict:
     """Run the map (module doc) and write its JSON, CSV and figure into ``out``."""

@@ -1,7 +1,7 @@
 """The robust suite (``rotordrop benchmark --suite robust``): the Full task under imperfect
 sensing, actuator spread and plant variation that the controller does not observe.
 
-Every scenario is one drop of ``RotorDrop-Full-v0`` drawn from :data:`ROBUST_RANGES` (friction,
+Every scenario is one drop of ``RotorDrop-Full-v1`` drawn from :data:`ROBUST_RANGES` (friction,
 unbalance mass and phase, housing stiffness ± 30 %, spin speed, power return, coil current limit
 and coil lag; the support's initial damping from the environments' default range), with
 displacement-sensor noise :data:`SENSOR_NOISE` and an observation latency of 1, 2 or 3 ms
@@ -218,7 +218,7 @@ def robust_markdown(report: dict, scenario_rows: bool = True) -> str:
     d = report["distribution"]
     ranges = ", ".join(f"{k} {lo:g}-{hi:g}" for k, (lo, hi) in d["ranges"].items())
     lines = [f"# rotordrop benchmark --suite robust{' (quick)' if report['quick'] else ''}", "",
-             f"{len(report['scenarios'])} drops of RotorDrop-Full-v0 (scenario seeds "
+             f"{len(report['scenarios'])} drops of RotorDrop-Full-v1 (scenario seeds "
              f"{d['scenario_seeds'][0]}-{d['scenario_seeds'][1]}) drawn from: {ranges}; "
              f"displacement-sensor noise {1e6 * d['sensor_noise_m']:g} µm, observation latency "
              f"{d['latency_ms'][0]}-{d['latency_ms'][1]} ms (whole control steps, rounded up); "

@@ -79,7 +79,7 @@ def cost_split(env_id: str, kwargs: dict, episodes: int, seed: int = 0):
     u = env.unwrapped
     space = env.action_space
     space.seed(seed)
-    passive = env_id == "RotorDrop-Passive-v0"
+    passive = env_id == "RotorDrop-Passive-v1"
     acts = [np.zeros(space.shape, dtype=space.dtype) if passive else space.sample()
             for _ in range(4096)]
 
@@ -223,26 +223,26 @@ def main(argv=None) -> int:
             kw["terminate_on_failure"] = False
         print(f"single environment, paper scene {res['overrides'] or ''}, {label}, whole 0.3 s "
               f"episodes (median of {R}):")
-        for env_id in ("RotorDrop-Passive-v0", "RotorDrop-Damping-v0"):
+        for env_id in ("RotorDrop-Passive-v1", "RotorDrop-Damping-v1"):
             for unwrapped in (False, True):
                 rate = _median(single_env_rate(env_id, kw, E, unwrapped), R)
                 key = f"{label}: {env_id}{' unwrapped' if unwrapped else ''}"
                 res[key + " steps/s"] = rate
                 print(f"  {env_id + (' unwrapped' if unwrapped else ''):36s} {rate:10.0f} steps/s")
-        for env_id in ("RotorDrop-Passive-v0", "RotorDrop-Damping-v0"):
+        for env_id in ("RotorDrop-Passive-v1", "RotorDrop-Damping-v1"):
             split = {k: _median(fn, R) for k, fn in cost_split(env_id, kw, E).items()}
             res[f"{label}: {env_id} per-step us"] = split
             _print_split(env_id, split)
 
     n, steps = args.n_envs, 600
-    single = res[f"{cases[0][0]}: RotorDrop-Damping-v0 steps/s"]
-    print(f"batched VecEnv, N = {n}, RotorDrop-Damping-v0 (paper scene), random actions, "
+    single = res[f"{cases[0][0]}: RotorDrop-Damping-v1 steps/s"]
+    print(f"batched VecEnv, N = {n}, RotorDrop-Damping-v1 (paper scene), random actions, "
           f"{steps} batch steps:")
-    split = res[f"{cases[0][0]}: RotorDrop-Damping-v0 per-step us"]
+    split = res[f"{cases[0][0]}: RotorDrop-Damping-v1 per-step us"]
     bound = dict(physics=split["wrapped"] / split["physics"], kernel=split["wrapped"] / split["kernel"])
     res["batching bound per core (Amdahl)"] = bound
     for threads in sorted({1, numba.config.NUMBA_NUM_THREADS}):
-        rate = _median(batched_rate("RotorDrop-Damping-v0", kwargs, n, steps, threads), R)
+        rate = _median(batched_rate("RotorDrop-Damping-v1", kwargs, n, steps, threads), R)
         per_core = rate if args.clock == "cpu" else rate / threads
         res[f"batched N={n} threads={threads} steps/s per core"] = per_core
         print(f"  {threads} thread(s): {per_core:10.0f} env steps/s per core "
@@ -254,7 +254,7 @@ def main(argv=None) -> int:
     print(f"batched VecEnv with default threads (chosen as it runs) over one thread, wall clock, "
           f"runs interleaved (median of {R}):")
     for n_b in sorted({1, n}):
-        ratio, auto, one = default_vs_one_thread("RotorDrop-Damping-v0", kwargs, n_b,
+        ratio, auto, one = default_vs_one_thread("RotorDrop-Damping-v1", kwargs, n_b,
                                                  max(steps, 4800 // n_b), R)
         res[f"batched N={n_b} default/one thread (wall)"] = ratio
         print(f"  N = {n_b:3d}: {ratio:.2f}x ({auto:.0f} vs {one:.0f} env steps/s)")

@@ -3,7 +3,7 @@ its cost as a multiple of one environment step timed in the same run.
 
     python benchmarks/bench_render.py [--repeats 5] [--frames 200] [--json out.json]
 
-``RotorDrop-Full-v0`` (the view with the most labels: damping and AMB lines too), paper scene at
+``RotorDrop-Full-v1`` (the view with the most labels: damping and AMB lines too), paper scene at
 μ = 0.5 run through its backward whirl (``terminate_on_failure=False``), default 1 ms control
 step. A frame's cost grows with the recorded trace, so frames are timed after 10, 150 and 300
 steps (the end of the 0.3 s episode). Also timed: a whole episode of steps without a render
@@ -34,7 +34,7 @@ def _median(fn, repeats: int) -> float:
 
 def episode_rate(render_mode: str | None):
     """Steps per second over a whole episode (reset included)."""
-    env = gym.make("RotorDrop-Full-v0", render_mode=render_mode, **KW)
+    env = gym.make("RotorDrop-Full-v1", render_mode=render_mode, **KW)
 
     def run():
         t0 = CLOCK()
@@ -50,7 +50,7 @@ def episode_rate(render_mode: str | None):
 
 def frame_rate(steps: int, frames: int):
     """render() calls per second with ``steps`` steps recorded."""
-    env = gym.make("RotorDrop-Full-v0", render_mode="rgb_array", **KW)
+    env = gym.make("RotorDrop-Full-v1", render_mode="rgb_array", **KW)
     env.reset(seed=0)
     for _ in range(steps):
         env.step(ACTION)

@@ -4,7 +4,7 @@
                                         [--threads 1 2] [--json out.json]
 
 For each algorithm and thread count (torch and numba threads, ``rotordrop train --threads``)
-a short ``agents.train.train`` run on ``RotorDrop-Damping-v0`` with the shipped
+a short ``agents.train.train`` run on ``RotorDrop-Damping-v1`` with the shipped
 hyperparameters (evaluation and checkpoints off) is timed; figures are medians of
 ``--repeats`` runs after a warm-up. Also the raw batched env with random actions
 (``bench_env.batched_rate``, timed by the wall clock like the training runs), to separate the
@@ -23,7 +23,7 @@ import numba
 import bench_env
 from bench_env import batched_rate
 
-ENV = "RotorDrop-Damping-v0"
+ENV = "RotorDrop-Damping-v1"
 ENV_KWARGS = dict(randomize=True, terminate_on_failure=False)
 N_ENVS, ENV_STEPS = 8, 500
 

@@ -1,6 +1,6 @@
 """Gymnasium vector environment against the SB3 batched VecEnv: steps per second per core.
 
-    python benchmarks/bench_vector.py [--env-id RotorDrop-Full-v0] [--n-envs 16] [--steps 600]
+    python benchmarks/bench_vector.py [--env-id RotorDrop-Full-v1] [--n-envs 16] [--steps 600]
                                       [--repeats 7] [--command supervisor]
 
 Both are the same numba batch (rotordrop_env.batch) on one thread (``n_threads=1``: the per-core
@@ -27,7 +27,7 @@ CLOCK = time.process_time
 
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--env-id", default="RotorDrop-Full-v0", choices=list(rotordrop_env.ENV_IDS))
+    ap.add_argument("--env-id", default="RotorDrop-Full-v1", choices=list(rotordrop_env.ENV_IDS))
     ap.add_argument("--n-envs", type=int, default=16)
     ap.add_argument("--steps", type=int, default=600)
     ap.add_argument("--repeats", type=int, default=7)

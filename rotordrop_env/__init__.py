@@ -1,23 +1,23 @@
 """Gymnasium environments of the AMB rotor drop, registered on import.
 
     import gymnasium as gym, rotordrop_env
-    env = gym.make("RotorDrop-Damping-v0", overrides={"contact.friction": 0.4})
-    envs = gym.make_vec("RotorDrop-Damping-v0", num_envs=16, vectorization_mode="vector_entry_point")
+    env = gym.make("RotorDrop-Damping-v1", overrides={"contact.friction": 0.4})
+    envs = gym.make_vec("RotorDrop-Damping-v1", num_envs=16, vectorization_mode="vector_entry_point")
 
-Ids: ``RotorDrop-Passive-v0``, ``RotorDrop-Damping-v0``, ``RotorDrop-Relevitate-v0``,
-``RotorDrop-Full-v0`` (see docs/environments.md). Each id's ``vector_entry_point`` is the
+Ids: ``RotorDrop-Passive-v1``, ``RotorDrop-Damping-v1``, ``RotorDrop-Relevitate-v1``,
+``RotorDrop-Full-v1`` (see docs/environments.md). Each id's ``vector_entry_point`` is the
 batched Gymnasium vector environment (:mod:`rotordrop_env.vector`); ``BatchedRotorDropVecEnv`` /
 ``make_batched`` are the same batch as a Stable-Baselines3 ``VecEnv``. In a process that has not
 imported ``rotordrop_env`` (e.g. a spawned worker) write the id as
-``"rotordrop_env:RotorDrop-Damping-v0"``: Gymnasium imports the module first.
+``"rotordrop_env:RotorDrop-Damping-v1"``: Gymnasium imports the module first.
 """
 from gymnasium.envs.registration import register, registry
 
 ENV_IDS = {
-    "RotorDrop-Passive-v0": "rotordrop_env.env:PassiveEnv",
-    "RotorDrop-Damping-v0": "rotordrop_env.env:DampingEnv",
-    "RotorDrop-Relevitate-v0": "rotordrop_env.env:RelevitateEnv",
-    "RotorDrop-Full-v0": "rotordrop_env.env:FullEnv",
+    "RotorDrop-Passive-v1": "rotordrop_env.env:PassiveEnv",
+    "RotorDrop-Damping-v1": "rotordrop_env.env:DampingEnv",
+    "RotorDrop-Relevitate-v1": "rotordrop_env.env:RelevitateEnv",
+    "RotorDrop-Full-v1": "rotordrop_env.env:FullEnv",
 }
 
 

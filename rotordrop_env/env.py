@@ -657,7 +657,7 @@ def _flag(name: str, value) -> bool:
 
 
 class PassiveEnv(RotorDropEnv):
-    """``RotorDrop-Passive-v0``: the paper's passive drop (the action does nothing).
+    """``RotorDrop-Passive-v1``: the paper's passive drop (the action does nothing).
 
     One episode reproduces ``rotordrop drop`` for the same scene from the fault on.
 
@@ -685,7 +685,7 @@ class PassiveEnv(RotorDropEnv):
 
 
 class DampingEnv(RotorDropEnv):
-    """``RotorDrop-Damping-v0``: semi-active support damping (spec §6).
+    """``RotorDrop-Damping-v1``: semi-active support damping (spec §6).
 
     Action space: ``Box(-1, 1, (2,), float32)``: ``damping1``, ``damping2``, the command of each
     housing's support damping, -1 -> C_min (``support.damping_min``, 2790 N s/m), +1 -> C_max
@@ -708,7 +708,7 @@ class DampingEnv(RotorDropEnv):
 
 
 class RelevitateEnv(RotorDropEnv):
-    """``RotorDrop-Relevitate-v0``: AMB reactivation (spec §5, ``effects.amb = "actuator"``).
+    """``RotorDrop-Relevitate-v1``: AMB reactivation (spec §5, ``effects.amb = "actuator"``).
 
     The AMBs (differential electromagnets, bias current, current limit, force capacity, optional
     coil lag, PID with filtered derivative) switch off at the fault; power returns
@@ -749,7 +749,7 @@ class RelevitateEnv(RotorDropEnv):
 
 
 class FullEnv(RotorDropEnv):
-    """``RotorDrop-Full-v0``: semi-active damping and AMB reactivation together.
+    """``RotorDrop-Full-v1``: semi-active damping and AMB reactivation together.
 
     Action space: ``Box(-1, 1, float32)``: ``damping1``, ``damping2`` (as in Damping), then
     with ``command="discrete"`` one entry ``levitate`` (> 0 switches the built-in controller on;

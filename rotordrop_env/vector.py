@@ -1,6 +1,6 @@
 """The Gymnasium vector environment of every id: N rotors stepped in one numba call.
 
-    envs = gymnasium.make_vec("RotorDrop-Full-v0", num_envs=16,
+    envs = gymnasium.make_vec("RotorDrop-Full-v1", num_envs=16,
                               vectorization_mode="vector_entry_point", command="supervisor")
 
 It is the Gymnasium face of the batch core :class:`rotordrop_env.batch.Batch` (the SB3

@@ -12,7 +12,7 @@ def test_evaluate_a_baseline_against_passive(tmp_path):
     """At mu = 0.1 the rotor rests at the bottom and never orbits backwards, so the whirl
     switch never leaves the passive damping: its episode is the passive drop, KPI for KPI."""
     out = tmp_path / "ev"
-    assert main(["evaluate", "--policy", "whirl-switch", "--env", "RotorDrop-Damping-v0",
+    assert main(["evaluate", "--policy", "whirl-switch", "--env", "RotorDrop-Damping-v1",
                  "--episodes", "1", "--fixed", "--set", "contact.friction=0.1",
                  "--out", str(out)]) == 0
     r = json.loads((out / "kpis.json").read_text())
@@ -26,12 +26,12 @@ def test_evaluate_a_baseline_against_passive(tmp_path):
 
 
 def test_evaluate_errors_name_the_problem(tmp_path, capsys):
-    assert main(["evaluate", "--policy", "no-such-policy", "--env", "RotorDrop-Damping-v0",
+    assert main(["evaluate", "--policy", "no-such-policy", "--env", "RotorDrop-Damping-v1",
                  "--out", str(tmp_path)]) == 2
     assert "max-damping" in capsys.readouterr().err          # the known names are listed
     assert main(["evaluate", "--policy", "passive", "--out", str(tmp_path)]) == 2
     assert "--env is required" in capsys.readouterr().err
-    assert main(["evaluate", "--policy", "max-damping", "--env", "RotorDrop-Relevitate-v0",
+    assert main(["evaluate", "--policy", "max-damping", "--env", "RotorDrop-Relevitate-v1",
                  "--out", str(tmp_path)]) == 2
     assert "needs action channels" in capsys.readouterr().err
 
@@ -76,7 +76,7 @@ def test_benchmark_quick_end_to_end(tmp_path):
 def test_evaluate_a_current_commanding_baseline_in_the_relevitation_env(tmp_path):
     """whirl-brake commands currents: evaluate gives the env the command it needs."""
     out = tmp_path / "ev"
-    assert main(["evaluate", "--policy", "whirl-brake", "--env", "RotorDrop-Relevitate-v0",
+    assert main(["evaluate", "--policy", "whirl-brake", "--env", "RotorDrop-Relevitate-v1",
                  "--episodes", "1", "--fixed", "--no-plots", "--no-passive",
                  "--set", "contact.friction=0.25", "--out", str(out)]) == 0
     r = json.loads((out / "kpis.json").read_text())
@@ -121,10 +121,10 @@ def test_ride_through_errors_name_the_option(tmp_path, capsys):
     assert "--friction" in capsys.readouterr().err
     assert main(["ride-through", "--delay-ms", "-5", "--out", str(tmp_path)]) == 2
     assert "--delay-ms values [-5.0]" in capsys.readouterr().err        # in the unit typed
-    assert main(["ride-through", "--env", "RotorDrop-Damping-v0", "--out", str(tmp_path)]) == 2
+    assert main(["ride-through", "--env", "RotorDrop-Damping-v1", "--out", str(tmp_path)]) == 2
     assert "re-levitation environment" in capsys.readouterr().err
     assert main(["ride-through", "--policy", "ppo-damping", "--out", str(tmp_path)]) == 2
-    assert "trained on RotorDrop-Damping-v0" in capsys.readouterr().err
+    assert "trained on RotorDrop-Damping-v1" in capsys.readouterr().err
     assert main(["ride-through", "--policy", "agents.plots:_plt", "--out", str(tmp_path)]) == 2
     assert "not a subclass" in capsys.readouterr().err
 
@@ -175,7 +175,7 @@ def test_a_users_controller_class_is_evaluated_and_benchmarked_like_a_baseline(t
     path.write_text(USER_CONTROLLER)
     spec = f"{path}:MidDamping"
     out = tmp_path / "ev"
-    assert main(["evaluate", "--policy", spec, "--env", "RotorDrop-Damping-v0", "--episodes", "1",
+    assert main(["evaluate", "--policy", spec, "--env", "RotorDrop-Damping-v1", "--episodes", "1",
                  "--fixed", "--no-plots", "--set", "contact.friction=0.1", "--out", str(out)]) == 0
     r = json.loads((out / "kpis.json").read_text())
     assert r["policy"] == "mid-damping"
@@ -193,7 +193,7 @@ def test_a_users_controller_class_is_evaluated_and_benchmarked_like_a_baseline(t
                        (f"{path}:Missing", "has no 'Missing'"),
                        ("no_such_module_xyz:Ctrl", "cannot import"),
                        (f"{tmp_path}/absent.py:Ctrl", "no file")):
-        assert main(["evaluate", "--policy", bad, "--env", "RotorDrop-Damping-v0",
+        assert main(["evaluate", "--policy", bad, "--env", "RotorDrop-Damping-v1",
                      "--out", str(tmp_path / "x")]) == 2
         assert words in capsys.readouterr().err
 
@@ -228,7 +228,7 @@ def test_evaluate_at_a_given_power_return(tmp_path, capsys):
     times = {}
     for ms in ("0", "50"):
         out = tmp_path / ms
-        assert main(["evaluate", "--policy", "whirl-brake", "--env", "RotorDrop-Relevitate-v0",
+        assert main(["evaluate", "--policy", "whirl-brake", "--env", "RotorDrop-Relevitate-v1",
                      "--episodes", "1", "--no-plots", "--no-passive", "--power-return-ms", ms,
                      "--set", "contact.friction=0.25", "--out", str(out)]) == 0
         r = json.loads((out / "kpis.json").read_text())
@@ -236,7 +236,7 @@ def test_evaluate_at_a_given_power_return(tmp_path, capsys):
         assert r["env_kwargs"]["randomization"]["power_return_time"] is None
         times[ms] = r["episodes"][0]["relevitation_time_s"]
     assert times["0"] < times["50"] - 0.03
-    assert main(["evaluate", "--policy", "max-damping", "--env", "RotorDrop-Damping-v0",
+    assert main(["evaluate", "--policy", "max-damping", "--env", "RotorDrop-Damping-v1",
                  "--power-return-ms", "30", "--out", str(tmp_path / "x")]) == 2
     err = capsys.readouterr().err
     assert "--power-return-ms" in err and "re-levitation environments" in err
@@ -280,7 +280,7 @@ def test_tune_moves_a_damper_level_towards_more_damping(tmp_path, capsys):
     path.write_text(LEVEL_CONTROLLER)
     spec = f"{path}:Level"
     out = tmp_path / "tune"
-    assert main(["tune", "--policy", spec, "--env", "RotorDrop-Damping-v0", "--gain", "level=-1:1",
+    assert main(["tune", "--policy", spec, "--env", "RotorDrop-Damping-v1", "--gain", "level=-1:1",
                  "--iterations", "3", "--population", "6", "--elite", "2", "--quiet",
                  "--out", str(out)]) == 0
     r = json.loads((out / "tune.json").read_text())
@@ -288,12 +288,12 @@ def test_tune_moves_a_damper_level_towards_more_damping(tmp_path, capsys):
     assert r["gains"]["level"] > 0.1
     assert r["validation_score"] > r["start_validation_score"]
     cls = load_controller(spec)
-    again, _ = Validator("RotorDrop-Damping-v0").score(
+    again, _ = Validator("RotorDrop-Damping-v1").score(
         lambda plant: cls(plant, level=r["gains"]["level"]), {})
     assert again == pytest.approx(r["validation_score"], rel=1e-12)
     assert (out / "tune.png").is_file()
     # a gain without a default starts mid-range (and the checks build it with that value)
-    assert main(["tune", "--policy", f"{path}:Required", "--env", "RotorDrop-Damping-v0",
+    assert main(["tune", "--policy", f"{path}:Required", "--env", "RotorDrop-Damping-v1",
                  "--gain", "level=0:1", "--iterations", "0", "--quiet", "--no-plots",
                  "--out", str(tmp_path / "req")]) == 0
     assert json.loads((tmp_path / "req" / "tune.json").read_text())["start"] == {"level": 0.5}
@@ -302,10 +302,10 @@ def test_tune_moves_a_damper_level_towards_more_damping(tmp_path, capsys):
                        (["--gain", "level=0:1", "--population", "2", "--elite", "3"],
                         "--elite = 3 must be <= --population = 2"),
                        ([], "--gain is required")):
-        assert main(["tune", "--policy", spec, "--env", "RotorDrop-Damping-v0", *bad,
+        assert main(["tune", "--policy", spec, "--env", "RotorDrop-Damping-v1", *bad,
                      "--out", str(tmp_path / "x")]) == 2
         assert words in capsys.readouterr().err
-    assert main(["tune", "--policy", "ppo-damping", "--env", "RotorDrop-Damping-v0",
+    assert main(["tune", "--policy", "ppo-damping", "--env", "RotorDrop-Damping-v1",
                  "--gain", "a=0:1", "--out", str(tmp_path / "x")]) == 2
     assert "not a learned policy" in capsys.readouterr().err
 
@@ -315,7 +315,7 @@ def test_tune_json_holds_what_recomputes_its_validation_score(tmp_path):
     from agents.benchmark import EPISODE_TIME
     from agents.score import overall_score, row_cost
     out = tmp_path / "tune"
-    assert main(["tune", "--policy", "whirl-brake", "--env", "RotorDrop-Relevitate-v0",
+    assert main(["tune", "--policy", "whirl-brake", "--env", "RotorDrop-Relevitate-v1",
                  "--gain", "kp=0.8:0.9", "--iterations", "0", "--quiet", "--no-plots",
                  "--out", str(out)]) == 0
     r = json.loads((out / "tune.json").read_text())
@@ -341,7 +341,7 @@ def test_evaluate_actions_are_named_and_the_planes_tell_apart(tmp_path, monkeypa
                            for line in ax.get_lines()}
         return finish(plt, fig, ax, ylabel, title, path)
     monkeypatch.setattr(plots, "_finish_time_plot", spy)
-    assert main(["evaluate", "--policy", "whirl-brake", "--env", "RotorDrop-Full-v0", "--episodes",
+    assert main(["evaluate", "--policy", "whirl-brake", "--env", "RotorDrop-Full-v1", "--episodes",
                  "1", "--fixed", "--no-passive", "--set", "contact.friction=0.45",
                  "--out", str(tmp_path / "ev")]) == 0
     lines = seen["actions.png"]

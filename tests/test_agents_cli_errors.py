@@ -39,7 +39,7 @@ def test_evaluate_kpis_json_is_strict_json(tmp_path):
     """In the damping task nothing re-levitates: the per-episode re-levitation time is
     undefined, and JSON says so with null (it had a bare NaN)."""
     out = tmp_path / "ev"
-    assert main(["evaluate", "--policy", "passive", "--env", "RotorDrop-Damping-v0", "--episodes",
+    assert main(["evaluate", "--policy", "passive", "--env", "RotorDrop-Damping-v1", "--episodes",
                  "1", "--fixed", "--no-plots", "--no-passive", "--out", str(out)]) == 0
     r = _strict((out / "kpis.json").read_text())
     assert r["episodes"][0]["relevitated"] is False
@@ -50,7 +50,7 @@ def test_evaluate_kpis_json_is_strict_json(tmp_path):
 def test_kpis_json_records_the_drawn_scenarios_end_to_end(tmp_path):
     """Every episode record, the policy's and passive's, holds the scenario reset drew."""
     out = tmp_path / "ev"
-    assert main(["evaluate", "--policy", "max-damping", "--env", "RotorDrop-Damping-v0",
+    assert main(["evaluate", "--policy", "max-damping", "--env", "RotorDrop-Damping-v1",
                  "--episodes", "2", "--no-plots", "--out", str(out)]) == 0
     r = _strict((out / "kpis.json").read_text())
     sc = [e["scenario"] for e in r["episodes"]]
@@ -63,9 +63,9 @@ def test_kpis_json_records_the_drawn_scenarios_end_to_end(tmp_path):
 def test_ride_through_advice_is_valid_and_ranges_are_the_real_ones(tmp_path, capsys):
     assert main(["ride-through", "--policy", "ppo-damping", "--out", str(tmp_path)]) == 2
     err = capsys.readouterr().err
-    assert "no re-levitation" in err and "pass --env RotorDrop-Damping-v0" not in err
+    assert "no re-levitation" in err and "pass --env RotorDrop-Damping-v1" not in err
     assert main(["ride-through", "--policy", "ppo-full", "--out", str(tmp_path)]) == 2
-    assert "pass --env RotorDrop-Full-v0" in capsys.readouterr().err      # advice that works
+    assert "pass --env RotorDrop-Full-v1" in capsys.readouterr().err      # advice that works
     # the scene's friction range, checked before any episode runs
     assert main(["ride-through", "--friction", "2", "--quiet", "--out", str(tmp_path)]) == 2
     assert "--friction values [2.0] are outside [0, 1]" in capsys.readouterr().err
@@ -75,7 +75,7 @@ def test_ride_through_advice_is_valid_and_ranges_are_the_real_ones(tmp_path, cap
 
 
 def test_power_return_after_the_episode_is_an_error(tmp_path, capsys):
-    assert main(["evaluate", "--policy", "whirl-brake", "--env", "RotorDrop-Relevitate-v0",
+    assert main(["evaluate", "--policy", "whirl-brake", "--env", "RotorDrop-Relevitate-v1",
                  "--power-return-ms", "1000", "--out", str(tmp_path)]) == 2
     assert "--power-return-ms = 1000 ms must be in [0, 300) ms" in capsys.readouterr().err
     assert main(["benchmark", "--power-return-ms", "300", "--quiet", "--out", str(tmp_path)]) == 2
@@ -99,9 +99,9 @@ def test_a_ride_through_time_at_the_end_of_the_grid_is_a_lower_bound(tmp_path):
 
 # --------------------------------------------------------------------------------- --seed --
 @pytest.mark.parametrize("argv", [
-    ["evaluate", "--policy", "passive", "--env", "RotorDrop-Damping-v0"],
-    ["train", "--env", "RotorDrop-Damping-v0", "--algo", "ppo", "--out", "x"],
-    ["tune", "--policy", "whirl-brake", "--env", "RotorDrop-Relevitate-v0", "--gain", "kp=0:1"]])
+    ["evaluate", "--policy", "passive", "--env", "RotorDrop-Damping-v1"],
+    ["train", "--env", "RotorDrop-Damping-v1", "--algo", "ppo", "--out", "x"],
+    ["tune", "--policy", "whirl-brake", "--env", "RotorDrop-Relevitate-v1", "--gain", "kp=0:1"]])
 def test_a_negative_seed_is_a_flag_error(argv, capsys, tmp_path):
     err = _flag_error([*argv, "--seed", "-1"], capsys)
     assert err == f"rotordrop {argv[0]}: error: argument --seed: must be an integer >= 0, got '-1'"
@@ -129,12 +129,12 @@ class Switch(Controller):
 def test_tune_names_only_the_gains_the_class_does_not_take(tmp_path, capsys):
     path = tmp_path / "switch.py"
     path.write_text(SWITCH_CONTROLLER)
-    assert main(["tune", "--policy", f"{path}:Switch", "--env", "RotorDrop-Damping-v0",
+    assert main(["tune", "--policy", f"{path}:Switch", "--env", "RotorDrop-Damping-v1",
                  "--gain", "r_on=0:1", "--gain", "level=0:1", "--out", str(tmp_path / "t")]) == 2
     err = capsys.readouterr().err
     assert "does not take the gains ['level']; its gains: r_on, hold" in err
     # a class taking **gains: its GAINS are its gains
-    assert main(["tune", "--policy", "whirl-brake", "--env", "RotorDrop-Relevitate-v0",
+    assert main(["tune", "--policy", "whirl-brake", "--env", "RotorDrop-Relevitate-v1",
                  "--gain", "kp=0:1", "--gain", "gamma=0:1", "--out", str(tmp_path / "t")]) == 2
     assert "does not take the gains ['gamma']; its gains: kp, kd" in capsys.readouterr().err
 
@@ -193,11 +193,11 @@ def test_a_normalised_policy_without_its_statistics_is_an_error(tmp_path, capsys
 
 
 def test_a_policy_on_an_environment_of_another_shape_is_an_error(tmp_path, capsys):
-    assert main(["evaluate", "--policy", "ppo-damping", "--env", "RotorDrop-Full-v0",
+    assert main(["evaluate", "--policy", "ppo-damping", "--env", "RotorDrop-Full-v1",
                  "--episodes", "1", "--out", str(tmp_path)]) == 2
     err = capsys.readouterr().err
-    assert ("policy ppo-damping was trained on RotorDrop-Damping-v0 with 14 observations; "
-            "RotorDrop-Full-v0 has 20") in err
+    assert ("policy ppo-damping was trained on RotorDrop-Damping-v1 with 14 observations; "
+            "RotorDrop-Full-v1 has 20") in err
 
 
 def test_evaluate_labels_a_run_and_compares_returns_at_its_control_step(tmp_path):
@@ -247,9 +247,9 @@ def _long_work(*args, **kwargs):
 @pytest.mark.parametrize("cmd, cls, patch", [
     (["benchmark", "--quick", "--quiet"], "Broken", "agents.benchmark.passive_threshold"),
     (["ride-through", "--quiet", "--quick"], "BrokenCurrents", "agents.ride_through.run_episodes"),
-    (["tune", "--env", "RotorDrop-Damping-v0", "--gain", "k=0:1", "--quiet"], "Broken",
+    (["tune", "--env", "RotorDrop-Damping-v1", "--gain", "k=0:1", "--quiet"], "Broken",
      "agents.tune.Validator"),
-    (["evaluate", "--env", "RotorDrop-Damping-v0"], "Broken", "agents.evaluate.run_episodes")])
+    (["evaluate", "--env", "RotorDrop-Damping-v1"], "Broken", "agents.evaluate.run_episodes")])
 def test_a_broken_user_controller_fails_before_long_work(cmd, cls, patch, tmp_path, capsys,
                                                          monkeypatch):
     path = tmp_path / "broken.py"
@@ -302,8 +302,8 @@ def test_the_benchmark_names_every_run_name_at_run_as_evaluate_does(tmp_path, mo
 
 @pytest.mark.parametrize("argv, name, commands", [
     (["--quick"], "max-damping", "damping only"),
-    (["--env", "RotorDrop-Full-v0"], "max-damping", "damping only"),
-    (["--env", "RotorDrop-Full-v0"], "whirl-switch", "damping only"),
+    (["--env", "RotorDrop-Full-v1"], "max-damping", "damping only"),
+    (["--env", "RotorDrop-Full-v1"], "whirl-switch", "damping only"),
     ([], "passive", "nothing")])
 def test_ride_through_refuses_a_controller_that_cannot_relevitate_up_front(
         argv, name, commands, tmp_path, capsys, monkeypatch):
@@ -323,7 +323,7 @@ def test_ride_through_refuses_a_users_damping_class_alike(tmp_path, capsys, monk
     path = tmp_path / "switch.py"
     path.write_text(SWITCH_CONTROLLER)
     monkeypatch.setattr("agents.ride_through.run_episodes", _long_work)
-    assert main(["ride-through", "--env", "RotorDrop-Full-v0", "--policy", f"{path}:Switch",
+    assert main(["ride-through", "--env", "RotorDrop-Full-v1", "--policy", f"{path}:Switch",
                  "--quiet", "--out", str(tmp_path / "o")]) == 2
     assert "switch-damping commands damping only" in capsys.readouterr().err
 
@@ -372,7 +372,7 @@ def test_a_friction_range_that_is_not_two_numbers_is_a_flag_error(capsys, tmp_pa
      "friction 0.3-0.6)"),
     (["oracle", "--suite", "robust", "--constant", "0:1.5", "--no-search"],
      "--constant GAIN:OFFSET_R must have both in [-1, 1] (supervisor actions), got 0:1.5"),
-    (["train", "--env", "RotorDrop-Relevitate-v0", "--algo", "tqc", "--time-limit", "0"],
+    (["train", "--env", "RotorDrop-Relevitate-v1", "--algo", "tqc", "--time-limit", "0"],
      "--time-limit must be a number of seconds > 0, got 0.0")])
 def test_a_bad_friction_range_or_time_limit_fails_before_anything_is_written(argv, message, capsys,
                                                                            tmp_path):

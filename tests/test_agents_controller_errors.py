@@ -14,7 +14,7 @@ CONTINUOUS = dict(command="continuous", **SHORT)
 
 @pytest.fixture(scope="module")
 def damping():
-    env = make_env("RotorDrop-Damping-v0", **SHORT)
+    env = make_env("RotorDrop-Damping-v1", **SHORT)
     obs, _ = env.reset(seed=0)
     yield Plant.from_env(env), obs
     env.close()
@@ -45,11 +45,11 @@ def test_a_misspelled_channel_is_named_with_the_controller_and_the_plants_channe
     plant, obs = damping
     msg = error(returning(lambda n: {"dampnig": np.ones((n, 2))}), plant, obs)
     assert "'dampnig'" in msg and "controller 'user' (User)" in msg
-    assert "did you mean 'damping'" in msg and "RotorDrop-Damping-v0 has the channels damping" in msg
+    assert "did you mean 'damping'" in msg and "RotorDrop-Damping-v1 has the channels damping" in msg
 
 
 def test_a_channel_the_environment_lacks_is_an_error():
-    env = make_env("RotorDrop-Relevitate-v0", **CONTINUOUS)
+    env = make_env("RotorDrop-Relevitate-v1", **CONTINUOUS)
     plant, (obs, _) = Plant.from_env(env), env.reset(seed=0)
     msg = error(returning(lambda n: {"currents": np.zeros((n, 4)), "damping": np.ones((n, 2))},
                           needs=("currents",)), plant, obs)
@@ -73,7 +73,7 @@ def test_round_off_beyond_one_is_accepted_and_clipped(damping):
 
 
 def test_currents_in_amperes_are_named_as_such():
-    env = make_env("RotorDrop-Relevitate-v0", **CONTINUOUS)
+    env = make_env("RotorDrop-Relevitate-v1", **CONTINUOUS)
     plant, (obs, _) = Plant.from_env(env), env.reset(seed=0)
     msg = error(returning(lambda n: {"currents": np.full((n, 4), 2.5)}, needs=("currents",)),
                 plant, obs)
@@ -91,7 +91,7 @@ def test_damping_of_another_shape_than_n_by_2_is_an_error(damping, shape, n):
 
 
 def test_levitate_takes_n_or_n_by_1():
-    env = make_env("RotorDrop-Relevitate-v0", command="discrete", **SHORT)
+    env = make_env("RotorDrop-Relevitate-v1", command="discrete", **SHORT)
     plant, (obs, _) = Plant.from_env(env), env.reset(seed=0)
     for shape in ((2,), (2, 1)):
         a = act(returning(lambda n: {"levitate": np.ones(shape)}, needs=("levitate",)), plant, obs, 2)
@@ -161,7 +161,7 @@ def test_the_cli_reports_a_controller_bug_in_one_line(tmp_path, capsys):
     from agents.cli import main
     path = tmp_path / "bad.py"
     path.write_text(BAD_FILE)
-    assert main(["evaluate", "--policy", f"{path}:Typo", "--env", "RotorDrop-Damping-v0",
+    assert main(["evaluate", "--policy", f"{path}:Typo", "--env", "RotorDrop-Damping-v1",
                  "--episodes", "1", "--no-plots", "--out", str(tmp_path / "x")]) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith("rotordrop evaluate: error: controller 'typo' (Typo):")
@@ -195,7 +195,7 @@ class Stateful(Counter):
 def test_identical_episodes_give_identical_kpis(cls):
     """Three runs of one scenario in one evaluation differed when state leaked."""
     kw = dict(overrides={"contact.friction": 0.3}, episode_time=0.03, terminate_on_failure=False)
-    eps = run_episodes("RotorDrop-Damping-v0", lambda p: make_controller(cls, p), [0, 0, 0], kw,
+    eps = run_episodes("RotorDrop-Damping-v1", lambda p: make_controller(cls, p), [0, 0, 0], kw,
                        record=True)
     for e in eps[1:]:
         assert e.kpis == eps[0].kpis
@@ -212,9 +212,9 @@ def test_one_controller_object_driven_by_hand_resets_its_state_at_episode_starts
     assert ctrl.k == 1 and np.all(first == -1.0)
 
 
-@pytest.mark.parametrize("env_id,kw", [("RotorDrop-Damping-v0", SHORT),
-                                       ("RotorDrop-Relevitate-v0", dict(command="discrete", **SHORT)),
-                                       ("RotorDrop-Full-v0", CONTINUOUS)])
+@pytest.mark.parametrize("env_id,kw", [("RotorDrop-Damping-v1", SHORT),
+                                       ("RotorDrop-Relevitate-v1", dict(command="discrete", **SHORT)),
+                                       ("RotorDrop-Full-v1", CONTINUOUS)])
 def test_check_actor_passes_every_supported_baseline(env_id, kw):
     env = make_env(env_id, **kw)
     plant = Plant.from_env(env)
@@ -237,7 +237,7 @@ def test_check_controller_fails_fast_naming_the_controller(damping):
     with pytest.raises(ControllerError, match=r"controller 'user' \(User\): channel 'damping' has shape"):
         check_controller(bad, plant, obs)
     with pytest.raises(ControllerError, match="'typo'"):
-        check_actor("RotorDrop-Damping-v0", lambda p: make_controller(
+        check_actor("RotorDrop-Damping-v1", lambda p: make_controller(
             returning(lambda n: {"typo": 0}), p), SHORT)
     with pytest.raises(ValueError, match=r"obs has shape \(3,\)"):
         check_controller(make_controller(Passive, plant), plant, obs[:3])

@@ -10,12 +10,12 @@ from physics.metrics import WHIRL_MIN_REVOLUTIONS
 
 SHORT = dict(episode_time=0.03, terminate_on_failure=False)
 LEV = {"power_return_time": 0.005}
-ENVS = [("RotorDrop-Damping-v0", {}), ("RotorDrop-Relevitate-v0", {"command": "discrete", **LEV}),
-        ("RotorDrop-Relevitate-v0", {"command": "continuous", **LEV}),
-        ("RotorDrop-Full-v0", {"command": "discrete", **LEV}),
-        ("RotorDrop-Full-v0", {"command": "continuous", **LEV}),
-        ("RotorDrop-Relevitate-v0", {"command": "supervisor", **LEV}),
-        ("RotorDrop-Full-v0", {"command": "supervisor", **LEV})]
+ENVS = [("RotorDrop-Damping-v1", {}), ("RotorDrop-Relevitate-v1", {"command": "discrete", **LEV}),
+        ("RotorDrop-Relevitate-v1", {"command": "continuous", **LEV}),
+        ("RotorDrop-Full-v1", {"command": "discrete", **LEV}),
+        ("RotorDrop-Full-v1", {"command": "continuous", **LEV}),
+        ("RotorDrop-Relevitate-v1", {"command": "supervisor", **LEV}),
+        ("RotorDrop-Full-v1", {"command": "supervisor", **LEV})]
 
 
 @pytest.mark.parametrize("env_id,kw", ENVS)
@@ -49,13 +49,13 @@ def test_controllers_obey_the_action_space(env_id, kw):
 
 
 def test_unknown_baseline_is_named():
-    env = make_env("RotorDrop-Damping-v0", **SHORT)
+    env = make_env("RotorDrop-Damping-v1", **SHORT)
     with pytest.raises(KeyError, match="max-damping"):
         make_baseline("maximum", Plant.from_env(env))
 
 
 def _damping_trace(ctrl_cls, mu, episode_time):
-    ep = run_episodes("RotorDrop-Damping-v0", ctrl_cls, [0], dict(
+    ep = run_episodes("RotorDrop-Damping-v1", ctrl_cls, [0], dict(
         overrides={"contact.friction": mu}, episode_time=episode_time, terminate_on_failure=False),
         record=True)[0]
     names = list(ep.obs_names)
@@ -93,8 +93,8 @@ def test_pid_relevitates_after_power_returns(command, cls):
     clearance); the passive controller leaves it on the retainer bearings."""
     kw = dict(overrides={"contact.friction": 0.1}, episode_time=0.15, terminate_on_failure=False,
               command=command, power_return_time=0.02)
-    pid = run_episodes("RotorDrop-Relevitate-v0", cls, [0], kw, record=True)[0]
-    passive = run_episodes("RotorDrop-Relevitate-v0", Passive, [0], dict(kw, command="discrete"))[0]
+    pid = run_episodes("RotorDrop-Relevitate-v1", cls, [0], kw, record=True)[0]
+    passive = run_episodes("RotorDrop-Relevitate-v1", Passive, [0], dict(kw, command="discrete"))[0]
     assert pid.kpis["relevitated"] and not passive.kpis["relevitated"]
     # the lift-off cannot start before the power returns
     assert pid.kpis["relevitation_time_s"] > 0.02
@@ -122,7 +122,7 @@ def test_full_task_controller_stops_a_whirl_that_max_damping_does_not(actor):
     constant C_max alone both reach 3 net backward revolutions (backward whirl); the whirl brake
     and the shipped ppo-full keep the peak below 3, re-levitate, and their peak contact force
     stays below passive."""
-    full = "RotorDrop-Full-v0"
+    full = "RotorDrop-Full-v1"
     passive = _kpis(full, Passive, 0.46)
     damping_only = _kpis(full, MaxDamping, 0.46)
     ctrl = _kpis(full, actor, 0.46, command="continuous")
@@ -135,14 +135,14 @@ def test_full_task_controller_stops_a_whirl_that_max_damping_does_not(actor):
 def test_whirl_brake_relevitates_sooner_than_the_ramped_pid():
     """Without a lift-off ramp the brake's PD lifts a resting rotor (mu = 0.2) sooner."""
     kw = dict(power_return_time=0.02)
-    brake = _kpis("RotorDrop-Relevitate-v0", WhirlBrake, 0.2, command="continuous", **kw)
-    builtin = _kpis("RotorDrop-Relevitate-v0", BuiltinRelevitate, 0.2, command="discrete", **kw)
+    brake = _kpis("RotorDrop-Relevitate-v1", WhirlBrake, 0.2, command="continuous", **kw)
+    builtin = _kpis("RotorDrop-Relevitate-v1", BuiltinRelevitate, 0.2, command="discrete", **kw)
     assert brake["relevitated"] and builtin["relevitated"]
     assert brake["relevitation_time_s"] < builtin["relevitation_time_s"] - 0.01
 
 
 def test_whirl_brake_rejects_unknown_gains():
-    env = make_env("RotorDrop-Relevitate-v0", command="continuous", **SHORT)
+    env = make_env("RotorDrop-Relevitate-v1", command="continuous", **SHORT)
     with pytest.raises(TypeError, match="unknown whirl-brake gains"):
         WhirlBrake(Plant.from_env(env), kq=1.0)
 
@@ -154,6 +154,6 @@ def test_a_whirl_unwound_afterwards_still_counts():
     peak keep the whirl that happened."""
     def push(plant):
         return WhirlBrake(plant, kp=0.0, kd=0.0, kc=0.0, kt=1.0, kr=0.0, r_on=0.0)
-    k = _kpis("RotorDrop-Relevitate-v0", push, 0.6, command="continuous")
+    k = _kpis("RotorDrop-Relevitate-v1", push, 0.6, command="continuous")
     assert k["peak_whirl_revolutions"] >= WHIRL_MIN_REVOLUTIONS and k["backward_whirl"]
     assert k["whirl_revolutions"] < k["peak_whirl_revolutions"] - WHIRL_MIN_REVOLUTIONS

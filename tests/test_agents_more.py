@@ -45,8 +45,8 @@ def _docs_loop(env, ctrl, seed=0):
 
 # ---------------------------------------------------------------- 1. episode starts --
 @pytest.mark.parametrize("name,env_id,kw", [
-    ("whirl-switch", "RotorDrop-Damping-v0", {}),
-    ("pid-relevitate", "RotorDrop-Relevitate-v0", dict(command="continuous", power_return_time=0.005))])
+    ("whirl-switch", "RotorDrop-Damping-v1", {}),
+    ("pid-relevitate", "RotorDrop-Relevitate-v1", dict(command="continuous", power_return_time=0.005))])
 def test_one_controller_runs_identical_episodes_identically_without_episode_start(name, env_id, kw):
     env = make_env(env_id, **WHIRL, **kw)
     ctrl = make_baseline(name, Plant.from_env(env))
@@ -61,7 +61,7 @@ def test_one_controller_runs_identical_episodes_identically_without_episode_star
 
 
 def test_a_users_stateful_controller_starts_episode_two_unlatched():
-    env = make_env("RotorDrop-Damping-v0", **WHIRL)
+    env = make_env("RotorDrop-Damping-v1", **WHIRL)
     ctrl = Latch(Plant.from_env(env))
     first, _ = _docs_loop(env, ctrl)
     assert first[0].max() < 1.0 and first[-1].min() == 1.0          # it latched in episode 1
@@ -72,7 +72,7 @@ def test_a_users_stateful_controller_starts_episode_two_unlatched():
 
 def test_one_step_episodes_each_start_afresh():
     """The time observation is 0 again: a new episode even if it did not go below the last."""
-    env = make_env("RotorDrop-Damping-v0", episode_time=1e-3, terminate_on_failure=False)
+    env = make_env("RotorDrop-Damping-v1", episode_time=1e-3, terminate_on_failure=False)
     ctrl = make_baseline("whirl-switch", Plant.from_env(env))
     for _ in range(3):
         actions, _ = _docs_loop(env, ctrl)
@@ -82,7 +82,7 @@ def test_one_step_episodes_each_start_afresh():
 
 
 def test_batch_rows_reset_where_their_time_goes_back_and_sb3_flags_still_work():
-    env = make_env("RotorDrop-Damping-v0", **WHIRL)
+    env = make_env("RotorDrop-Damping-v1", **WHIRL)
     plant = Plant.from_env(env)
     obs = [env.reset(seed=0)[0]]
     for _ in range(10):
@@ -105,7 +105,7 @@ FULL = dict(full_state=True, **WHIRL)
 
 
 def test_a_full_state_env_has_a_plant_but_sensor_controllers_are_refused_by_name():
-    env = make_env("RotorDrop-Damping-v0", **FULL)
+    env = make_env("RotorDrop-Damping-v1", **FULL)
     plant = Plant.from_env(env)
     env.close()
     with pytest.raises(ControllerError, match=r"controller 'whirl-switch' \(WhirlSwitch\) needs the "
@@ -116,7 +116,7 @@ def test_a_full_state_env_has_a_plant_but_sensor_controllers_are_refused_by_name
 
 
 def test_passive_on_the_full_state_is_the_passive_drop_and_records_the_sensor_orbit():
-    eps = [run_episodes("RotorDrop-Damping-v0", lambda p: make_baseline("passive", p), [3],
+    eps = [run_episodes("RotorDrop-Damping-v1", lambda p: make_baseline("passive", p), [3],
                         dict(WHIRL, full_state=fs, randomize=True), record=True)[0]
            for fs in (False, True)]
     sensor, full = eps
@@ -144,7 +144,7 @@ def _save_policy(path, env_id, env_kwargs, algo="td3", best=False):
 
 def test_a_policy_trained_on_the_full_state_is_evaluated_against_passive(tmp_path):
     from agents.evaluate import evaluate
-    _save_policy(tmp_path / "run", "RotorDrop-Damping-v0", dict(full_state=True))
+    _save_policy(tmp_path / "run", "RotorDrop-Damping-v1", dict(full_state=True))
     report = evaluate(str(tmp_path / "run"), None, 1, tmp_path / "ev", env_kwargs=dict(WHIRL),
                       randomize=False)
     assert report["env_kwargs"]["full_state"] is True
@@ -156,14 +156,14 @@ def test_a_residual_on_a_sensor_controller_refuses_full_state_training():
     from agents.train import check_env
     meta, _ = split(dict(residual="whirl-switch", env_kwargs=dict(full_state=True)))
     with pytest.raises(ConfigError, match="residual: .*needs the sensor observations.*full_state"):
-        check_env("RotorDrop-Damping-v0", "td3", meta)
+        check_env("RotorDrop-Damping-v1", "td3", meta)
 
 
 # ---------------------------------------------------------- 3. train_freq as a list --
 def test_train_freq_list_becomes_sb3s_tuple_as_in_rl_zoo3():
     meta, kwargs = split({"train_freq": [1, "episode"], "n_envs": 1, "learning_starts": 0})
     assert kwargs["train_freq"] == (1, "episode")
-    env = make_env("RotorDrop-Damping-v0", **SHORT)
+    env = make_env("RotorDrop-Damping-v1", **SHORT)
     model = algo_class("td3")("MlpPolicy", env, device="cpu", **kwargs)
     env.close()
     assert (model.train_freq.frequency, model.train_freq.unit.value) == (1, "episode")
@@ -179,12 +179,12 @@ def test_a_runs_best_directory_loads_as_a_policy(tmp_path):
     """``--policy RUN/best``: best_model.zip and vecnormalize.pkl there, config.yaml in RUN."""
     from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
     from agents.policies import LearnedPolicy
-    model = _save_policy(tmp_path, "RotorDrop-Damping-v0", SHORT, best=True)
-    vn = VecNormalize(DummyVecEnv([lambda: make_env("RotorDrop-Damping-v0", **SHORT)]))
+    model = _save_policy(tmp_path, "RotorDrop-Damping-v1", SHORT, best=True)
+    vn = VecNormalize(DummyVecEnv([lambda: make_env("RotorDrop-Damping-v1", **SHORT)]))
     vn.obs_rms.mean[:] = 0.5
     vn.save(str(tmp_path / "best" / "vecnormalize.pkl"))
     pol = LearnedPolicy.load(tmp_path / "best")
-    assert pol.env_id == "RotorDrop-Damping-v0" and pol.algo == "td3"
+    assert pol.env_id == "RotorDrop-Damping-v1" and pol.algo == "td3"
     obs = np.linspace(-1.0, 1.0, 14, dtype=np.float32)
     np.testing.assert_array_equal(pol.predict(obs)[0],
                                   model.predict(vn.normalize_obs(obs), deterministic=True)[0])

@@ -72,7 +72,7 @@ def _trained_run(tmp_path, algo, residual=None, sde=False):
     (``sde``: with gSDE exploration)."""
     from stable_baselines3.common.env_util import make_vec_env
     from stable_baselines3.common.vec_env import VecNormalize
-    env_id = "RotorDrop-Full-v0"
+    env_id = "RotorDrop-Full-v1"
     env_kwargs = dict(command="continuous", episode_time=0.02, randomize=True)
     venv = VecNormalize(make_vec_env(env_id, 2, seed=0, env_kwargs=env_kwargs))
     kw = dict(n_steps=64, batch_size=64) if algo == "ppo" else dict(learning_starts=50, buffer_size=500)
@@ -123,7 +123,7 @@ def test_a_residual_on_a_stateful_baseline_refuses_plain_sb3(tmp_path):
 def test_memoryless_baselines_act_on_the_observation_alone(name):
     """What a zip relies on: the baseline's action on a shuffled batch of observations is
     its action in the episode, step by step."""
-    env_id = "RotorDrop-Full-v0"
+    env_id = "RotorDrop-Full-v1"
     env = gym.make(env_id, command="continuous", randomize=True, terminate_on_failure=False)
     ctrl = make_baseline(name, Plant.from_env(env))
     obs, acts = [], []
@@ -154,12 +154,12 @@ def test_export_reads_env_and_residual_from_the_models_training_env(tmp_path):
     from agents.residual import ResidualAction
     from rotordrop_env import make_batched
     kw = dict(command="continuous", episode_time=0.02)
-    venv = VecNormalize(ResidualAction(make_batched("RotorDrop-Relevitate-v0", 2, seed=0,
+    venv = VecNormalize(ResidualAction(make_batched("RotorDrop-Relevitate-v1", 2, seed=0,
                                                     n_threads=1, **kw), base="whirl-brake", scale=0.5))
     model = PPO("MlpPolicy", venv, n_steps=32, batch_size=32, seed=0, device="cpu")
     model.learn(64)
     out = export_self_contained(model, venv, tmp_path / "p.zip")
     inside = PPO.load(out, device="cpu").policy.rotordrop
     assert (inside["env_id"], inside["residual"], inside["residual_scale"]) == \
-        ("RotorDrop-Relevitate-v0", "whirl-brake", 0.5)
+        ("RotorDrop-Relevitate-v1", "whirl-brake", 0.5)
     assert inside["env_kwargs"] == kw and inside["normalize"]["clip_obs"] == 10.0

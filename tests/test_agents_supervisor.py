@@ -7,7 +7,7 @@ from agents.controllers import BASELINES, InnerLoop, WhirlBrake, WhirlBrakeSuper
 from agents.plant import Plant, make_env
 from agents.rollout import run_episodes
 
-FULL = "RotorDrop-Full-v0"
+FULL = "RotorDrop-Full-v1"
 KW = dict(command="supervisor", episode_time=0.15, terminate_on_failure=False,
           power_return_time=0.02, overrides={"contact.friction": 0.3})
 

@@ -15,7 +15,7 @@ from agents.sb3_policy import is_self_contained, zip_algo
 from agents.train import train
 
 torch.set_num_threads(1)
-ENV = "RotorDrop-Relevitate-v0"
+ENV = "RotorDrop-Relevitate-v1"
 TINY = (f"{ENV}:\n  n_envs: 2\n  learning_starts: 64\n  buffer_size: 2000\n  batch_size: 32\n"
         "  policy_kwargs: \"dict(net_arch=[16, 16], n_critics=2, n_quantiles=5)\"\n"
         "  top_quantiles_to_drop_per_net: 1\n  eval_freq: 128\n  n_eval_episodes: 2\n"

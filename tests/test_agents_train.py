@@ -10,7 +10,7 @@ from agents.hyperparams import (ConfigError, load_hyperparams, parse_literal, re
 
 from helpers import phys
 
-ENV_IDS = ("RotorDrop-Damping-v0", "RotorDrop-Relevitate-v0", "RotorDrop-Full-v0")
+ENV_IDS = ("RotorDrop-Damping-v1", "RotorDrop-Relevitate-v1", "RotorDrop-Full-v1")
 
 
 @pytest.mark.parametrize("algo", ["ppo", "sac", "td3", "tqc"])
@@ -46,9 +46,9 @@ def test_every_experiment_config_passes_the_checks_rotordrop_train_makes(cfg):
 
 def test_config_override_and_literals(tmp_path):
     cfg = tmp_path / "my.yaml"
-    cfg.write_text("RotorDrop-Damping-v0:\n  n_steps: 64\n  env_kwargs:\n    control_dt: 0.002\n")
-    shipped = load_hyperparams("ppo", "RotorDrop-Damping-v0")
-    hp = load_hyperparams("ppo", "RotorDrop-Damping-v0", cfg)
+    cfg.write_text("RotorDrop-Damping-v1:\n  n_steps: 64\n  env_kwargs:\n    control_dt: 0.002\n")
+    shipped = load_hyperparams("ppo", "RotorDrop-Damping-v1")
+    hp = load_hyperparams("ppo", "RotorDrop-Damping-v1", cfg)
     assert hp["n_steps"] == 64
     assert hp["env_kwargs"] == {**shipped["env_kwargs"], "control_dt": 0.002}   # merged, not replaced
     assert parse_literal("dict(net_arch=[32, 32], log_std_init=-1.0)", "k") == \
@@ -57,20 +57,20 @@ def test_config_override_and_literals(tmp_path):
     assert lr(1.0) == pytest.approx(1e-3) and lr(0.0) == 0.0
     with pytest.raises(ConfigError, match="policy_kwargs"):
         parse_literal("__import__('os').system('true')", "policy_kwargs")
-    with pytest.raises(ConfigError, match="no block for RotorDrop-Damping-v0"):
-        (tmp_path / "other.yaml").write_text("RotorDrop-Full-v0:\n  n_steps: 64\n")
-        load_hyperparams("ppo", "RotorDrop-Damping-v0", tmp_path / "other.yaml")
+    with pytest.raises(ConfigError, match="no block for RotorDrop-Damping-v1"):
+        (tmp_path / "other.yaml").write_text("RotorDrop-Full-v1:\n  n_steps: 64\n")
+        load_hyperparams("ppo", "RotorDrop-Damping-v1", tmp_path / "other.yaml")
     with pytest.raises(ConfigError, match="algo"):
-        load_hyperparams("a2c", "RotorDrop-Damping-v0")
+        load_hyperparams("a2c", "RotorDrop-Damping-v1")
 
 
 def test_scientific_notation_in_a_config_is_a_number(tmp_path):
     """YAML 1.1 (PyYAML's default) reads 1e-3 as a string; configs read it as a float."""
     cfg = tmp_path / "sci.yaml"
-    cfg.write_text("RotorDrop-Damping-v0:\n  learning_rate: 3e-4\n  n_timesteps: 2E5\n"
+    cfg.write_text("RotorDrop-Damping-v1:\n  learning_rate: 3e-4\n  n_timesteps: 2E5\n"
                    "  ent_coef: -1.5e-2\n  policy: MlpPolicy\n  n_steps: 64\n"
                    "  env_kwargs:\n    control_dt: 2e-3\n")
-    hp = load_hyperparams("ppo", "RotorDrop-Damping-v0", cfg)
+    hp = load_hyperparams("ppo", "RotorDrop-Damping-v1", cfg)
     assert hp["learning_rate"] == 3e-4 and hp["n_timesteps"] == 2e5 and hp["ent_coef"] == -0.015
     assert hp["env_kwargs"]["control_dt"] == 2e-3 and hp["n_steps"] == 64
     assert hp["policy"] == "MlpPolicy"
@@ -84,10 +84,10 @@ def trained(tmp_path_factory):
     from agents.train import train
     out = tmp_path_factory.mktemp("ppo")
     cfg = out / "tiny.yaml"
-    cfg.write_text("RotorDrop-Damping-v0:\n  n_steps: 256\n  batch_size: 128\n  n_epochs: 2\n"
+    cfg.write_text("RotorDrop-Damping-v1:\n  n_steps: 256\n  batch_size: 128\n  n_epochs: 2\n"
                    "  eval_freq: 1024\n  n_eval_episodes: 2\n  checkpoint_freq: 1024\n"
                    "  env_kwargs:\n    episode_time: 0.05\n")
-    res = train("RotorDrop-Damping-v0", "ppo", out / "run", timesteps=2048, n_envs=4, config=cfg,
+    res = train("RotorDrop-Damping-v1", "ppo", out / "run", timesteps=2048, n_envs=4, config=cfg,
                 seed=3, progress=False)
     return res, cfg
 
@@ -107,7 +107,7 @@ def test_training_saves_a_loadable_model(trained):
     assert all(0.0 <= h["mean_failure"] <= 1.0 for h in info["learning_curve"])
 
     pol = LearnedPolicy.load(run)
-    assert pol.env_id == "RotorDrop-Damping-v0" and pol.name == "ppo-damping"
+    assert pol.env_id == "RotorDrop-Damping-v1" and pol.name == "ppo-damping"
     env = make_env(pol.env_id, episode_time=0.02)
     pol.bound(Plant.from_env(env))          # the shipped config trains a residual on max-damping
     assert pol.residual == "max-damping"
@@ -125,7 +125,7 @@ def test_training_resumes_from_a_checkpoint(trained, tmp_path):
     ckpt, vn, _ = find_checkpoint(res.out)
     assert ckpt.name == "rl_model_2048_steps.zip" and vn is not None
     first, _, _ = find_checkpoint(res.out / "checkpoints" / "rl_model_1024_steps.zip")
-    resumed = train("RotorDrop-Damping-v0", "ppo", tmp_path / "resumed", timesteps=3072, n_envs=4,
+    resumed = train("RotorDrop-Damping-v1", "ppo", tmp_path / "resumed", timesteps=3072, n_envs=4,
                     config=cfg, seed=3, resume=first, progress=False)
     # continued from 1024 steps: one more rollout of 4 x 256 steps would end at 2048, so two more
     assert resumed.timesteps == 3072
@@ -140,7 +140,7 @@ def test_evaluate_a_trained_policy_against_passive(trained, tmp_path):
     assert main(["evaluate", "--policy", str(res.out), "--episodes", "2", "--set",
                  "contact.friction=0.1", "--out", str(out)]) == 0
     report = json.loads((out / "kpis.json").read_text())
-    assert report["policy"] == "ppo-damping@run" and report["env_id"] == "RotorDrop-Damping-v0"
+    assert report["policy"] == "ppo-damping@run" and report["env_id"] == "RotorDrop-Damping-v1"
     eps = report["episodes"]
     assert [e["seed"] for e in eps] == [0, 1]
     # the summary is the episodes' statistics
@@ -176,7 +176,7 @@ def test_kpi_reward_returns_minus_the_episode_cost():
     """The KPI reward telescopes: an episode's return is minus the potential of its final KPIs
     (peak backward revolutions capped at 3, peak force, max displacement; weights as given)."""
     from agents.training_env import make_vec_env
-    venv = make_vec_env("RotorDrop-Damping-v0", 2, 0, dict(
+    venv = make_vec_env("RotorDrop-Damping-v1", 2, 0, dict(
         episode_time=0.06, terminate_on_failure=False, overrides={"contact.friction": 0.6}),
         reward="kpi", reward_kwargs=W)
     venv.reset()
@@ -202,7 +202,7 @@ def test_residual_zero_action_is_the_base_controller():
     from physics.scene import load_scene
     s = load_scene("paper").support
     for a, target in ((0.0, s.damping_max), (-1.0, s.damping_min)):
-        venv = make_vec_env("RotorDrop-Damping-v0", 2, 0, dict(episode_time=0.1), residual="max-damping")
+        venv = make_vec_env("RotorDrop-Damping-v1", 2, 0, dict(episode_time=0.1), residual="max-damping")
         venv.reset()
         for _ in range(60):
             obs, *_ = venv.step(np.full((2, 2), a, dtype=np.float32))
@@ -217,7 +217,7 @@ def test_kpi_reward_charges_the_time_before_relevitation():
     from agents.training_env import make_vec_env
     kw = dict(episode_time=0.15, terminate_on_failure=False, command="discrete",
               power_return_time=0.02, overrides={"contact.friction": 0.1})
-    venv = make_vec_env("RotorDrop-Relevitate-v0", 1, 0, kw, reward="kpi",
+    venv = make_vec_env("RotorDrop-Relevitate-v1", 1, 0, kw, reward="kpi",
                         reward_kwargs=dict(W, w_relevitate=0.7, w_time=1.5))
     venv.reset()
     ret, pre, done = 0.0, 0, False
@@ -243,19 +243,19 @@ def test_validation_keeps_the_best_model_by_validation_score(tmp_path):
     from agents.policies import LearnedPolicy
     from agents.train import train
     cfg = tmp_path / "val.yaml"
-    cfg.write_text("RotorDrop-Full-v0:\n  n_steps: 128\n  batch_size: 128\n  n_epochs: 1\n"
+    cfg.write_text("RotorDrop-Full-v1:\n  n_steps: 128\n  batch_size: 128\n  n_epochs: 1\n"
                    "  eval_freq: 512\n  n_eval_episodes: 1\n  checkpoint_freq: 0\n"
                    "  policy_kwargs: \"dict(net_arch=[16], log_std_init=-3.0)\"\n"
                    "  residual: whirl-brake\n  residual_scale: 0.01\n  validation: true\n"
                    "  reward: kpi\n  env_kwargs: {command: continuous, terminate_on_failure: false}\n")
-    res = train("RotorDrop-Full-v0", "ppo", tmp_path / "run", timesteps=1024, n_envs=4, config=cfg,
+    res = train("RotorDrop-Full-v1", "ppo", tmp_path / "run", timesteps=1024, n_envs=4, config=cfg,
                 progress=False)
     curve = json.loads((res.out / "training.json").read_text())["learning_curve"]
     scores = [e["validation_score"] for e in curve]
     assert len(scores) == 2 and (res.out / "best" / "best_model.zip").is_file()
     pol = LearnedPolicy.load(res.out / "best" / "best_model.zip")
     assert pol.residual == "whirl-brake" and pol.residual_scale == pytest.approx(0.01)
-    v = Validator("RotorDrop-Full-v0")
+    v = Validator("RotorDrop-Full-v1")
     base, _ = v.score(WhirlBrake, {"command": "continuous"})
     assert max(scores) == pytest.approx(base, abs=1.0)       # a 1 % residual barely moves it
     kept, _ = v.score(pol.bound, {"command": "continuous"})
@@ -267,7 +267,7 @@ def test_validation_keeps_the_best_model_by_validation_score(tmp_path):
 # --- run directories, resuming, config errors, short runs (UAT defects) ---------------------------
 
 #: a tiny PPO damping config: 2 envs x 64 steps per rollout, one short evaluation episode
-TINY = ("RotorDrop-Damping-v0:\n  n_steps: 64\n  batch_size: 64\n  n_epochs: 1\n  n_envs: 2\n"
+TINY = ("RotorDrop-Damping-v1:\n  n_steps: 64\n  batch_size: 64\n  n_epochs: 1\n  n_envs: 2\n"
         "  n_eval_episodes: 1\n  validation: false\n  policy_kwargs: \"dict(net_arch=[8])\"\n"
         "  env_kwargs:\n    episode_time: 0.02\n")
 
@@ -280,13 +280,13 @@ def _tiny(tmp_path, extra: str = "", name: str = "tiny.yaml"):
 
 def _train(cfg, out, timesteps, **kw):
     from agents.train import train
-    return train("RotorDrop-Damping-v0", kw.pop("algo", "ppo"), out, timesteps=timesteps,
+    return train("RotorDrop-Damping-v1", kw.pop("algo", "ppo"), out, timesteps=timesteps,
                  config=cfg, progress=False, **kw)
 
 
 @pytest.mark.parametrize("extra, match", [
     ("  learning_rat: 1.0e-3\n", r"ppo config: unknown key 'learning_rat' \(did you mean learning_rate\?\)"),
-    ("  env_kwargs: {foo: 1}\n", r"env_kwargs \(RotorDrop-Damping-v0 arguments\): unknown key 'foo'; "
+    ("  env_kwargs: {foo: 1}\n", r"env_kwargs \(RotorDrop-Damping-v1 arguments\): unknown key 'foo'; "
                                  r"allowed: scene, overrides"),
     ("  normalize: \"dict(foo=3)\"\n", r"normalize \(VecNormalize arguments\): unknown key 'foo'"),
     ("  batch_size: -4\n", r"batch_size must be >= 1, got -4"),
@@ -307,15 +307,15 @@ def test_config_errors_name_the_key_before_anything_is_written(tmp_path, extra, 
 def test_config_errors_of_the_action_space_and_the_algorithm(tmp_path):
     from agents.train import train
     cfg = tmp_path / "relev.yaml"
-    cfg.write_text("RotorDrop-Relevitate-v0:\n  env_kwargs: {command: discrete}\n")
+    cfg.write_text("RotorDrop-Relevitate-v1:\n  env_kwargs: {command: discrete}\n")
     # the shipped Relevitate config trains a residual on whirl-brake, which needs the currents
     with pytest.raises(ConfigError, match=r"residual: whirl-brake needs continuous actions: "
-                                          r"RotorDrop-Relevitate-v0 has the action space Discrete\(2\)"
+                                          r"RotorDrop-Relevitate-v1 has the action space Discrete\(2\)"
                                           r".*env_kwargs.command: continuous"):
-        train("RotorDrop-Relevitate-v0", "ppo", tmp_path / "run", timesteps=128, config=cfg,
+        train("RotorDrop-Relevitate-v1", "ppo", tmp_path / "run", timesteps=128, config=cfg,
               progress=False)
     with pytest.raises(ConfigError, match=r"--algo sac needs continuous actions"):
-        train("RotorDrop-Relevitate-v0", "sac", tmp_path / "run", timesteps=128, config=cfg,
+        train("RotorDrop-Relevitate-v1", "sac", tmp_path / "run", timesteps=128, config=cfg,
               progress=False)
     with pytest.raises(ConfigError, match=r"ppo hyperparameters: .*batch_size"):   # SB3's own check
         _train(_tiny(tmp_path, "  batch_size: 1\n"), tmp_path / "run", 128)
@@ -325,7 +325,7 @@ def test_config_errors_of_the_action_space_and_the_algorithm(tmp_path):
 def test_config_errors_reach_the_cli_as_one_line(tmp_path, capsys):
     from agents.cli import main
     cfg = _tiny(tmp_path, "  learning_rat: 1.0e-3\n")
-    assert main(["train", "--env", "RotorDrop-Damping-v0", "--algo", "ppo", "--config", str(cfg),
+    assert main(["train", "--env", "RotorDrop-Damping-v1", "--algo", "ppo", "--config", str(cfg),
                  "--out", str(tmp_path / "run"), "--quiet"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("rotordrop train: error: ppo config: unknown key")
@@ -337,19 +337,19 @@ def test_resume_checks_the_algorithm_and_the_env_of_the_run(trained, tmp_path):
     res, cfg = trained
     with pytest.raises(ConfigError, match=r"--algo sac does not match the run resumed from .*"
                                           r"rl_model_2048_steps.zip, trained with --algo ppo"):
-        train("RotorDrop-Damping-v0", "sac", tmp_path / "a", resume=res.out, progress=False)
-    with pytest.raises(ConfigError, match=r"--env RotorDrop-Full-v0 does not match .* trained with "
-                                          r"--env RotorDrop-Damping-v0"):
-        train("RotorDrop-Full-v0", "ppo", tmp_path / "b", resume=res.out, progress=False)
+        train("RotorDrop-Damping-v1", "sac", tmp_path / "a", resume=res.out, progress=False)
+    with pytest.raises(ConfigError, match=r"--env RotorDrop-Full-v1 does not match .* trained with "
+                                          r"--env RotorDrop-Damping-v1"):
+        train("RotorDrop-Full-v1", "ppo", tmp_path / "b", resume=res.out, progress=False)
     # a bare checkpoint (no config.yaml): the algorithm from the zip, the env from its spaces
     bare = tmp_path / "bare"
     bare.mkdir()
     for f in ("rl_model_2048_steps.zip", "rl_model_vecnormalize_2048_steps.pkl"):
         shutil.copy(res.out / "checkpoints" / f, bare / f)
     with pytest.raises(ConfigError, match=r"--algo sac does not match .* trained with --algo ppo"):
-        train("RotorDrop-Damping-v0", "sac", tmp_path / "c", resume=bare, progress=False)
-    with pytest.raises(ConfigError, match=r"--resume .* does not fit --algo ppo --env RotorDrop-Full-v0"):
-        train("RotorDrop-Full-v0", "ppo", tmp_path / "d", resume=bare, progress=False)
+        train("RotorDrop-Damping-v1", "sac", tmp_path / "c", resume=bare, progress=False)
+    with pytest.raises(ConfigError, match=r"--resume .* does not fit --algo ppo --env RotorDrop-Full-v1"):
+        train("RotorDrop-Full-v1", "ppo", tmp_path / "d", resume=bare, progress=False)
     assert not any((tmp_path / d).exists() for d in "abcd")
 
 

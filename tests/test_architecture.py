@@ -95,7 +95,7 @@ def test_physics_commands_run_without_the_rl_extra():
 
 
 def test_an_rl_command_without_the_rl_extra_says_so_in_one_line(tmp_path):
-    proc = without_rl_extra("evaluate", "--policy", "max-damping", "--env", "RotorDrop-Damping-v0",
+    proc = without_rl_extra("evaluate", "--policy", "max-damping", "--env", "RotorDrop-Damping-v1",
                             "--episodes", "1", "--out", str(tmp_path))
     assert proc.returncode == 2
     assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr

@@ -167,7 +167,7 @@ def test_train_seeds_are_checked_before_anything_runs(tmp_path, capsys):
     for bad in ("", "a,b", "0,0", "-1"):
         with pytest.raises(ValueError, match="--seeds expects distinct integers >= 0"):
             parse_seeds(bad)
-    base = ["train", "--env", "RotorDrop-Damping-v0", "--algo", "ppo", "--out", str(tmp_path / "t")]
+    base = ["train", "--env", "RotorDrop-Damping-v1", "--algo", "ppo", "--out", str(tmp_path / "t")]
     for extra, message in ((["--seeds", "1,1"], "--seeds expects"),
                            (["--seeds", "0,1", "--resume", str(tmp_path)], "--resume continues one run"),
                            (["--seeds", "0,1", "--backend", "ray", "--address", "127.0.0.9:6999"],

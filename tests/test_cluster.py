@@ -164,7 +164,7 @@ def test_one_node_ray_gives_the_local_numbers_of_the_paper_study_drops(tmp_path)
         assert without_timing(a.metrics) == without_timing(b.metrics) and a.extra == b.extra
 
 
-TINY = ("RotorDrop-Damping-v0:\n  n_steps: 64\n  batch_size: 64\n  n_epochs: 1\n  eval_freq: 0\n"
+TINY = ("RotorDrop-Damping-v1:\n  n_steps: 64\n  batch_size: 64\n  n_epochs: 1\n  eval_freq: 0\n"
         "  checkpoint_freq: 0\n  env_kwargs:\n    episode_time: 0.02\n")
 
 
@@ -174,7 +174,7 @@ def test_seeds_trained_as_ray_tasks_equal_the_local_ones(tmp_path):
     import torch
     from stable_baselines3 import PPO
     (tmp_path / "tiny.yaml").write_text(TINY)
-    args = ["train", "--env", "RotorDrop-Damping-v0", "--algo", "ppo", "--timesteps", "128",
+    args = ["train", "--env", "RotorDrop-Damping-v1", "--algo", "ppo", "--timesteps", "128",
             "--n-envs", "1", "--config", str(tmp_path / "tiny.yaml"), "--seeds", "0,1", "--quiet"]
     assert cli_main(args + ["--out", str(tmp_path / "local")]) == 0
     assert cli_main(args + ["--out", str(tmp_path / "ray"), "--backend", "ray"]) == 0
@@ -191,7 +191,7 @@ def test_seeds_trained_as_ray_tasks_equal_the_local_ones(tmp_path):
 def test_ray_tune_finds_the_gains_of_the_local_search(tmp_path):
     """`tune --backend ray`: Ray Tune runs the candidates as trials; same history, same gains."""
     pytest.importorskip("ray")
-    args = ["tune", "--policy", "whirl-brake", "--env", "RotorDrop-Relevitate-v0", "--gain",
+    args = ["tune", "--policy", "whirl-brake", "--env", "RotorDrop-Relevitate-v1", "--gain",
             "kp=0.5:1.5", "--iterations", "2", "--population", "3", "--elite", "1", "--quiet",
             "--no-plots"]
     assert cli_main(args + ["--out", str(tmp_path / "local")]) == 0

@@ -185,11 +185,11 @@ def test_batched_env_reports_the_same_validity_as_the_single_env():
     import gymnasium as gym
     from rotordrop_env import BatchedRotorDropVecEnv
     kw = dict(overrides=STIFF, episode_time=0.006, terminate_on_failure=False)
-    venv = BatchedRotorDropVecEnv("RotorDrop-Passive-v0", 2, seed=3, **kw)
+    venv = BatchedRotorDropVecEnv("RotorDrop-Passive-v1", 2, seed=3, **kw)
     venv.reset()
     batched = [venv.step(np.zeros((2,) + venv.action_space.shape, np.float32))[3]
                for _ in range(6)]
-    env = gym.make("RotorDrop-Passive-v0", **kw)
+    env = gym.make("RotorDrop-Passive-v1", **kw)
     env.reset(seed=3)
     single = [env.step(np.zeros(env.action_space.shape, np.float32))[4]["beyond_validity"]
               for _ in range(6)]

@@ -9,7 +9,7 @@ from agents.plant import Plant
 from helpers import run_env_checkers
 
 
-def damper_states(damping, steps: int = 40, env_id="RotorDrop-Damping-v0", **kw):
+def damper_states(damping, steps: int = 40, env_id="RotorDrop-Damping-v1", **kw):
     """The damper states (C_s of housing 1, 2) and the full state after each step."""
     env = gym.make(env_id, episode_time=0.05, terminate_on_failure=False, **kw)
     env.reset(seed=5)
@@ -36,7 +36,7 @@ def test_linear_is_the_default_and_zero_is_mid_range():
 
 
 def test_zero_action_holds_c_max_in_the_full_supervisor_env():
-    env = gym.make("RotorDrop-Full-v0", command="supervisor", damping_action="from_max",
+    env = gym.make("RotorDrop-Full-v1", command="supervisor", damping_action="from_max",
                    episode_time=0.1, terminate_on_failure=False)
     env.reset(seed=1)
     for _ in range(100):
@@ -47,8 +47,8 @@ def test_zero_action_holds_c_max_in_the_full_supervisor_env():
     assert got == pytest.approx([c_max, c_max], rel=1e-3)      # after 10 damper time constants
 
 
-@pytest.mark.parametrize("env_id, kw", [("RotorDrop-Damping-v0", {}),
-                                        ("RotorDrop-Full-v0", {"command": "supervisor"})])
+@pytest.mark.parametrize("env_id, kw", [("RotorDrop-Damping-v1", {}),
+                                        ("RotorDrop-Full-v1", {"command": "supervisor"})])
 def test_env_checkers_pass_with_from_max(env_id, kw):
     run_env_checkers(lambda: gym.make(env_id, damping_action="from_max", episode_time=0.01, **kw))
 
@@ -56,16 +56,16 @@ def test_env_checkers_pass_with_from_max(env_id, kw):
 def test_unknown_map_names_the_maps():
     with pytest.raises(ValueError, match="damping_action = 'max' is not a damper map; the maps "
                                          "are 'linear', 'from_max'"):
-        gym.make("RotorDrop-Damping-v0", damping_action="max")
+        gym.make("RotorDrop-Damping-v1", damping_action="max")
 
 
 def test_from_max_needs_damper_commands():
     with pytest.raises(ValueError, match="applies to the environments with damper commands"):
-        gym.make("RotorDrop-Relevitate-v0", damping_action="from_max")
+        gym.make("RotorDrop-Relevitate-v1", damping_action="from_max")
 
 
 def test_setting_is_fixed_after_construction():
-    env = gym.make("RotorDrop-Damping-v0", damping_action="from_max")
+    env = gym.make("RotorDrop-Damping-v1", damping_action="from_max")
     with pytest.raises(AttributeError):
         env.unwrapped.damping_action = "linear"
 
@@ -76,7 +76,7 @@ def test_controllers_command_the_same_damping_under_either_map(command):
     the action of the env's map: the same damping under both maps."""
     acts = {}
     for m in ("linear", "from_max"):
-        env = gym.make("RotorDrop-Damping-v0", damping_action=m)
+        env = gym.make("RotorDrop-Damping-v1", damping_action=m)
         plant = Plant.from_env(env)
         assert plant.damping_action == m
         acts[m] = plant.compose(1, {"damping": np.full((1, 2), command)})[0]

@@ -14,11 +14,11 @@ from rotordrop_env.scenario import DEFAULT_RANGES
 
 from helpers import phys, run_env_checkers
 
-VARIANTS = [("RotorDrop-Passive-v0", {}), ("RotorDrop-Damping-v0", {}),
-            ("RotorDrop-Relevitate-v0", {"command": "discrete"}),
-            ("RotorDrop-Relevitate-v0", {"command": "continuous"}),
-            ("RotorDrop-Full-v0", {"command": "discrete"}),
-            ("RotorDrop-Full-v0", {"command": "continuous"})]
+VARIANTS = [("RotorDrop-Passive-v1", {}), ("RotorDrop-Damping-v1", {}),
+            ("RotorDrop-Relevitate-v1", {"command": "discrete"}),
+            ("RotorDrop-Relevitate-v1", {"command": "continuous"}),
+            ("RotorDrop-Full-v1", {"command": "discrete"}),
+            ("RotorDrop-Full-v1", {"command": "continuous"})]
 
 
 @pytest.mark.parametrize("env_id,kwargs", VARIANTS, ids=lambda v: v if isinstance(v, str) else
@@ -29,7 +29,7 @@ def test_gymnasium_and_sb3_checkers_pass(env_id, kwargs):
 
 def test_registered_ids_and_public_attributes():
     assert set(rotordrop_env.ENV_IDS) <= set(gym.registry)
-    env = gym.make("RotorDrop-Full-v0", episode_time=0.002)
+    env = gym.make("RotorDrop-Full-v1", episode_time=0.002)
     u = env.unwrapped
     for name in ("x1", "y1", "vx1", "vy1", "x2", "y2", "vx2", "vy2", "rotor_speed",
                  "sleeve_speed1", "sleeve_speed2", "damping1", "damping2", "amb_power",
@@ -47,7 +47,7 @@ def test_registered_ids_and_public_attributes():
 
 def test_seeding_makes_scenarios_and_trajectories_reproducible():
     def run(seed):
-        env = gym.make("RotorDrop-Damping-v0", randomize=True, episode_time=0.005)
+        env = gym.make("RotorDrop-Damping-v1", randomize=True, episode_time=0.005)
         obs, info = env.reset(seed=seed)
         env.action_space.seed(seed)
         traj = [obs]
@@ -65,7 +65,7 @@ def test_seeding_makes_scenarios_and_trajectories_reproducible():
 
 
 def test_reset_options_fix_the_scenario():
-    env = gym.make("RotorDrop-Relevitate-v0", randomize=True, episode_time=0.003)
+    env = gym.make("RotorDrop-Relevitate-v1", randomize=True, episode_time=0.003)
     _, info = env.reset(seed=1, options={"scenario": {"contact.friction": 0.33,
                                                       "power_return_time": 0.0123}})
     assert env.unwrapped.scene.contact.friction == 0.33
@@ -82,7 +82,7 @@ def test_passive_env_reproduces_the_simulator(mu, whirl):
     """Same scene, same physics: states at the control steps and the KPIs of `rotordrop drop`;
     the paper's whirl threshold (spec §7: between mu 0.25 and 0.5) is seen by both."""
     episode = 0.15
-    env = gym.make("RotorDrop-Passive-v0", overrides={"contact.friction": mu}, samples_per_step=20,
+    env = gym.make("RotorDrop-Passive-v1", overrides={"contact.friction": mu}, samples_per_step=20,
                    terminate_on_failure=False, episode_time=episode)
     u = env.unwrapped
     sv = u.scene
@@ -120,7 +120,7 @@ def test_passive_env_reproduces_the_simulator(mu, whirl):
 
 
 def test_stator_contact_terminates_with_the_failure_penalty():
-    env = gym.make("RotorDrop-Passive-v0", overrides={"contact.friction": 0.5}, episode_time=0.3)
+    env = gym.make("RotorDrop-Passive-v1", overrides={"contact.friction": 0.5}, episode_time=0.3)
     env.reset(seed=0)
     n = 0
     worst_step = 0.0                  # most negative reward of a step that did not terminate
@@ -143,7 +143,7 @@ def test_stator_contact_terminates_with_the_failure_penalty():
 def test_failure_flags_latch_when_the_episode_is_not_terminated():
     """With ``terminate_on_failure=False`` the final KPIs still say the orbit reached the stator
     (the whirl at mu = 0.5 passes the 600 um AMB gap around 50 ms, then the episode runs on)."""
-    env = gym.make("RotorDrop-Passive-v0", overrides={"contact.friction": 0.5}, episode_time=0.3,
+    env = gym.make("RotorDrop-Passive-v1", overrides={"contact.friction": 0.5}, episode_time=0.3,
                    terminate_on_failure=False)
     env.reset(seed=0)
     flags = []
@@ -157,11 +157,11 @@ def test_failure_flags_latch_when_the_episode_is_not_terminated():
 
 
 @pytest.mark.parametrize("env_id,action,match", [
-    ("RotorDrop-Damping-v0", [np.nan, 0.0], "non-finite"),
-    ("RotorDrop-Damping-v0", [1.5, 0.0], "out-of-range"),
-    ("RotorDrop-Damping-v0", [0.0, 0.0, 0.0], "shape"),
-    ("RotorDrop-Relevitate-v0", 2, "out-of-range"),
-    ("RotorDrop-Relevitate-v0", float("nan"), "non-finite"),
+    ("RotorDrop-Damping-v1", [np.nan, 0.0], "non-finite"),
+    ("RotorDrop-Damping-v1", [1.5, 0.0], "out-of-range"),
+    ("RotorDrop-Damping-v1", [0.0, 0.0, 0.0], "shape"),
+    ("RotorDrop-Relevitate-v1", 2, "out-of-range"),
+    ("RotorDrop-Relevitate-v1", float("nan"), "non-finite"),
 ])
 def test_bad_actions_raise_clear_errors(env_id, action, match):
     env = gym.make(env_id, episode_time=0.003).unwrapped
@@ -173,26 +173,26 @@ def test_bad_actions_raise_clear_errors(env_id, action, match):
 
 
 def test_step_before_reset_raises():
-    env = gym.make("RotorDrop-Damping-v0").unwrapped
+    env = gym.make("RotorDrop-Damping-v1").unwrapped
     with pytest.raises(gym.error.ResetNeeded):
         env.step(np.zeros(2, np.float32))
 
 
 def test_bad_kwargs_raise_clear_errors():
     with pytest.raises(ValueError, match="control_dt"):
-        gym.make("RotorDrop-Passive-v0", control_dt=0.0)
+        gym.make("RotorDrop-Passive-v1", control_dt=0.0)
     with pytest.raises(ValueError, match="command"):
-        gym.make("RotorDrop-Passive-v0", command="discrete")
+        gym.make("RotorDrop-Passive-v1", command="discrete")
     with pytest.raises(ValueError, match="w_contact"):
-        gym.make("RotorDrop-Damping-v0", w_contact=-1.0)
+        gym.make("RotorDrop-Damping-v1", w_contact=-1.0)
     with pytest.raises(SceneError, match="contact.friction"):
-        gym.make("RotorDrop-Damping-v0", overrides={"contact.friction": 2.0})
+        gym.make("RotorDrop-Damping-v1", overrides={"contact.friction": 2.0})
     with pytest.raises(ValueError, match="randomization"):
-        gym.make("RotorDrop-Damping-v0", randomization={"contact.friction": (0.5, 0.1)})
+        gym.make("RotorDrop-Damping-v1", randomization={"contact.friction": (0.5, 0.1)})
 
 
 def test_time_limit_truncates_and_final_info_has_kpis():
-    env = gym.make("RotorDrop-Relevitate-v0", episode_time=0.004)
+    env = gym.make("RotorDrop-Relevitate-v1", episode_time=0.004)
     env.reset(seed=0)
     flags = [env.step(0)[2:4] for _ in range(4)]
     assert flags[:3] == [(False, False)] * 3 and flags[3] == (False, True)
@@ -208,7 +208,7 @@ def test_time_limit_truncates_and_final_info_has_kpis():
 
 
 def test_rgb_render_shows_the_orbit():
-    env = gym.make("RotorDrop-Passive-v0", episode_time=0.02, render_mode="rgb_array")
+    env = gym.make("RotorDrop-Passive-v1", episode_time=0.02, render_mode="rgb_array")
     env.reset(seed=0)
     for _ in range(20):
         env.step(np.zeros(1, np.float32))

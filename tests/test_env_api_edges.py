@@ -27,7 +27,7 @@ def _whirl_terms(set_weight, step, n_before=40, n_after=15):
 def test_a_reward_weight_set_on_the_env_counts_from_the_next_step():
     """w_whirl 10 -> 25 on one of two identical envs: same physics, whirl term x 2.5 from the
     next step on, the other terms unchanged."""
-    envs = [gym.make("RotorDrop-Damping-v0", **WHIRL) for _ in range(2)]
+    envs = [gym.make("RotorDrop-Damping-v1", **WHIRL) for _ in range(2)]
     for e in envs:
         e.reset(seed=0)
     a = np.zeros(2, np.float32)
@@ -48,10 +48,10 @@ def test_a_reward_weight_set_on_the_env_counts_from_the_next_step():
 @pytest.mark.parametrize("how", ["batched set_attr", "DummyVecEnv env_method"])
 def test_a_reward_weight_set_through_a_vec_env_counts(how):
     if how == "batched set_attr":
-        make = lambda: make_batched("RotorDrop-Damping-v0", 2, seed=0, n_threads=1, **WHIRL)
+        make = lambda: make_batched("RotorDrop-Damping-v1", 2, seed=0, n_threads=1, **WHIRL)
         set_w = lambda v: v.set_attr("w_whirl", 0.0, indices=[1])
     else:       # SB3's setattr would land on its Monitor wrapper: set_wrapper_attr reaches the env
-        make = lambda: make_vec_env("RotorDrop-Damping-v0", 2, seed=0, env_kwargs=WHIRL)
+        make = lambda: make_vec_env("RotorDrop-Damping-v1", 2, seed=0, env_kwargs=WHIRL)
         set_w = lambda v: v.env_method("set_wrapper_attr", "w_whirl", 0.0, indices=[1])
     venv = make()
     venv.reset()
@@ -66,10 +66,10 @@ def test_a_reward_weight_set_through_a_vec_env_counts(how):
 @pytest.mark.parametrize("target", ["env", "wrapper", "batch"])
 def test_settings_fixed_at_construction_and_misspelt_weights_raise(target):
     if target == "batch":
-        venv = make_batched("RotorDrop-Damping-v0", 1, n_threads=1)
+        venv = make_batched("RotorDrop-Damping-v1", 1, n_threads=1)
         setter = lambda name, value: venv.set_attr(name, value)
     else:
-        env = gym.make("RotorDrop-Damping-v0")
+        env = gym.make("RotorDrop-Damping-v1")
         # through gym.make's wrappers: Gymnasium's set_wrapper_attr reaches the environment
         setter = (lambda name, value: setattr(env.unwrapped, name, value)) if target == "env" \
             else env.set_wrapper_attr
@@ -86,7 +86,7 @@ def test_settings_fixed_at_construction_and_misspelt_weights_raise(target):
 
 
 def test_a_step_after_the_end_warns_once_like_gymnasium():
-    env = gym.make("RotorDrop-Passive-v0", episode_time=0.003)
+    env = gym.make("RotorDrop-Passive-v1", episode_time=0.003)
     a = np.zeros(1, np.float32)
     for _ in range(2):                            # also in the second episode
         env.reset(seed=0)
@@ -102,10 +102,10 @@ def test_a_step_after_the_end_warns_once_like_gymnasium():
 @pytest.mark.parametrize("target", ["env", "wrapper", "batch"])
 def test_a_closed_env_refuses_to_step_or_reset(target):
     if target == "batch":
-        env = make_batched("RotorDrop-Damping-v0", 2, n_threads=1, render_mode="rgb_array")
+        env = make_batched("RotorDrop-Damping-v1", 2, n_threads=1, render_mode="rgb_array")
         step = lambda: env.step(np.zeros((2, 2), np.float32))
     else:
-        env = gym.make("RotorDrop-Damping-v0", render_mode="rgb_array")
+        env = gym.make("RotorDrop-Damping-v1", render_mode="rgb_array")
         env = env.unwrapped if target == "env" else env
         step = lambda: env.step(np.zeros(2, np.float32))
     env.reset()
@@ -124,8 +124,8 @@ BAD = [True, np.bool_(False), np.array([True, False]), 1 + 0j, np.array([0.5 + 1
 
 @pytest.mark.parametrize("action", BAD, ids=repr)
 @pytest.mark.parametrize("env_id,kwargs,space", [
-    ("RotorDrop-Damping-v0", {}, r"Box\(-1.0, 1.0, \(2,\), float32\)"),
-    ("RotorDrop-Relevitate-v0", {}, r"Discrete\(2\)")])
+    ("RotorDrop-Damping-v1", {}, r"Box\(-1.0, 1.0, \(2,\), float32\)"),
+    ("RotorDrop-Relevitate-v1", {}, r"Discrete\(2\)")])
 def test_non_real_actions_raise_naming_the_action_space(env_id, kwargs, space, action):
     env = gym.make(env_id, **kwargs)
     env.reset(seed=0)

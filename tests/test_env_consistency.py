@@ -13,7 +13,7 @@ def test_fixed_step_env_follows_the_simulator_step_for_step():
     """solver.method = fixed steps with solver.dt (solver.max_step applies to the adaptive
     method only): 1 ms control steps are 50 of the simulator's 20 µs steps, so the passive env's
     states at the control steps equal `rotordrop drop`'s to round-off, through the impacts."""
-    env = gym.make("RotorDrop-Passive-v0", overrides=FIXED, terminate_on_failure=False,
+    env = gym.make("RotorDrop-Passive-v1", overrides=FIXED, terminate_on_failure=False,
                    episode_time=0.03, full_state=True)
     u = env.unwrapped
     env.reset(seed=0)
@@ -35,7 +35,7 @@ def test_zero_gravity_scene_steps_with_the_film_reference_force_scale():
     scene = load_scene("paper", {"world.gravity": 0.0})
     share = static_weight_share(scene)
     assert share == static_weight_share(load_scene("paper", {"world.gravity": STANDARD_GRAVITY}))
-    env = gym.make("RotorDrop-Damping-v0", overrides={"world.gravity": 0.0}, episode_time=0.02)
+    env = gym.make("RotorDrop-Damping-v1", overrides={"world.gravity": 0.0}, episode_time=0.02)
     env.reset(seed=0)
     done = False
     while not done:

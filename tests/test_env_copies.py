@@ -13,7 +13,7 @@ from gymnasium.envs.registration import EnvSpec
 from physics.scene import Scene, SceneError, load_scene
 from rotordrop_env import make_batched
 
-IDS = ["RotorDrop-Passive-v0", "RotorDrop-Damping-v0", "RotorDrop-Relevitate-v0", "RotorDrop-Full-v0"]
+IDS = ["RotorDrop-Passive-v1", "RotorDrop-Damping-v1", "RotorDrop-Relevitate-v1", "RotorDrop-Full-v1"]
 COPIERS = {"deepcopy": copy.deepcopy, "pickle": lambda x: pickle.loads(pickle.dumps(x))}
 
 
@@ -63,7 +63,7 @@ def test_a_copied_env_steps_and_renders_like_the_original(env_id, render_mode, c
 
 @pytest.mark.parametrize("copier", COPIERS.values(), ids=COPIERS.keys())
 def test_a_copied_rendering_batch_draws_the_same_frames(copier):
-    venv = make_batched("RotorDrop-Full-v0", 2, seed=0, render_mode="rgb_array",
+    venv = make_batched("RotorDrop-Full-v1", 2, seed=0, render_mode="rgb_array",
                         episode_time=0.003, n_threads=1)
     venv.reset()
     acts = np.stack(_actions(venv.action_space, 12)).reshape(6, 2, -1)
@@ -91,7 +91,7 @@ def test_a_json_env_spec_makes_the_same_environment():
     """gym.make(EnvSpec.from_json(env.spec.to_json())): same kwargs, same trajectory, also
     with a Scene object, randomisation ranges (tuples become JSON lists) and overrides."""
     scene = load_scene("paper", {"support.stiffness": 2e7, "rotor.speed_rpm": 9000.0})
-    env = gym.make("RotorDrop-Full-v0", scene=scene, overrides={"contact.friction": 0.45},
+    env = gym.make("RotorDrop-Full-v1", scene=scene, overrides={"contact.friction": 0.45},
                    randomize=True, randomization={"power_return_time": (0.03, 0.04)},
                    command="continuous", episode_time=0.006, w_whirl=3.0)
     again = gym.make(EnvSpec.from_json(env.spec.to_json()))
@@ -113,8 +113,8 @@ def test_a_scene_survives_json(preset, overrides):
     assert back == scene and back.name == "my machine"
     assert back.contact.friction == scene.contact.friction          # bit for bit (0.30000000000000004)
     assert Scene.from_dict(json.loads(json.dumps(dataclasses.asdict(scene)))) == scene
-    env_a = gym.make("RotorDrop-Damping-v0", scene=scene, episode_time=0.004)
-    env_b = gym.make("RotorDrop-Damping-v0", scene=json.loads(scene.to_json()), episode_time=0.004)
+    env_a = gym.make("RotorDrop-Damping-v1", scene=scene, episode_time=0.004)
+    env_b = gym.make("RotorDrop-Damping-v1", scene=json.loads(scene.to_json()), episode_time=0.004)
     (t1, _), (t2, _) = _trajectory(env_a, 0, 4), _trajectory(env_b, 0, 4)
     assert np.array_equal(t1, t2)
 
@@ -127,4 +127,4 @@ def test_bad_scene_json_names_the_problem():
     with pytest.raises(SceneError, match="malformed scene JSON"):
         Scene.from_json("{contact")
     with pytest.raises(ValueError, match="scene = 3 must be a preset name"):
-        gym.make("RotorDrop-Passive-v0", scene=3)
+        gym.make("RotorDrop-Passive-v1", scene=3)

@@ -61,7 +61,7 @@ def test_info_has_the_same_numpy_keys_at_reset_and_every_step_and_no_nan(env_id,
 
 
 def test_the_damping_env_reports_no_relevitation_with_the_sentinel():
-    env = gym.make("RotorDrop-Damping-v0", episode_time=0.003)
+    env = gym.make("RotorDrop-Damping-v1", episode_time=0.003)
     env.reset(seed=0)
     for _ in range(3):
         *_, info = env.step(np.zeros(2, np.float32))
@@ -70,7 +70,7 @@ def test_the_damping_env_reports_no_relevitation_with_the_sentinel():
 
 
 def test_without_ball_model_the_ball_kpis_are_the_sentinel():
-    env = gym.make("RotorDrop-Passive-v0", episode_time=0.003,
+    env = gym.make("RotorDrop-Passive-v1", episode_time=0.003,
                    overrides={"effects.retainer_bearing": "linear"})
     *_, info = (env.reset(seed=0), env.step(np.zeros(1, np.float32)))[1]
     assert info["kpi_max_ball_load_N"] == MISSING == info["kpi_max_contact_pressure_MPa"]
@@ -110,7 +110,7 @@ def test_the_cost_counts_stator_contact_and_bearing_overload():
     """Safety-Gymnasium convention: cost >= 0 each step; an overload step costs 1 (the
     static safety factor C_0 / F below 1), an uneventful one 0; the contact-law validity
     component is there and 0."""
-    env = gym.make("RotorDrop-Damping-v0", episode_time=0.05, overrides=OVERLOAD)
+    env = gym.make("RotorDrop-Damping-v1", episode_time=0.05, overrides=OVERLOAD)
     env.reset(seed=0)
     costs = []
     while True:
@@ -122,7 +122,7 @@ def test_the_cost_counts_stator_contact_and_bearing_overload():
     assert term and info["kpi_bearing_overload"]
     assert costs[-1][:2] == (1.0, 1.0) and costs[-1][3] == 0.0
     assert all(c == (0.0, 0.0, 0.0, 0.0) for c in costs[:-1])
-    env = gym.make("RotorDrop-Damping-v0", episode_time=0.05, terminate_on_failure=False,
+    env = gym.make("RotorDrop-Damping-v1", episode_time=0.05, terminate_on_failure=False,
                    overrides={"amb.air_gap": 5e-4, "contact.friction": 0.5})
     env.reset(seed=0)
     infos = [env.step(np.zeros(2, np.float32))[4] for _ in range(50)]  # a whirl reaches the stator
@@ -142,7 +142,7 @@ def test_both_checkers_pass_with_the_kpi_reward(env_id, command):
 
 
 def test_the_kpi_reward_returns_minus_the_final_potential():
-    env = gym.make("RotorDrop-Damping-v0", reward="kpi", reward_kwargs=W, episode_time=0.06,
+    env = gym.make("RotorDrop-Damping-v1", reward="kpi", reward_kwargs=W, episode_time=0.06,
                    terminate_on_failure=False, overrides={"contact.friction": 0.6})
     env.reset(seed=0)
     env.action_space.seed(0)
@@ -164,16 +164,16 @@ def test_the_default_reward_is_unchanged_and_the_kpi_reward_equals_the_sb3_wrapp
     kw = dict(command="discrete", power_return_time=0.002, episode_time=0.05,
               terminate_on_failure=False, overrides={"contact.friction": 0.1})
     wk = dict(W, w_relevitate=0.7, w_time=1.5)
-    env = gym.make("RotorDrop-Relevitate-v0", **kw)
+    env = gym.make("RotorDrop-Relevitate-v1", **kw)
     env.reset(seed=0)
     for _ in range(5):
         _, r, *_, info = env.step(1)
         assert r == sum(info["reward_" + t] for t in
                         ("whirl", "contact", "displacement", "effort", "success", "failure"))
-    own = make_vec_env("RotorDrop-Relevitate-v0", 2, seed=0,
+    own = make_vec_env("RotorDrop-Relevitate-v1", 2, seed=0,
                        env_kwargs=dict(kw, reward="kpi", reward_kwargs=wk))
-    wrapped = KpiReward(make_vec_env("RotorDrop-Relevitate-v0", 2, seed=0, env_kwargs=kw), **wk)
-    batched = rotordrop_env.make_batched("RotorDrop-Relevitate-v0", 2, seed=0, n_threads=1,
+    wrapped = KpiReward(make_vec_env("RotorDrop-Relevitate-v1", 2, seed=0, env_kwargs=kw), **wk)
+    batched = rotordrop_env.make_batched("RotorDrop-Relevitate-v1", 2, seed=0, n_threads=1,
                                          reward="kpi", reward_kwargs=wk, **kw)
     for v in (own, wrapped, batched):
         v.reset()
@@ -190,11 +190,11 @@ def test_the_default_reward_is_unchanged_and_the_kpi_reward_equals_the_sb3_wrapp
 
 def test_reward_kwargs_are_checked():
     with pytest.raises(ValueError, match=r"reward_kwargs: unknown key 'w_wirl' \(did you mean w_whirl\?\)"):
-        gym.make("RotorDrop-Damping-v0", reward="kpi", reward_kwargs={"w_wirl": 1.0})
+        gym.make("RotorDrop-Damping-v1", reward="kpi", reward_kwargs={"w_wirl": 1.0})
     with pytest.raises(ValueError, match=r"reward_kwargs.force_ref must be a finite number > 0"):
-        gym.make("RotorDrop-Damping-v0", reward="kpi", reward_kwargs={"force_ref": 0.0})
+        gym.make("RotorDrop-Damping-v1", reward="kpi", reward_kwargs={"force_ref": 0.0})
     with pytest.raises(ValueError, match="reward_kwargs are the weights of reward='kpi'"):
-        gym.make("RotorDrop-Damping-v0", reward_kwargs={"w_whirl": 1.0})
+        gym.make("RotorDrop-Damping-v1", reward_kwargs={"w_whirl": 1.0})
     with pytest.raises(ValueError, match="reward = 'kpis' is not a reward"):
-        gym.make("RotorDrop-Damping-v0", reward="kpis")
+        gym.make("RotorDrop-Damping-v1", reward="kpis")
     assert set(KPI_WEIGHTS) >= set(W)

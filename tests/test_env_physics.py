@@ -98,7 +98,7 @@ def test_actuator_scene_errors_name_the_parameter():
 
 def test_damper_follows_its_command_with_the_first_order_lag():
     """Spec §6: C_s lags its command with tau = 10 ms: after one tau it has covered 1 - 1/e."""
-    env = gym.make("RotorDrop-Damping-v0", episode_time=0.02)
+    env = gym.make("RotorDrop-Damping-v1", episode_time=0.02)
     u = env.unwrapped
     env.reset(seed=0)
     c0 = u.scene.support.damping
@@ -118,7 +118,7 @@ def test_discrete_command_relevitates_the_rotor_at_low_friction():
     """Paper scene at mu = 0.1: switching the built-in controller on when power returns lifts the
     rotor off the retainer bearings and holds it (contact-free, within c/2)."""
     def run(action):
-        env = gym.make("RotorDrop-Relevitate-v0", overrides={"contact.friction": 0.1},
+        env = gym.make("RotorDrop-Relevitate-v1", overrides={"contact.friction": 0.1},
                        episode_time=0.2)
         env.reset(seed=0)
         done, forces = False, []
@@ -143,7 +143,7 @@ def test_discrete_command_relevitates_the_rotor_at_low_friction():
 
 
 def test_direct_currents_act_after_power_returns_only():
-    env = gym.make("RotorDrop-Relevitate-v0", command="continuous", episode_time=0.06)
+    env = gym.make("RotorDrop-Relevitate-v1", command="continuous", episode_time=0.06)
     u = env.unwrapped
     env.reset(seed=0)
     full_lift = np.array([0.0, 1.0, 0.0, 1.0], np.float32)

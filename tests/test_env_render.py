@@ -29,7 +29,7 @@ def _value_box(k):
 
 
 def test_the_view_records_what_the_env_reports():
-    env, infos = _episode("RotorDrop-Damping-v0", 0.3, 30)
+    env, infos = _episode("RotorDrop-Damping-v1", 0.3, 30)
     u = env.unwrapped
     rows = u._renderer.recorded
     assert rows.shape == (31, len(R.COLUMNS))                      # reset + 30 steps
@@ -43,7 +43,7 @@ def test_the_view_records_what_the_env_reports():
 
 @pytest.mark.parametrize("friction,whirl", [(0.1, False), (0.5, True)])
 def test_a_frame_shows_orbits_at_both_planes_and_the_whirl_state(friction, whirl):
-    env, infos = _episode("RotorDrop-Passive-v0", friction, 120)
+    env, infos = _episode("RotorDrop-Passive-v1", friction, 120)
     assert bool(infos[-1]["backward_whirl"]) is whirl
     img = env.render()
     assert img.shape == (R.HEIGHT, R.WIDTH, 3) and img.dtype == np.uint8
@@ -60,7 +60,7 @@ def test_a_frame_shows_orbits_at_both_planes_and_the_whirl_state(friction, whirl
 
 
 def test_frames_differ_as_the_numbers_change_and_the_amb_line_appears():
-    env, _ = _episode("RotorDrop-Full-v0", 0.3, 10, command="continuous")
+    env, _ = _episode("RotorDrop-Full-v1", 0.3, 10, command="continuous")
     first = env.render()
     env.step(np.zeros(6, np.float32))
     second = env.render()
@@ -76,7 +76,7 @@ def test_record_video_writes_an_mp4_of_every_step(tmp_path):
         pytest.skip("no ffmpeg")
     import imageio.v2 as imageio
     from gymnasium.wrappers import RecordVideo
-    env = RecordVideo(gym.make("RotorDrop-Damping-v0", render_mode="rgb_array",
+    env = RecordVideo(gym.make("RotorDrop-Damping-v1", render_mode="rgb_array",
                                episode_time=0.012), tmp_path / "videos", episode_trigger=lambda e: e == 0,
                       disable_logger=True)
     env.reset(seed=0)
@@ -97,7 +97,7 @@ def test_record_video_writes_an_mp4_of_every_step(tmp_path):
 def test_write_video_round_trip(tmp_path, suffix):
     if suffix == ".mp4" and not mp4_available():
         pytest.skip("no ffmpeg")
-    env, _ = _episode("RotorDrop-Passive-v0", 0.3, 4)
+    env, _ = _episode("RotorDrop-Passive-v1", 0.3, 4)
     frames = [env.render()]
     for _ in range(3):
         env.step(np.zeros(1, np.float32))

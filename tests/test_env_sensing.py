@@ -14,7 +14,7 @@ from rotordrop_env import BatchedRotorDropVecEnv
 from rotordrop_env.sensors import VELOCITY_ESTIMATE_DT
 from tests.helpers import run_env_checkers
 
-FULL = "RotorDrop-Full-v0"
+FULL = "RotorDrop-Full-v1"
 SUP = dict(command="supervisor", control_dt=0.005, episode_time=0.15, terminate_on_failure=False)
 #: supervisor action: C_max, PID on, nominal gain, no offsets (the inner loop)
 ACTION = np.array([1, 1, 1, 0, 0, 0, 0, 0], dtype=np.float32)
@@ -143,5 +143,5 @@ def test_sensing_is_fixed_at_construction():
 
 def test_env_checkers_pass_with_noise_and_latency():
     run_env_checkers(lambda: gym.make(FULL, **SUP, sensor_noise=2e-6, obs_latency_steps=(1, 3)))
-    run_env_checkers(lambda: gym.make("RotorDrop-Passive-v0", episode_time=0.01,
+    run_env_checkers(lambda: gym.make("RotorDrop-Passive-v1", episode_time=0.01,
                                       sensor_noise=2e-6, obs_latency_steps=2))

@@ -19,13 +19,13 @@ def _make_and_step(env_id: str):
 def test_a_spawned_worker_makes_the_env_with_the_module_prefix():
     ctx = mp.get_context("spawn")
     with ctx.Pool(1) as pool:
-        shape, reward = pool.apply(_make_and_step, ("rotordrop_env:RotorDrop-Damping-v0",))
-    assert shape == gym.make("RotorDrop-Damping-v0").observation_space.shape
+        shape, reward = pool.apply(_make_and_step, ("rotordrop_env:RotorDrop-Damping-v1",))
+    assert shape == gym.make("RotorDrop-Damping-v1").observation_space.shape
     assert np.isfinite(reward)
 
 
 def test_async_make_vec_with_spawned_workers():
-    envs = gym.make_vec("RotorDrop-Passive-v0", num_envs=2, vectorization_mode="async",
+    envs = gym.make_vec("RotorDrop-Passive-v1", num_envs=2, vectorization_mode="async",
                         vector_kwargs={"context": "spawn"}, episode_time=0.002)
     try:
         envs.reset(seed=0)

@@ -39,26 +39,26 @@ def sup(levitate=1.0, gain=0.0, radial=0.0, tangential=0.0, damping=1.0, full=Tr
     return ([damping, damping] + a) if full else a
 
 
-@pytest.mark.parametrize("env_id", ["RotorDrop-Relevitate-v0", "RotorDrop-Full-v0"])
+@pytest.mark.parametrize("env_id", ["RotorDrop-Relevitate-v1", "RotorDrop-Full-v1"])
 def test_env_checkers_pass(env_id):
     run_env_checkers(lambda: gym.make(env_id, command="supervisor", episode_time=0.01))
 
 
 def test_spaces_and_names():
-    env = gym.make("RotorDrop-Full-v0", command="supervisor", episode_time=0.002)
+    env = gym.make("RotorDrop-Full-v1", command="supervisor", episode_time=0.002)
     u = env.unwrapped
     assert u.action_names == ["damping1", "damping2", *SUPERVISOR_ACTIONS]
     assert env.action_space.shape == (8,) and env.action_space.low.min() == -1.0
     assert u.obs_names[-4:] == list(SUPERVISOR_OBS)
     obs, _ = env.reset(seed=0)
     assert obs.dtype == np.float32 and obs.shape == (len(u.obs_names),)
-    relev = gym.make("RotorDrop-Relevitate-v0", command="supervisor", episode_time=0.002)
+    relev = gym.make("RotorDrop-Relevitate-v1", command="supervisor", episode_time=0.002)
     assert relev.unwrapped.action_names == list(SUPERVISOR_ACTIONS)
 
 
 def test_unknown_mode_names_the_modes():
     with pytest.raises(ValueError) as err:
-        gym.make("RotorDrop-Full-v0", command="supervise")
+        gym.make("RotorDrop-Full-v1", command="supervise")
     for mode in COMMANDS:
         assert repr(mode) in str(err.value)
 
@@ -69,7 +69,7 @@ def test_zero_commands_reproduce_the_builtin_controller_exactly():
     kw = dict(episode_time=0.2, terminate_on_failure=False)
     states = {}
     for command, action in (("discrete", [1.0, 1.0, 1.0]), ("supervisor", sup())):
-        env = gym.make("RotorDrop-Full-v0", command=command, **kw)
+        env = gym.make("RotorDrop-Full-v1", command=command, **kw)
         env.reset(seed=0)
         traj = []
         for _ in range(200):
@@ -81,7 +81,7 @@ def test_zero_commands_reproduce_the_builtin_controller_exactly():
 
 
 def test_no_switch_no_levitation():
-    env = gym.make("RotorDrop-Relevitate-v0", command="supervisor", episode_time=0.1)
+    env = gym.make("RotorDrop-Relevitate-v1", command="supervisor", episode_time=0.1)
     _, info = run(env, lambda i: sup(levitate=-1.0, radial=-1.0, full=False), 100)
     assert not info["kpi_relevitated"] and info["kpi_control_effort"] == 0.0
 
@@ -96,7 +96,7 @@ def test_radial_offset_moves_the_equilibrium_by_the_command(a):
     200-270 ms after the offset, earlier or later with the arithmetic's last bits (a different
     step control or summation order moves it). The agent keeps the ring by acting on it every
     1 ms step; a constant command does not."""
-    env = gym.make("RotorDrop-Full-v0", command="supervisor", episode_time=0.5,
+    env = gym.make("RotorDrop-Full-v1", command="supervisor", episode_time=0.5,
                    overrides=STILL, terminate_on_failure=False)
     c = env.unwrapped.scene.contact.clearance
     r, _ = run(env, lambda i: sup(radial=a if i >= 150 else 0.0), 300)
@@ -111,7 +111,7 @@ def test_radial_offset_moves_the_equilibrium_by_the_command(a):
 def test_gain_scale_stiffens_the_loop():
     """A higher gain scale (stiffer closed loop) lifts the rotor to the centre sooner; below
     about 0.7 the PID cannot hold it off the retainer."""
-    env = gym.make("RotorDrop-Full-v0", command="supervisor", episode_time=0.3,
+    env = gym.make("RotorDrop-Full-v1", command="supervisor", episode_time=0.3,
                    terminate_on_failure=False)
     c = env.unwrapped.scene.contact.clearance
     times = []
@@ -125,7 +125,7 @@ def test_gain_scale_stiffens_the_loop():
 
 
 def test_tangential_offset_drives_a_forward_orbit():
-    env = gym.make("RotorDrop-Relevitate-v0", command="supervisor", episode_time=0.3,
+    env = gym.make("RotorDrop-Relevitate-v1", command="supervisor", episode_time=0.3,
                    overrides=STILL, terminate_on_failure=False)
     env.reset(seed=0)
     u = env.unwrapped
@@ -139,16 +139,16 @@ def test_tangential_offset_drives_a_forward_orbit():
 @pytest.mark.parametrize("bad", [0.0, -0.5, 1.5, math.nan, math.inf, "half", True])
 def test_supervisor_authority_out_of_range_names_the_range(bad):
     with pytest.raises(ValueError, match=r"supervisor_authority = .* must be (a real number )?in \(0, 1\]"):
-        gym.make("RotorDrop-Full-v0", command="supervisor", supervisor_authority=bad)
+        gym.make("RotorDrop-Full-v1", command="supervisor", supervisor_authority=bad)
 
 
 def test_supervisor_authority_needs_the_supervisor_command():
     with pytest.raises(ValueError, match="supervisor_authority = 0.5 applies to command='supervisor'"):
-        gym.make("RotorDrop-Full-v0", command="discrete", supervisor_authority=0.5)
+        gym.make("RotorDrop-Full-v1", command="discrete", supervisor_authority=0.5)
 
 
 def trajectory(action, steps: int = 120, **kw):
-    env = gym.make("RotorDrop-Full-v0", command="supervisor", episode_time=0.12,
+    env = gym.make("RotorDrop-Full-v1", command="supervisor", episode_time=0.12,
                    terminate_on_failure=False, **kw)
     env.reset(seed=3)
     traj = []

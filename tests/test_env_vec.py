@@ -18,13 +18,13 @@ def _actions(n_envs, steps, seed=0):
 
 def test_batched_env_equals_single_envs_and_auto_resets():
     n, steps = 3, 6
-    venv = BatchedRotorDropVecEnv("RotorDrop-Damping-v0", n, seed=10, **KW)
+    venv = BatchedRotorDropVecEnv("RotorDrop-Damping-v1", n, seed=10, **KW)
     assert isinstance(venv, VecEnv) and venv.num_envs == n
     acts = _actions(n, steps)
     obs0 = venv.reset()
     batched = [venv.step(acts[k]) for k in range(steps)]
     for e in range(n):
-        env = gym.make("RotorDrop-Damping-v0", **KW)
+        env = gym.make("RotorDrop-Damping-v1", **KW)
         obs, _ = env.reset(seed=10 + e)
         assert np.array_equal(obs, obs0[e])
         for k in range(steps):
@@ -44,7 +44,7 @@ def test_batched_env_equals_single_envs_and_auto_resets():
 
 
 def test_batched_env_errors_and_factory():
-    venv = make_batched("RotorDrop-Relevitate-v0", 2, seed=0, n_threads=1, episode_time=0.003)
+    venv = make_batched("RotorDrop-Relevitate-v1", 2, seed=0, n_threads=1, episode_time=0.003)
     venv.reset()
     with pytest.raises(ValueError, match="out-of-range"):
         venv.step(np.array([0, 3]))
@@ -52,9 +52,9 @@ def test_batched_env_errors_and_factory():
         venv.step(np.zeros(3, dtype=np.int64))
     assert venv.get_attr("obs_names")[0] == venv.envs[0].obs_names
     with pytest.raises(ValueError, match="n_envs"):
-        BatchedRotorDropVecEnv("RotorDrop-Passive-v0", 0)
+        BatchedRotorDropVecEnv("RotorDrop-Passive-v1", 0)
 
 
 def test_checkers_pass_on_the_batched_envs_single_counterpart():
-    venv = BatchedRotorDropVecEnv("RotorDrop-Full-v0", 2, seed=0, episode_time=0.004)
+    venv = BatchedRotorDropVecEnv("RotorDrop-Full-v1", 2, seed=0, episode_time=0.004)
     run_env_checkers(lambda: venv.envs[0])

@@ -21,12 +21,12 @@ def _acts(n_envs, steps, width=2, seed=0):
 def test_batched_rgb_frames_equal_the_single_envs():
     """The batch records every step as a single env does: same orbit/force trace, same frame."""
     steps = 3
-    venv = make_batched("RotorDrop-Damping-v0", 2, seed=4, render_mode="rgb_array", **KW)
+    venv = make_batched("RotorDrop-Damping-v1", 2, seed=4, render_mode="rgb_array", **KW)
     venv.reset()
     acts = _acts(2, steps)
     for k in range(steps):
         venv.step(acts[k])
-    env = gym.make("RotorDrop-Damping-v0", render_mode="rgb_array", episode_time=0.004)
+    env = gym.make("RotorDrop-Damping-v1", render_mode="rgb_array", episode_time=0.004)
     env.reset(seed=5)
     for k in range(steps):
         env.step(acts[k, 1])
@@ -38,7 +38,7 @@ def test_batched_rgb_frames_equal_the_single_envs():
 
 @pytest.mark.filterwarnings("ignore:.*non-interactive 'agg' backend")
 def test_batched_human_mode_redraws_every_step():
-    venv = make_batched("RotorDrop-Passive-v0", 2, seed=0, render_mode="human", **KW)
+    venv = make_batched("RotorDrop-Passive-v1", 2, seed=0, render_mode="human", **KW)
     venv.reset()
     with mock.patch.object(RotorDropEnv, "render", autospec=True) as render:
         venv.step(np.zeros((2, 1), np.float32))
@@ -51,7 +51,7 @@ def test_batched_human_mode_redraws_every_step():
 @pytest.mark.parametrize("copier", [copy.deepcopy, lambda v: pickle.loads(pickle.dumps(v))],
                          ids=["deepcopy", "pickle"])
 def test_a_copied_batch_steps_identically_across_episode_ends(copier):
-    venv = make_batched("RotorDrop-Damping-v0", 2, seed=0, **KW)
+    venv = make_batched("RotorDrop-Damping-v1", 2, seed=0, **KW)
     venv.reset()
     acts = _acts(2, 9)
     venv.step(acts[0])
@@ -71,9 +71,9 @@ def test_a_copied_batch_steps_identically_across_episode_ends(copier):
 
 
 @pytest.mark.parametrize("env_id,bad,match", [
-    ("RotorDrop-Damping-v0", (1, 0, np.nan), "non-finite"),
-    ("RotorDrop-Damping-v0", (2, 1, 1.5), "out-of-range"),
-    ("RotorDrop-Relevitate-v0", (1, 0, 3), "must be 0 \\(stay off\\) or 1"),
+    ("RotorDrop-Damping-v1", (1, 0, np.nan), "non-finite"),
+    ("RotorDrop-Damping-v1", (2, 1, 1.5), "out-of-range"),
+    ("RotorDrop-Relevitate-v1", (1, 0, 3), "must be 0 \\(stay off\\) or 1"),
 ])
 def test_one_bad_action_advances_no_environment(env_id, bad, match):
     venv = make_batched(env_id, 3, seed=0, **KW)
@@ -98,7 +98,7 @@ def test_gym_make_time_limit_final_info_carries_the_kpis():
     with that final step (every step's info carries the KPIs so far), so SB3's Monitor finds
     its info_keywords."""
     keys = ("kpi_backward_whirl", "kpi_peak_contact_force_N", "kpi_episode_time_s")
-    made = gym.make("RotorDrop-Damping-v0", max_episode_steps=3, episode_time=0.01)
+    made = gym.make("RotorDrop-Damping-v1", max_episode_steps=3, episode_time=0.01)
     env = Monitor(made, info_keywords=keys)
     for seed in (0, 1):                             # also after a reset
         env.reset(seed=seed)
@@ -113,4 +113,4 @@ def test_gym_make_time_limit_final_info_carries_the_kpis():
 
 def test_the_batch_refuses_max_episode_steps():
     with pytest.raises(ValueError, match="max_episode_steps.*episode_time"):
-        make_batched("RotorDrop-Damping-v0", 2, max_episode_steps=3)
+        make_batched("RotorDrop-Damping-v1", 2, max_episode_steps=3)

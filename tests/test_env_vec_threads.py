@@ -35,8 +35,8 @@ def test_few_environments_run_on_one_thread_without_trials():
 def test_default_threads_step_exactly_like_one_thread():
     kw = dict(episode_time=0.02, overrides={"contact.friction": 0.5})
     n = 2 * ENVS_PER_THREAD
-    auto = make_batched("RotorDrop-Damping-v0", n, seed=3, **kw)
-    one = make_batched("RotorDrop-Damping-v0", n, seed=3, n_threads=1, **kw)
+    auto = make_batched("RotorDrop-Damping-v1", n, seed=3, **kw)
+    one = make_batched("RotorDrop-Damping-v1", n, seed=3, n_threads=1, **kw)
     rng = np.random.default_rng(0)
     obs_a, obs_o = auto.reset(), one.reset()
     for _ in range(2 * TRIAL_STEPS + 4):            # through the trials of both candidates

@@ -58,8 +58,8 @@ def test_the_vector_env_steps_as_single_envs_episode_by_episode(extra):
     n, steps = 16, 26
     kw = dict(command="supervisor", randomize=True, episode_time=0.012,
               overrides={"bearing.static_load_rating": 3000.0}, **extra)
-    envs = make_vec("RotorDrop-Full-v0", n, **kw)
-    singles = [gym.make("RotorDrop-Full-v0", **kw) for _ in range(n)]
+    envs = make_vec("RotorDrop-Full-v1", n, **kw)
+    singles = [gym.make("RotorDrop-Full-v1", **kw) for _ in range(n)]
     obs, info = envs.reset(seed=5)
     for e, env in enumerate(singles):
         o, i = env.reset(seed=5 + e)
@@ -95,9 +95,9 @@ def test_the_vector_env_matches_gymnasiums_sync_vector_env_in_both_autoreset_mod
     rewards, flags and infos (Gymnasium stores bool infos as object arrays: compared by value),
     also with sensor noise and a drawn latency (each env's random stream)."""
     n, kw = 3, dict(episode_time=0.005, randomize=True, sensor_noise=2e-6, obs_latency_steps=(0, 2))
-    ours = make_vec("RotorDrop-Damping-v0", n, autoreset_mode=mode, **kw)
+    ours = make_vec("RotorDrop-Damping-v1", n, autoreset_mode=mode, **kw)
     assert ours.metadata["autoreset_mode"] is mode
-    ref = gym.make_vec("RotorDrop-Damping-v0", num_envs=n, vectorization_mode="sync",
+    ref = gym.make_vec("RotorDrop-Damping-v1", num_envs=n, vectorization_mode="sync",
                        vector_kwargs={"autoreset_mode": mode}, **kw)
     outs = [v.reset(seed=3) for v in (ours, ref)]
     ours.action_space.seed(0)
@@ -130,9 +130,9 @@ def test_gymnasiums_observation_wrappers_take_the_next_step_mode():
     its RecordEpisodeStatistics takes both."""
     from gymnasium.wrappers.vector import NormalizeObservation, RecordEpisodeStatistics
     with pytest.raises(ValueError, match="NEXT_STEP"):
-        NormalizeObservation(make_vec("RotorDrop-Damping-v0", 2, episode_time=0.003))
+        NormalizeObservation(make_vec("RotorDrop-Damping-v1", 2, episode_time=0.003))
     for mode in ("NextStep", "SameStep"):
-        envs = RecordEpisodeStatistics(make_vec("RotorDrop-Damping-v0", 2, episode_time=0.003,
+        envs = RecordEpisodeStatistics(make_vec("RotorDrop-Damping-v1", 2, episode_time=0.003,
                                                 autoreset_mode=mode))
         if mode == "NextStep":
             envs = NormalizeObservation(envs)
@@ -144,12 +144,12 @@ def test_gymnasiums_observation_wrappers_take_the_next_step_mode():
                 lengths += list(info["episode"]["l"][info["_episode"]])
         assert lengths == [3, 3, 3, 3]                  # two episodes of each env
     with pytest.raises(ValueError, match="autoreset_mode"):
-        make_vec("RotorDrop-Damping-v0", 2, autoreset_mode="Disabled")
+        make_vec("RotorDrop-Damping-v1", 2, autoreset_mode="Disabled")
 
 
 def test_sync_and_async_make_vec_still_work():
     for mode in ("sync", "async"):
-        envs = gym.make_vec("RotorDrop-Passive-v0", num_envs=2, vectorization_mode=mode,
+        envs = gym.make_vec("RotorDrop-Passive-v1", num_envs=2, vectorization_mode=mode,
                             episode_time=0.003)
         envs.reset(seed=0)
         for _ in range(4):
@@ -161,7 +161,7 @@ def test_sync_and_async_make_vec_still_work():
 def test_a_copied_vector_env_steps_like_the_original_and_renders():
     import copy
     import pickle
-    envs = make_vec("RotorDrop-Full-v0", 2, episode_time=0.003, render_mode="rgb_array",
+    envs = make_vec("RotorDrop-Full-v1", 2, episode_time=0.003, render_mode="rgb_array",
                     command="continuous", autoreset_mode="NextStep")
     envs.reset(seed=0)
     envs.action_space.seed(0)
@@ -182,7 +182,7 @@ def test_a_copied_vector_env_steps_like_the_original_and_renders():
 
 
 def test_the_vector_env_set_attr_call_and_errors():
-    envs = make_vec("RotorDrop-Damping-v0", 2, episode_time=0.003)
+    envs = make_vec("RotorDrop-Damping-v1", 2, episode_time=0.003)
     with pytest.raises(gym.error.ResetNeeded):
         envs.step(np.zeros((2, 2), np.float32))
     envs.reset(seed=0)
@@ -194,4 +194,4 @@ def test_the_vector_env_set_attr_call_and_errors():
     with pytest.raises(ValueError, match="out-of-range action"):
         envs.step(np.full((2, 2), 2.0, np.float32))
     with pytest.raises(ValueError, match="max_episode_steps"):
-        make_vec("RotorDrop-Damping-v0", 2, max_episode_steps=3)
+        make_vec("RotorDrop-Damping-v1", 2, max_episode_steps=3)

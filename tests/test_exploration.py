@@ -12,7 +12,7 @@ from agents.hyperparams import ConfigError, load_hyperparams, project_keys, spli
 from agents.train import train
 
 SPREAD = {"damping2": -0.5}
-TINY = ("RotorDrop-Damping-v0:\n  n_steps: 64\n  batch_size: 64\n  n_epochs: 1\n  n_envs: 2\n"
+TINY = ("RotorDrop-Damping-v1:\n  n_steps: 64\n  batch_size: 64\n  n_epochs: 1\n  n_envs: 2\n"
         "  n_eval_episodes: 1\n  validation: false\n"
         "  policy_kwargs: \"dict(net_arch=[8], log_std_init=-2.0)\"\n"
         "  env_kwargs:\n    episode_time: 0.02\n")
@@ -20,7 +20,7 @@ TINY = ("RotorDrop-Damping-v0:\n  n_steps: 64\n  batch_size: 64\n  n_epochs: 1\n
 
 def _model(log_std_init=-2.0):
     """A fresh PPO on SB3's DummyVecEnv of gym.make envs, as rl-zoo3 builds it."""
-    venv = make_vec_env("RotorDrop-Damping-v0", 1, seed=0, env_kwargs=dict(episode_time=0.02))
+    venv = make_vec_env("RotorDrop-Damping-v1", 1, seed=0, env_kwargs=dict(episode_time=0.02))
     return PPO("MlpPolicy", venv, n_steps=64, batch_size=64, seed=0, device="cpu",
                policy_kwargs=dict(net_arch=[8], log_std_init=log_std_init))
 
@@ -49,9 +49,9 @@ def test_a_resumed_model_keeps_the_spread_it_learned():
 def test_the_rl_zoo3_entry_and_the_key_mean_the_same(tmp_path):
     cfg = tmp_path / "c.yaml"
     cfg.write_text("callback:\n  - agents.exploration.ActionSpread: {log_std: {damping2: -0.5}}\n")
-    meta, _ = split(load_hyperparams("ppo", "RotorDrop-Damping-v0", cfg))
+    meta, _ = split(load_hyperparams("ppo", "RotorDrop-Damping-v1", cfg))
     cfg.write_text("action_log_std: {damping2: -0.5}\n")
-    meta2, _ = split(load_hyperparams("ppo", "RotorDrop-Damping-v0", cfg))
+    meta2, _ = split(load_hyperparams("ppo", "RotorDrop-Damping-v1", cfg))
     assert meta["action_log_std"] == meta2["action_log_std"] == SPREAD
     # the shipped block's validation callback is replaced by the user's callback list, as for
     # every callback entry
@@ -64,7 +64,7 @@ def test_the_rl_zoo3_entry_and_the_key_mean_the_same(tmp_path):
 def test_rotordrop_train_starts_from_the_configured_spread(tmp_path):
     cfg = tmp_path / "t.yaml"
     cfg.write_text(TINY + "  action_log_std: {damping1: 0.0}\n  learning_rate: 1.0e-12\n")
-    res = train("RotorDrop-Damping-v0", "ppo", tmp_path / "run", timesteps=128, config=cfg,
+    res = train("RotorDrop-Damping-v1", "ppo", tmp_path / "run", timesteps=128, config=cfg,
                 progress=False)
     assert np.allclose(_log_std(PPO.load(res.model_path)), [0.0, -2.0], atol=1e-6)
 
@@ -86,14 +86,14 @@ def test_bad_spreads_are_named_before_anything_is_written(tmp_path, extra, algo,
     ppo_only = "  n_steps: 64\n  batch_size: 64\n  n_epochs: 1\n"
     cfg.write_text((TINY.replace(ppo_only, "") if algo == "sac" else TINY) + extra)
     with pytest.raises(ConfigError, match=match):
-        train("RotorDrop-Damping-v0", algo, tmp_path / "run", timesteps=128, config=cfg,
+        train("RotorDrop-Damping-v1", algo, tmp_path / "run", timesteps=128, config=cfg,
               progress=False)
     assert not (tmp_path / "run").exists()
 
 
 def test_a_policy_without_a_per_entry_log_std_is_refused():
     """What rl-zoo3 would run: a gSDE PPO, whose log std is per latent feature and entry."""
-    venv = make_vec_env("RotorDrop-Damping-v0", 1, seed=0, env_kwargs=dict(episode_time=0.02))
+    venv = make_vec_env("RotorDrop-Damping-v1", 1, seed=0, env_kwargs=dict(episode_time=0.02))
     model = PPO("MlpPolicy", venv, n_steps=64, batch_size=64, seed=0, device="cpu", use_sde=True,
                 policy_kwargs=dict(net_arch=[8]))
     with pytest.raises(ConfigError, match="needs a policy with one state-independent log std"):

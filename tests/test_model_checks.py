@@ -16,7 +16,7 @@ def test_full_state_observation_sizes_keep_every_state_order_one():
     its observation size stays within 10, the tilt rates included (their old size 0.1 tilt =
     7.9e-5 rad/s gave thousands); only the unbounded angles phi and theta grow. The tolerance
     sizes stay as they were (they set the step sizes)."""
-    env = gym.make("RotorDrop-Passive-v0", overrides={"contact.friction": 0.3, "unbalance.z": 0.3},
+    env = gym.make("RotorDrop-Passive-v1", overrides={"contact.friction": 0.3, "unbalance.z": 0.3},
                    full_state=True, terminate_on_failure=False)
     u = env.unwrapped
     env.reset(seed=0)

@@ -24,9 +24,9 @@ def test_whirl_bound_never_reports_worse_than_its_baseline(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("args, message", [
-    (["whirl-bound", "--env", "RotorDrop-Damping-v0"], "--env must be one of RotorDrop-Relevitate-v0"),
+    (["whirl-bound", "--env", "RotorDrop-Damping-v1"], "--env must be one of RotorDrop-Relevitate-v1"),
     (["whirl-bound", "--baseline", "max-damping"], "must be a controller that commands the AMB currents"),
-    (["tune-whirl-brake", "--env", "RotorDrop-Nope-v0"], "not the environment of a benchmark task"),
+    (["tune-whirl-brake", "--env", "RotorDrop-Nope-v1"], "not the environment of a benchmark task"),
 ])
 def test_research_usage_errors_are_one_line(tmp_path, capsys, args, message):
     assert main(["research", *args, "--out", str(tmp_path)]) == 2

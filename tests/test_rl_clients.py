@@ -23,7 +23,7 @@ def test_torchrl_reads_every_info_key_and_trains_ppo(tmp_path):
     from torchrl.objectives.value import GAE
     warnings.simplefilter("ignore")
     torch.manual_seed(0)
-    made = gym.make("RotorDrop-Full-v0", command="supervisor", episode_time=0.05, reward="kpi")
+    made = gym.make("RotorDrop-Full-v1", command="supervisor", episode_time=0.05, reward="kpi")
     info_keys = set(made.reset(seed=0)[1])
     env = GymWrapper(made)
     env.auto_register_info_dict()
@@ -94,7 +94,7 @@ def test_skrl_ppo_trains_on_the_vector_env(tmp_path):
 
     warnings.simplefilter("ignore")
     torch.manual_seed(0)
-    venv = gym.make_vec("RotorDrop-Damping-v0", num_envs=8, vectorization_mode="vector_entry_point",
+    venv = gym.make_vec("RotorDrop-Damping-v1", num_envs=8, vectorization_mode="vector_entry_point",
                         episode_time=0.05, reward="kpi")
     env = wrap_env(venv, wrapper="gymnasium")
     assert env.num_envs == 8

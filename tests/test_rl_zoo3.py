@@ -21,8 +21,8 @@ from rotordrop_env import make_batched
 
 ROOT = Path(__file__).resolve().parents[1]
 #: what the shipped PPO blocks meant before they were written as rl-zoo3 entries
-SHIPPED = {"RotorDrop-Damping-v0": ("max-damping", 0.5), "RotorDrop-Relevitate-v0": ("whirl-brake", 0.5),
-           "RotorDrop-Full-v0": ("whirl-brake", 1.0)}
+SHIPPED = {"RotorDrop-Damping-v1": ("max-damping", 0.5), "RotorDrop-Relevitate-v1": ("whirl-brake", 0.5),
+           "RotorDrop-Full-v1": ("whirl-brake", 1.0)}
 
 
 def _zoo(module, *args, timeout=300):
@@ -39,16 +39,16 @@ def test_rl_zoo3_trains_from_the_shipped_yaml_with_the_projects_wrappers_and_cal
     interval shortened (rl-zoo3's -params) so that it runs and keeps a self-contained best."""
     best = tmp_path / "validation"
     callback = f"[{{'agents.validation.ValidationCallback': {{'eval_freq': 512, 'save_path': '{best}'}}}}]"
-    out = _zoo("train", "--algo", "ppo", "--env", "RotorDrop-Damping-v0", "--gym-packages",
+    out = _zoo("train", "--algo", "ppo", "--env", "RotorDrop-Damping-v1", "--gym-packages",
                "rotordrop_env", "-conf", "agents/configs/ppo.yaml", "-n", "300", "-f", str(tmp_path),
                "--eval-freq", "-1", "--num-threads", "1", "--seed", "0", "-params",
                f"callback:{callback}")
     assert "validation score" in out
-    run = tmp_path / "ppo" / "RotorDrop-Damping-v0_1"
-    saved = yaml.load((run / "RotorDrop-Damping-v0" / "config.yml").read_text(), Loader=yaml.UnsafeLoader)
+    run = tmp_path / "ppo" / "RotorDrop-Damping-v1_1"
+    saved = yaml.load((run / "RotorDrop-Damping-v1" / "config.yml").read_text(), Loader=yaml.UnsafeLoader)
     assert dict(saved)["vec_env_wrapper"][0] == {"agents.residual.ResidualAction":
                                                  {"base": "max-damping", "scale": 0.5}}
-    model = PPO.load(run / "RotorDrop-Damping-v0.zip", device="cpu")
+    model = PPO.load(run / "RotorDrop-Damping-v1.zip", device="cpu")
     assert model.num_timesteps == 1024                          # one rollout of 8 x 128 steps
     assert (best / "best_model.zip").is_file()
     chosen = PPO.load(best / "best_model.zip", device="cpu")     # plain SB3, residual inside
@@ -57,7 +57,7 @@ def test_rl_zoo3_trains_from_the_shipped_yaml_with_the_projects_wrappers_and_cal
 
 def test_rl_zoo3_enjoy_plays_a_shipped_policy(tmp_path):
     export_zoo("ppo-damping", tmp_path)
-    out = _zoo("enjoy", "--algo", "ppo", "--env", "RotorDrop-Damping-v0", "--gym-packages",
+    out = _zoo("enjoy", "--algo", "ppo", "--env", "RotorDrop-Damping-v1", "--gym-packages",
                "rotordrop_env", "-f", str(tmp_path), "--exp-id", "-1", "--no-render",
                "--deterministic", "-n", "61", "--num-threads", "1")
     assert "Episode Length 60" in out                          # 0.3 s at its 5 ms control step
@@ -75,10 +75,10 @@ def test_the_shipped_entries_are_the_projects_options(env_id):
 def test_a_user_config_overrides_the_entries_in_either_form(tmp_path):
     cfg = tmp_path / "c.yaml"
     cfg.write_text("residual: whirl-switch\nresidual_scale: 1.0\n")            # the old keys
-    meta, _ = split(load_hyperparams("ppo", "RotorDrop-Damping-v0", cfg))
+    meta, _ = split(load_hyperparams("ppo", "RotorDrop-Damping-v1", cfg))
     assert (meta["residual"], meta["residual_scale"], meta["reward"]) == ("whirl-switch", 1.0, "kpi")
     cfg.write_text("vec_env_wrapper: []\ncallback: []\n")                        # drop them
-    meta, _ = split(load_hyperparams("ppo", "RotorDrop-Damping-v0", cfg))
+    meta, _ = split(load_hyperparams("ppo", "RotorDrop-Damping-v1", cfg))
     assert meta.get("residual") is None and meta["reward"] == "env" and meta["validation"] is False
 
 
@@ -103,8 +103,8 @@ def test_the_wrappers_on_sb3s_dummy_vec_env_equal_the_batched_training_env():
     (the batched VecEnv): same observations and KPI rewards under the same residual."""
     kw = dict(command="continuous", randomize=True, episode_time=0.02, terminate_on_failure=False)
     envs = [KpiReward(ResidualAction(v, base="whirl-brake", scale=0.5)) for v in
-            (make_vec_env("RotorDrop-Full-v0", 2, seed=0, env_kwargs=kw),
-             make_batched("RotorDrop-Full-v0", 2, seed=0, n_threads=1, **kw))]
+            (make_vec_env("RotorDrop-Full-v1", 2, seed=0, env_kwargs=kw),
+             make_batched("RotorDrop-Full-v1", 2, seed=0, n_threads=1, **kw))]
     assert np.array_equal(envs[0].reset(), envs[1].reset())
     rng = np.random.default_rng(0)
     for _ in range(45):                                            # past two episode ends
@@ -128,7 +128,7 @@ def test_every_shipped_yaml_has_only_keys_rl_zoo3_passes_on_correctly():
 
 def test_the_run_flags_override_the_config(tmp_path):
     from agents.train import resolve_config
-    hp = resolve_config("RotorDrop-Damping-v0", "ppo", eval_freq=1000, n_eval_episodes=2,
+    hp = resolve_config("RotorDrop-Damping-v1", "ppo", eval_freq=1000, n_eval_episodes=2,
                         checkpoint_freq=0)
     meta, _ = split(hp)
     assert (meta["eval_freq"], meta["n_eval_episodes"], meta["checkpoint_freq"]) == (1000, 2, 0)
@@ -139,7 +139,7 @@ def test_export_policy_command(tmp_path, capsys):
     assert main(["export-policy", "ppo-relevitate", "--out", str(tmp_path / "p.zip")]) == 0
     assert PPO.load(tmp_path / "p.zip", device="cpu").policy.rotordrop["residual"] == "whirl-brake"
     assert main(["export-policy", "ppo-relevitate", "--zoo", str(tmp_path / "zoo")]) == 0
-    assert "rl_zoo3.enjoy --algo ppo --env RotorDrop-Relevitate-v0" in capsys.readouterr().out
-    assert (tmp_path / "zoo" / "ppo" / "RotorDrop-Relevitate-v0" / "config.yml").is_file()
+    assert "rl_zoo3.enjoy --algo ppo --env RotorDrop-Relevitate-v1" in capsys.readouterr().out
+    assert (tmp_path / "zoo" / "ppo" / "RotorDrop-Relevitate-v1" / "config.yml").is_file()
     assert main(["export-policy", "no-such-policy", "--out", str(tmp_path / "x.zip")]) == 2
     assert "no-such-policy" in capsys.readouterr().err

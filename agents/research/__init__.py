@@ -20,8 +20,8 @@ def register(subparsers) -> None:
 
     q = sub.add_parser("whirl-bound", help="how few backward-whirl revolutions can any AMB current "
                                            "sequence reach once the power is back? (whirl_bound.json)")
-    q.add_argument("--env", default="RotorDrop-Relevitate-v0",
-                   help="RotorDrop-Relevitate-v0 or RotorDrop-Full-v0")
+    q.add_argument("--env", default="RotorDrop-Relevitate-v1",
+                   help="RotorDrop-Relevitate-v1 or RotorDrop-Full-v1")
     q.add_argument("--baseline", default="whirl-brake",
                    help="a controller that commands the AMB currents: baseline name, "
                         "module:Class or file.py:Class")
@@ -41,8 +41,8 @@ def register(subparsers) -> None:
 
     q = sub.add_parser("tune-whirl-brake", help="tune the whirl-brake baseline's gains by "
                                                 "cross-entropy search on a tuning set (tune.json)")
-    q.add_argument("--env", default="RotorDrop-Relevitate-v0",
-                   help="RotorDrop-Relevitate-v0 or RotorDrop-Full-v0")
+    q.add_argument("--env", default="RotorDrop-Relevitate-v1",
+                   help="RotorDrop-Relevitate-v1 or RotorDrop-Full-v1")
     q.add_argument("--iterations", type=at_least(1), default=12)
     q.add_argument("--population", type=at_least(1), default=24)
     q.add_argument("--elite", type=at_least(1), default=6)
