@@ -211,15 +211,18 @@ def collect(make_actor, env_id: str, env_kwargs: dict, seeds, progress: bool = F
 
 
 def _jsonable(value):
-    """Numbers and containers as JSON types (numpy scalars -> Python; NaN kept as NaN)."""
+    """Numbers and containers as strict JSON types (numpy scalars -> Python, NaN and
+    infinities -> None, as the project's reports write them)."""
     if isinstance(value, dict):
         return {str(k): _jsonable(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
         return [_jsonable(v) for v in value]
-    if isinstance(value, np.generic):
-        return value.item()
     if isinstance(value, np.ndarray):
-        return value.tolist()
+        return _jsonable(value.tolist())
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
     return value
 
 

@@ -1,0 +1,188 @@
+"""``rotordrop dataset`` (Minari data sets) and ``rotordrop bc`` (behaviour cloning): the
+stored episodes equal a replay of the same controller on the same seeds, the seeds and
+scenarios are recorded, bad input is one line naming the parameter, and a cloned policy
+fits its teacher and runs in the benchmark."""
+import math
+
+import numpy as np
+import pytest
+
+minari = pytest.importorskip("minari")
+
+from agents.cli import main
+from agents.dataset import info_arrays, info_columns, write_dataset
+from agents.evaluate import _actor, _merge_kwargs
+from agents.plant import Plant, make_env
+
+FULL = "RotorDrop-Full-v0"
+DAMPING = "RotorDrop-Damping-v0"
+
+
+def _replay(policy, env_id, user_kwargs, seeds, randomize=True):
+    """The episodes as evaluate would run them, written out here step by step (not through
+    agents.dataset): [(observations, actions, rewards, terminated, truncated, infos)]."""
+    make_actor, env_id, base, _ = _actor(policy, env_id)
+    env = make_env(env_id, **_merge_kwargs(base, user_kwargs, randomize))
+    plant = Plant.from_env(env)
+    out = []
+    for s in seeds:
+        actor = make_actor(plant)
+        obs, info = env.reset(seed=s)
+        o, a, r, te, tr, infos = [obs], [], [], [], [], [info]
+        first = True
+        while True:
+            act, _ = actor.predict(obs[None, :], episode_start=np.array([first]), deterministic=True)
+            first = False
+            obs, rew, term, trunc, info = env.step(act[0])
+            o.append(obs)
+            a.append(np.asarray(act[0], dtype=env.action_space.dtype))
+            r.append(rew)
+            te.append(term)
+            tr.append(trunc)
+            infos.append(info)
+            if term or trunc:
+                break
+        out.append((np.array(o), np.array(a), np.array(r), np.array(te), np.array(tr), infos))
+    env.close()
+    return out
+
+
+def _check_round_trip(ds, expected, seeds):
+    assert ds.total_episodes == len(seeds)
+    assert ds.total_steps == sum(len(e[2]) for e in expected)
+    metas = list(ds.storage.get_episode_metadata(range(ds.total_episodes)))
+    assert [m["seed"] for m in metas] == seeds
+    assert ds.storage.metadata["rotordrop"]["seeds"] == seeds
+    for ep, meta, (obs, act, rew, term, trunc, infos) in zip(ds.iterate_episodes(), metas, expected):
+        np.testing.assert_array_equal(ep.observations, obs)
+        np.testing.assert_array_equal(ep.actions, act)
+        np.testing.assert_array_equal(ep.rewards, rew)
+        np.testing.assert_array_equal(ep.terminations, term)
+        np.testing.assert_array_equal(ep.truncations, trunc)
+        # infos: the reset row, then one per step; the KPIs on the last row only
+        np.testing.assert_array_equal(ep.infos["time_s"], [i["time_s"] for i in infos])
+        np.testing.assert_array_equal(ep.infos["contact_force_N"][1:],
+                                      [i["contact_force_N"] for i in infos[1:]])
+        assert math.isnan(ep.infos["contact_force_N"][0])
+        assert np.isnan(ep.infos["kpi_peak_contact_force_N"][:-1]).all()
+        assert ep.infos["kpi_peak_contact_force_N"][-1] == infos[-1]["kpi_peak_contact_force_N"]
+        assert meta["kpis"]["peak_contact_force_N"] == infos[-1]["kpi_peak_contact_force_N"]
+        assert meta["scenario"] == pytest.approx(infos[0]["scenario"])
+        assert meta["return"] == pytest.approx(float(np.sum(rew)))
+
+
+def test_whirl_brake_on_full_round_trips_through_minari(tmp_path, monkeypatch):
+    seeds = [5, 6, 7]
+    kw = {"episode_time": 0.06}
+    r = write_dataset("whirl-brake", FULL, 3, tmp_path / "root", seed=5, env_kwargs=kw,
+                      progress=False)
+    assert r["dataset_id"] == "rotordrop/full/whirl-brake-v0"
+    assert (tmp_path / "root" / r["dataset_id"] / "data").is_dir()
+    monkeypatch.setenv("MINARI_DATASETS_PATH", str(tmp_path / "root"))
+    ds = minari.load_dataset(r["dataset_id"])
+    _check_round_trip(ds, _replay("whirl-brake", FULL, kw, seeds), seeds)
+    # every episode drew its own scenario (randomize is on by default)
+    frictions = [m["scenario"]["contact.friction"]
+                 for m in ds.storage.get_episode_metadata(range(3))]
+    assert len(set(frictions)) == 3
+    # Minari rebuilds the environment with the kwargs the episodes ran with
+    env = ds.recover_environment()
+    assert env.spec.id == FULL and env.spec.kwargs["episode_time"] == 0.06
+    assert env.spec.kwargs["command"] == "continuous"
+    env.close()
+
+
+def test_damping_controller_round_trips_with_fixed_scene(tmp_path):
+    kw = {"episode_time": 0.05, "overrides": {"contact.friction": 0.45}}
+    assert main(["dataset", "--policy", "whirl-switch", "--env", DAMPING, "--episodes", "2",
+                 "--seed", "3", "--out", str(tmp_path), "--name", "damping/switch-v1", "--quiet",
+                 "--env-kwarg", "episode_time=0.05", "--env-kwarg", "randomize=False",
+                 "--env-kwarg", "overrides={'contact.friction': 0.45}"]) == 0
+    from agents.dataset import load
+    ds = load("damping/switch-v1", tmp_path)
+    assert ds.storage.metadata["rotordrop"]["policy_name"] == "whirl-switch"
+    _check_round_trip(ds, _replay("whirl-switch", DAMPING, kw, [3, 4], randomize=False), [3, 4])
+    assert all(m["scenario"]["contact.friction"] == 0.45
+               for m in ds.storage.get_episode_metadata(range(2)))
+    # the data set's directory loads too, and an existing id is not overwritten silently
+    assert load(tmp_path / "damping/switch-v1").total_episodes == 2
+    assert main(["dataset", "--policy", "whirl-switch", "--env", DAMPING, "--episodes", "1",
+                 "--out", str(tmp_path), "--name", "damping/switch-v1", "--quiet"]) == 2
+
+
+def test_info_columns_keep_scalars_of_every_step_and_the_last_steps_kpis():
+    reset = {"scenario": {"contact.friction": 0.3}, "time_s": 0.0}
+    steps = [{"f": 1.0, "w": False, "n": 3, "only_first": 1.0, "nested": {"a": 1}},
+             {"f": 2.0, "w": True, "n": 4, "nested": {"a": 2}, "kpi_x": np.float64(7.0),
+              "kpi_t": None, "kpi_b": True}]
+    cols = info_columns(reset, steps)
+    assert cols == {"f": "float", "w": "bool", "n": "float", "kpi_x": "float", "kpi_t": "float",
+                    "kpi_b": "float"}
+    arr = info_arrays(cols, [reset, *steps])
+    np.testing.assert_array_equal(arr["w"], [False, False, True])
+    assert arr["w"].dtype == bool
+    np.testing.assert_array_equal(arr["f"], [np.nan, 1.0, 2.0])
+    np.testing.assert_array_equal(arr["kpi_x"], [np.nan, np.nan, 7.0])
+    np.testing.assert_array_equal(arr["kpi_b"], [np.nan, np.nan, 1.0])
+    assert np.isnan(arr["kpi_t"]).all()
+
+
+@pytest.mark.parametrize("args, names", [
+    (["--policy", "no-such-policy", "--env", FULL, "--episodes", "2"],
+     ["--policy", "whirl-brake", "inner-loop-lift", "max-damping"]),
+    (["--policy", "whirl-brake", "--env", "RotorDrop-Nope-v0", "--episodes", "2"],
+     ["--env", FULL, DAMPING]),
+    (["--policy", "whirl-brake", "--env", FULL, "--episodes", "0"], ["--episodes", ">= 1"]),
+    (["--policy", "whirl-brake", "--env", FULL, "--episodes", "1", "--env-kwarg", "oops"],
+     ["--env-kwarg", "KEY=VALUE"]),
+])
+def test_bad_input_is_one_line_naming_the_parameter(tmp_path, capsys, args, names):
+    assert main(["dataset", *args, "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("rotordrop dataset: error:")
+    for n in names:
+        assert n in err[0]
+    assert not any(tmp_path.rglob("metadata.json"))
+
+
+def test_bc_clones_the_teacher_and_runs_in_the_benchmark(tmp_path):
+    from agents.benchmark import Entry, scenario_suite, suite_rows, extras
+    from agents.dataset import load
+    from agents.imitation import dataset_arrays, train_bc
+    root = tmp_path / "root"
+    r = write_dataset("whirl-brake", FULL, 6, root, env_kwargs={"episode_time": 0.06},
+                      progress=False)
+    rep = train_bc(r["dataset_id"], tmp_path / "bc", root=root, epochs=150, batch_size=64,
+                   progress=False)
+    assert rep["episodes"] == {"train": 5, "validation": 1}
+    # the cloned policy as the benchmark loads it: its actions against the teacher's on the
+    # training observations
+    policies, _ = extras([str(tmp_path / "bc" / "model.zip")])
+    pol = policies[0]
+    assert pol.name == "bc-whirl-brake@bc" and pol.env_id == FULL
+    ds = load(r["dataset_id"], root)
+    train = [i for i, m in enumerate(ds.storage.get_episode_metadata(range(6)))
+             if m["seed"] not in rep["validation_seeds"]]
+    obs, act = dataset_arrays(ds, train)
+    pred, _ = pol.predict(obs, deterministic=True)
+    mse = np.mean(np.sum((pred - act) ** 2, axis=1))
+    variance = np.sum(act.var(axis=0))
+    assert mse < 0.2 * variance
+    assert rep["train"]["mse"] == pytest.approx(mse, rel=1e-5)
+    # an untrained network of the same shape is far off (the fit is the training's doing)
+    rep0 = train_bc(r["dataset_id"], tmp_path / "bc0", root=root, epochs=1, lr=1e-9,
+                    progress=False)
+    assert rep0["train"]["mse_over_variance"] > 0.5
+    # the benchmark machinery runs it on one scenario
+    entry = Entry(pol.name, "full", pol.bound, dict(pol.env_kwargs))
+    rows = suite_rows(entry, scenario_suite(0.3, quick=True)[:1], (0.0,))
+    assert len(rows) == 1 and rows[0]["controller"] == "bc-whirl-brake@bc"
+    assert np.isfinite(rows[0]["peak_contact_force_N"])
+
+
+def test_bc_refuses_discrete_actions(tmp_path):
+    from agents.imitation import train_bc
+    r = write_dataset("builtin-relevitate", "RotorDrop-Relevitate-v0", 1, tmp_path,
+                      env_kwargs={"episode_time": 0.06}, progress=False)
+    with pytest.raises(ValueError, match="Box"):
+        train_bc(r["dataset_id"], tmp_path / "bc", root=tmp_path, progress=False)
