@@ -47,8 +47,6 @@ from pathlib import Path
 
 import numpy as np
 
-from .controllers import Controller
-
 #: Minari storage format (pyarrow; no h5py needed)
 DATA_FORMAT = "arrow"
 #: metadata key of everything rotordrop records about the data set
@@ -197,6 +195,7 @@ def run_episode(env, plant, actor, seed: int) -> Collected:
 def collect(make_actor, env_id: str, env_kwargs: dict, seeds, progress: bool = False):
     """Run one episode per seed (a controller anew each episode); yields :class:`Collected`."""
     from tqdm.auto import tqdm
+    from .controllers import Controller
     from .plant import Plant, make_env
     env = make_env(env_id, **env_kwargs)
     try:

@@ -186,3 +186,26 @@ def test_bc_refuses_discrete_actions(tmp_path):
                       env_kwargs={"episode_time": 0.06}, progress=False)
     with pytest.raises(ValueError, match="Box"):
         train_bc(r["dataset_id"], tmp_path / "bc", root=tmp_path, progress=False)
+
+
+BLOCK_MINARI = """
+import importlib.abc, sys
+class NoMinari(importlib.abc.MetaPathFinder):
+    def find_spec(self, name, path=None, target=None):
+        if name.split(".")[0] == "minari":
+            raise ModuleNotFoundError(f"No module named {name!r}", name=name)
+sys.meta_path.insert(0, NoMinari())
+from agents.cli import main
+sys.exit(main(sys.argv[1:]))
+"""
+
+
+def test_dataset_without_minari_names_the_offline_extra(tmp_path):
+    import subprocess
+    import sys
+    from pathlib import Path
+    proc = subprocess.run([sys.executable, "-c", BLOCK_MINARI, "dataset", "--policy", "max-damping",
+                           "--env", DAMPING, "--episodes", "1", "--out", str(tmp_path)],
+                          cwd=Path(__file__).resolve().parents[1], capture_output=True, text=True)
+    assert proc.returncode == 2
+    assert proc.stderr.count("\n") == 1 and "offline extra" in proc.stderr, proc.stderr
