@@ -49,6 +49,21 @@ def dataset_arrays(ds, episodes=None) -> tuple[np.ndarray, np.ndarray]:
     return np.concatenate(obs), np.concatenate(act)
 
 
+def duplicate_columns(obs: np.ndarray, names) -> list[tuple[str, str]]:
+    """Pairs of observations that are equal in every sample (and not constant): the data never
+    tell them apart, so the clone cannot learn how to act when they differ. A symmetric
+    teacher on the symmetric drop keeps the two bearing planes identical (x1 = x2, ...), and
+    its clone then loses a tilting rotor; recording with sensor noise
+    (``--env-kwarg sensor_noise=1e-6``) separates them (docs/datasets.md)."""
+    pairs = []
+    varying = [j for j in range(obs.shape[1]) if np.ptp(obs[:, j]) > 0]
+    for a, i in enumerate(varying):
+        for j in varying[a + 1:]:
+            if np.array_equal(obs[:, i], obs[:, j]):
+                pairs.append((names[i], names[j]))
+    return pairs
+
+
 def obs_statistics(obs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Mean and variance per observation; a (near-)constant one keeps variance 1, so that
     it is only shifted (divided by ~0 it would map any new value to the clip)."""
@@ -134,12 +149,14 @@ def train_bc(dataset: str | Path, out: str | Path, root: str | Path | None = Non
             if time_limit is not None and time.perf_counter() - t0 > time_limit:
                 break
         fit_s = time.perf_counter() - t0
+        names = list(env.unwrapped.obs_names)
         report = dict(name=name, teacher=teacher, dataset=ds.id, env_id=meta["env_id"],
                       env_kwargs=meta["env_kwargs"], episodes=dict(train=len(train_eps),
                                                                    validation=len(val_eps)),
                       samples=int(len(x)), hidden=list(hidden), lr=lr, batch_size=batch_size,
                       epochs=done, seed=seed, fit_s=fit_s,
-                      train=fit_quality(policy, obs, act))
+                      train=fit_quality(policy, obs, act),
+                      duplicate_observations=[list(p) for p in duplicate_columns(obs, names)])
         if val_eps:
             report["validation"] = fit_quality(policy, *dataset_arrays(ds, val_eps))
         report["validation_seeds"] = [episode_metadata(ds)[i]["seed"] for i in val_eps]
@@ -220,6 +237,10 @@ def cmd_bc(args) -> int:
     print(f"{r['name']}: {r['samples']} samples ({r['episodes']['train']} episodes), {r['epochs']} "
           f"epochs in {r['fit_s']:.0f} s; MSE / action variance: train {fit['mse_over_variance']:.3f}"
           + (f", validation {val['mse_over_variance']:.3f}" if val else ""))
+    if r["duplicate_observations"]:
+        print("warning: observations equal in every sample (the clone cannot tell them apart; "
+              "record with --env-kwarg sensor_noise=1e-6, docs/datasets.md): "
+              + ", ".join("=".join(p) for p in r["duplicate_observations"]))
     print(f"wrote {Path(r['out']) / 'model.zip'}, bc.json; run it: python3 -m agents.cli "
           f"benchmark --quick --policy {Path(r['out']) / 'model.zip'}")
     return 0

@@ -155,6 +155,9 @@ def test_bc_clones_the_teacher_and_runs_in_the_benchmark(tmp_path):
     rep = train_bc(r["dataset_id"], tmp_path / "bc", root=root, epochs=150, batch_size=64,
                    progress=False)
     assert rep["episodes"] == {"train": 5, "validation": 1}
+    # the symmetric drop under a symmetric teacher: the two bearing planes never differ
+    assert ["x1", "x2"] in rep["duplicate_observations"]
+    assert ["vy1", "vy2"] in rep["duplicate_observations"]
     # the cloned policy as the benchmark loads it: its actions against the teacher's on the
     # training observations
     policies, _ = extras([str(tmp_path / "bc" / "model.zip")])
@@ -209,3 +212,11 @@ def test_dataset_without_minari_names_the_offline_extra(tmp_path):
                           cwd=Path(__file__).resolve().parents[1], capture_output=True, text=True)
     assert proc.returncode == 2
     assert proc.stderr.count("\n") == 1 and "offline extra" in proc.stderr, proc.stderr
+
+
+def test_duplicate_columns_names_pairs_equal_in_every_sample():
+    from agents.imitation import duplicate_columns
+    x = np.array([[1.0, 1.0, 5.0, 0.0, 2.0], [2.0, 2.0, 5.0, 0.0, 2.0], [3.0, 3.0, 5.0, 0.0, 3.0]])
+    assert duplicate_columns(x, ["a", "b", "c", "d", "e"]) == [("a", "b")]   # constants do not count
+    x[1, 1] += 1e-6
+    assert duplicate_columns(x, ["a", "b", "c", "d", "e"]) == []
