@@ -238,8 +238,9 @@ def cmd_bc(args) -> int:
           f"epochs in {r['fit_s']:.0f} s; MSE / action variance: train {fit['mse_over_variance']:.3f}"
           + (f", validation {val['mse_over_variance']:.3f}" if val else ""))
     if r["duplicate_observations"]:
-        print("warning: observations equal in every sample (the clone cannot tell them apart; "
-              "record with --env-kwarg sensor_noise=1e-6, docs/datasets.md): "
+        print("warning: observations equal in every sample (the data never tell them apart: "
+              "where they differ, the clone acts on inputs it was not trained on; see "
+              "docs/datasets.md): "
               + ", ".join("=".join(p) for p in r["duplicate_observations"]))
     print(f"wrote {Path(r['out']) / 'model.zip'}, bc.json; run it: python3 -m agents.cli "
           f"benchmark --quick --policy {Path(r['out']) / 'model.zip'}")
