@@ -51,6 +51,8 @@ import numpy as np
 DATA_FORMAT = "arrow"
 #: metadata key of everything rotordrop records about the data set
 META_KEY = "rotordrop"
+#: episodes held in memory before they are written
+CHUNK = 100
 
 
 def default_dataset_id(policy_name: str, env_id: str) -> str:
@@ -267,38 +269,47 @@ def write_dataset(policy: str, env_id: str | None, episodes: int, out: str | Pat
     seeds = list(range(seed, seed + episodes))
     t0 = time.perf_counter()
     from minari.data_collector.episode_buffer import EpisodeBuffer
-    buffers, extra, columns = [], [], None
-    for i, ep in enumerate(collect(make_actor, env_id, kwargs, seeds, progress)):
-        if columns is None:
-            columns = info_columns(ep.infos[0], ep.infos[1:])
-        buffers.append(EpisodeBuffer(id=i, seed=ep.seed, observations=ep.observations,
-                                     actions=ep.actions, rewards=list(ep.rewards),
-                                     terminations=list(ep.terminations),
-                                     truncations=list(ep.truncations),
-                                     # lists: Minari's arrow storage cannot read back 1-D
-                                     # arrays (it records an empty shape for them)
-                                     infos={k: v.tolist() for k, v in
-                                            info_arrays(columns, ep.infos).items()}))
-        extra.append(dict(scenario=_jsonable(ep.scenario), kpis=_jsonable(ep.kpis),
-                          **{"return": float(ep.rewards.sum())}))
-    run_s = time.perf_counter() - t0
-    meta = dict(policy=policy, policy_name=name, env_id=env_id, env_kwargs=_jsonable(kwargs),
-                user_env_kwargs=_jsonable(user), randomize=randomize, seeds=seeds, info_columns=columns, command=_command())
     from .plant import make_env
+    meta = dict(policy=policy, policy_name=name, env_id=env_id, env_kwargs=_jsonable(kwargs),
+                user_env_kwargs=_jsonable(user), randomize=randomize, seeds=seeds,
+                command=_command())
+    ds, columns, steps, pending, extra = None, None, 0, [], []
     spec_env = make_env(env_id, **kwargs)          # its spec (id + kwargs): recover_environment
     try:
         with datasets_root(root), warnings.catch_warnings():
             warnings.filterwarnings("ignore", message=r".*(code_permalink|author|author_email|"
                                     r"description|eval_env|algorithm_name).*", category=UserWarning)
-            ds = minari.create_dataset_from_buffers(
-                dataset_id, buffers, env=spec_env, algorithm_name=name, author="rotordrop",
-                description=f"{episodes} seeded episodes of {name} on {env_id} (rotordrop dataset)",
-                data_format=DATA_FORMAT)
-            ds.storage.update_episode_metadata(extra, range(len(extra)))
-            ds.storage.update_metadata({META_KEY: meta})
+            for i, ep in enumerate(collect(make_actor, env_id, kwargs, seeds, progress)):
+                if columns is None:
+                    columns = info_columns(ep.infos[0], ep.infos[1:])
+                pending.append(EpisodeBuffer(
+                    id=i, seed=ep.seed, observations=ep.observations, actions=ep.actions,
+                    rewards=list(ep.rewards), terminations=list(ep.terminations),
+                    truncations=list(ep.truncations),
+                    # lists: Minari's arrow storage cannot read back 1-D arrays (it records an
+                    # empty shape for them)
+                    infos={k: v.tolist() for k, v in info_arrays(columns, ep.infos).items()}))
+                extra.append(dict(scenario=_jsonable(ep.scenario), kpis=_jsonable(ep.kpis),
+                                  **{"return": float(ep.rewards.sum())}))
+                if len(pending) == CHUNK or i == episodes - 1:     # bounded memory
+                    if ds is None:
+                        ds = minari.create_dataset_from_buffers(
+                            dataset_id, pending, env=spec_env, algorithm_name=name,
+                            author="rotordrop", data_format=DATA_FORMAT,
+                            description=f"{episodes} seeded episodes of {name} on {env_id} "
+                                        f"(rotordrop dataset)")
+                    else:
+                        ds.storage.update_episodes(pending)
+                    ds.storage.update_episode_metadata(extra, range(i + 1 - len(extra), i + 1))
+                    steps += sum(len(b) for b in pending)
+                    pending, extra = [], []
+            ds.storage.update_metadata({META_KEY: dict(meta, info_columns=columns)})
+    except BaseException:
+        shutil.rmtree(target, ignore_errors=True)               # no half-written data set
+        raise
     finally:
         spec_env.close()
-    steps = int(sum(len(b) for b in buffers))
+    run_s = time.perf_counter() - t0
     return dict(dataset_id=dataset_id, root=str(root), path=str(target), episodes=episodes,
                 steps=steps, seeds=seeds, policy=name, env_id=env_id, run_s=run_s,
                 episodes_per_s=episodes / run_s if run_s > 0 else math.inf,

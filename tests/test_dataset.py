@@ -72,6 +72,7 @@ def _check_round_trip(ds, expected, seeds):
 
 
 def test_whirl_brake_on_full_round_trips_through_minari(tmp_path, monkeypatch):
+    monkeypatch.setattr("agents.dataset.CHUNK", 2)          # written in two parts: 2 + 1
     seeds = [5, 6, 7]
     kw = {"episode_time": 0.06}
     r = write_dataset("whirl-brake", FULL, 3, tmp_path / "root", seed=5, env_kwargs=kw,
@@ -220,3 +221,70 @@ def test_duplicate_columns_names_pairs_equal_in_every_sample():
     assert duplicate_columns(x, ["a", "b", "c", "d", "e"]) == [("a", "b")]   # constants do not count
     x[1, 1] += 1e-6
     assert duplicate_columns(x, ["a", "b", "c", "d", "e"]) == []
+
+
+FAILING = """
+from agents.controllers import Controller
+import numpy as np
+
+class Flaky(Controller):
+    name = "flaky"
+    needs = ("damping",)
+    built = 0
+
+    def __init__(self, plant):
+        super().__init__(plant)
+        type(self).built += 1
+
+    def commands(self, obs):
+        if type(self).built > 3:        # check_actor's, then episodes 0 and 1 are fine
+            raise RuntimeError("broken in the third episode")
+        return {"damping": np.ones((len(obs), 2))}
+"""
+
+
+def test_a_failure_midway_leaves_no_data_set(tmp_path, capsys, monkeypatch):
+    monkeypatch.setattr("agents.dataset.CHUNK", 1)          # episodes 0 and 1 are on disk then
+    (tmp_path / "flaky.py").write_text(FAILING)
+    spec = f"{tmp_path / 'flaky.py'}:Flaky"
+    assert main(["dataset", "--policy", spec, "--env", DAMPING, "--episodes", "4", "--quiet",
+                 "--env-kwarg", "episode_time=0.02", "--out", str(tmp_path / "root")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "flaky" in err[0] and "third episode" in err[0]
+    assert not (tmp_path / "root" / "rotordrop" / "damping" / "flaky-v0").exists()
+
+
+def test_a_shipped_policy_round_trips_on_its_own_environment(tmp_path):
+    r = write_dataset("ppo-damping", None, 2, tmp_path, seed=11,
+                      env_kwargs={"episode_time": 0.03}, progress=False)
+    assert r["env_id"] == DAMPING and r["dataset_id"] == "rotordrop/damping/ppo-damping-v0"
+    from agents.dataset import load, replay
+    ds = load(r["dataset_id"], tmp_path)
+    for i in range(2):
+        again = replay(ds, i)
+        ep = ds[i]
+        assert again.seed == 11 + i
+        np.testing.assert_array_equal(ep.observations, again.observations)
+        np.testing.assert_array_equal(ep.actions, again.actions)
+        np.testing.assert_array_equal(ep.rewards, again.rewards)
+
+
+def test_bc_command_line(tmp_path, capsys):
+    root = tmp_path / "root"
+    write_dataset("whirl-switch", DAMPING, 2, root, env_kwargs={"episode_time": 0.03},
+                  progress=False)
+    assert main(["bc", "--dataset", "rotordrop/damping/whirl-switch-v0", "--root", str(root),
+                 "--out", str(tmp_path / "bc"), "--epochs", "2", "--quiet"]) == 0
+    assert "MSE / action variance" in capsys.readouterr().out
+    from agents.policies import LearnedPolicy
+    pol = LearnedPolicy.load(tmp_path / "bc")                 # the directory loads too
+    assert pol.name == "bc-whirl-switch" and pol.env_id == DAMPING and pol.self_contained
+    for argv, name in ((["--dataset", "rotordrop/damping/nothing-v0", "--root", str(root)],
+                        "--dataset"),
+                       (["--dataset", "rotordrop/damping/whirl-switch-v0", "--root", str(root),
+                         "--epochs", "0"], "--epochs"),
+                       (["--dataset", "rotordrop/damping/whirl-switch-v0", "--root", str(root),
+                         "--hidden", "64,x"], "--hidden")):
+        assert main(["bc", *argv, "--out", str(tmp_path / "bc2")]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and err[0].startswith("rotordrop bc: error:") and name in err[0]
