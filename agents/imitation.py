@@ -99,6 +99,7 @@ def train_bc(dataset: str | Path, out: str | Path, root: str | Path | None = Non
     ``epochs`` passes (or until ``time_limit`` seconds) and write it into ``out``. Returns the
     report written to ``bc.json``."""
     import torch as th
+    from .residual import RESIDUAL_SCALE
     if epochs < 1:
         raise ValueError(f"--epochs must be >= 1, got {epochs}")
     if batch_size < 1:
@@ -124,7 +125,7 @@ def train_bc(dataset: str | Path, out: str | Path, root: str | Path | None = Non
     teacher = meta.get("policy_name", meta["policy"])
     name = name or f"bc-{teacher}"
     inside = dict(env_id=meta["env_id"], env_kwargs=dict(meta["env_kwargs"]), normalize=NORMALIZE,
-                  residual=None, residual_scale=2.0, memoryless=True)
+                  residual=None, residual_scale=RESIDUAL_SCALE, memoryless=True)
     model, env = _policy_model(meta["env_id"], meta["env_kwargs"], hidden, inside)
     try:
         policy = model.policy
