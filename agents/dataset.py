@@ -333,24 +333,18 @@ def load_snippet(dataset_id: str, root: str) -> str:
 
 # --------------------------------------------------------------------------- reading --
 def load(dataset: str | Path, root: str | Path | None = None):
-    """A data set by id (under ``root``, default ``MINARI_DATASETS_PATH``) or by its directory
-    (``<root>/<id>``, or its ``data/``). FileNotFoundError naming ``--dataset`` if absent."""
-    import minari
+    """A data set by id under ``root`` (default ``MINARI_DATASETS_PATH``, else Minari's
+    ``~/.minari/datasets``), or by its directory (``<root>/<id>``, or its ``data/``), as
+    ``minari.load_dataset`` opens it but without creating the root when it is absent.
+    FileNotFoundError naming ``--dataset`` if there is none."""
     from minari.dataset.minari_dataset import MinariDataset
-    path = Path(dataset)
-    for candidate in (path, path / "data"):
-        if (candidate / "metadata.json").is_file() and candidate.name == "data":
+    if root is None:
+        root = os.environ.get("MINARI_DATASETS_PATH") or Path("~/.minari/datasets").expanduser()
+    for candidate in (Path(dataset), Path(dataset) / "data", Path(root) / dataset / "data"):
+        if candidate.name == "data" and (candidate / "metadata.json").is_file():
             return MinariDataset(str(candidate))
-    if root is not None and (Path(root) / dataset / "data" / "metadata.json").is_file():
-        return MinariDataset(str(Path(root) / dataset / "data"))
-    with datasets_root(root):
-        try:
-            return minari.load_dataset(str(dataset))
-        except (FileNotFoundError, ValueError) as exc:
-            where = Path(root) if root is not None else os.environ.get(
-                "MINARI_DATASETS_PATH", "~/.minari/datasets")
-            raise FileNotFoundError(f"--dataset {str(dataset)!r}: no Minari data set there nor "
-                                    f"under the root {where} ({exc})") from None
+    raise FileNotFoundError(f"--dataset {str(dataset)!r}: no Minari data set at that path nor "
+                            f"under the root {root} (--root, MINARI_DATASETS_PATH)")
 
 
 def rotordrop_meta(ds) -> dict:

@@ -288,3 +288,8 @@ def test_bc_command_line(tmp_path, capsys):
         assert main(["bc", *argv, "--out", str(tmp_path / "bc2")]) == 2
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and err[0].startswith("rotordrop bc: error:") and name in err[0]
+    # a mistyped root is reported, not created
+    assert main(["bc", "--dataset", "rotordrop/damping/whirl-switch-v0", "--root",
+                 str(tmp_path / "nowhere"), "--out", str(tmp_path / "bc3")]) == 2
+    assert "--dataset" in capsys.readouterr().err
+    assert not (tmp_path / "nowhere").exists() and not (tmp_path / "bc3").exists()
