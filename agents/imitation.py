@@ -104,6 +104,8 @@ def train_bc(dataset: str | Path, out: str | Path, root: str | Path | None = Non
         raise ValueError(f"--epochs must be >= 1, got {epochs}")
     if batch_size < 1:
         raise ValueError(f"--batch-size must be >= 1, got {batch_size}")
+    if seed < 0:
+        raise ValueError(f"--seed must be >= 0, got {seed}")
     if not (lr > 0 and math.isfinite(lr)):
         raise ValueError(f"--lr must be a positive number, got {lr}")
     ds = load(dataset, root)
