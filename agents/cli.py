@@ -1,5 +1,5 @@
 """The ``rotordrop`` command line (entry point :func:`main`) and agents' commands ``train |
-evaluate | benchmark | oracle | tune | ride-through | export-policy | results`` (and ``research``, :mod:`agents.research`).
+evaluate | benchmark | oracle | tune | ride-through | export-policy | results | dataset | bc`` (and ``research``, :mod:`agents.research`).
 
 This top-layer module builds the parser from every layer's ``register(subparsers)``: physics'
 ``drop``, ``params`` (:mod:`physics.cli`), ``study`` and ``accuracy``, then agents' own. Registration
@@ -17,7 +17,7 @@ from physics import cli as physics_cli
 from physics.backend import add_backend_args
 from physics.cli import at_least
 
-from . import research
+from . import imitation, research
 from .hyperparams import ALGOS
 
 OPTIONAL_RL_MODULES = ("gymnasium", "stable_baselines3", "torch", "tensorboard", "yaml")
@@ -204,6 +204,22 @@ def cmd_oracle(args) -> int:
     return 0
 
 
+def cmd_dataset(args) -> int:
+    from .dataset import load_snippet, parse_env_kwargs, write_dataset
+    try:
+        r = write_dataset(args.policy, args.env, args.episodes, args.out, seed=args.seed,
+                          env_kwargs=parse_env_kwargs(args.env_kwarg), dataset_id=args.name,
+                          overwrite=args.overwrite, progress=not args.quiet)
+    except ERRORS as exc:
+        return _fail("dataset", exc)
+    print(f"{r['policy']} on {r['env_id']}: {r['episodes']} episodes (seeds {r['seeds'][0]}.."
+          f"{r['seeds'][-1]}), {r['steps']} steps in {r['run_s']:.1f} s "
+          f"({r['episodes_per_s']:.1f} episodes/s), {r['size_mb']:.1f} MB")
+    print(f"wrote the Minari data set {r['dataset_id']} at {r['path']}; load it with")
+    print(f"  {load_snippet(r['dataset_id'], r['root'])}")
+    return 0
+
+
 def register(sub) -> None:
     p = sub.add_parser("train", help="train an SB3 agent on a rotor-drop environment")
     p.add_argument("--env", required=True, help="environment id, e.g. RotorDrop-Damping-v1")
@@ -273,6 +289,31 @@ def register(sub) -> None:
     p.add_argument("--video", action="store_true",
                    help="the first episode as episode.mp4 (episode.gif without ffmpeg)")
     p.set_defaults(func=cmd_evaluate)
+
+    p = sub.add_parser("dataset", help="seeded episodes of a controller or policy as a Minari "
+                                       "data set (offline RL, behaviour cloning)")
+    p.add_argument("--policy", required=True,
+                   help="as in evaluate: baseline or designed controller name (whirl-brake, "
+                        "inner-loop-lift, max-damping, ...), shipped policy name, training "
+                        "directory / model zip, or package.module:Class / file.py:Class")
+    p.add_argument("--env", default=None, help="environment id (default: the one the policy was "
+                                               "trained on; required for controllers)")
+    p.add_argument("--episodes", type=int, required=True, help="number of episodes (>= 1)")
+    p.add_argument("--seed", type=_SEED, default=0, help="episode i is reset with seed + i")
+    p.add_argument("--env-kwarg", action="append", default=[], metavar="KEY=VALUE",
+                   help="gym.make kwarg over the policy's own (repeatable; Python literals), "
+                        "e.g. episode_time=0.1, randomize=False, "
+                        "overrides=\"{'contact.friction': 0.4}\"")
+    p.add_argument("--out", required=True,
+                   help="Minari datasets root: the data set goes to OUT/<name> "
+                        "(MINARI_DATASETS_PATH=OUT to load it)")
+    p.add_argument("--name", default=None,
+                   help="Minari dataset id (default rotordrop/<task>/<policy>-v0)")
+    p.add_argument("--overwrite", action="store_true", help="replace a data set of that id")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=cmd_dataset)
+
+    imitation.register(sub)
 
     p = sub.add_parser("benchmark", help="every baseline and shipped policy on a fixed scenario suite")
     p.add_argument("--quick", action="store_true",
@@ -401,6 +442,10 @@ def main(argv: list[str] | None = None) -> int:
     try:
         return physics_cli.run(args)
     except ModuleNotFoundError as exc:      # an RL command without the rl extra
+        if exc.name and exc.name.split(".")[0] == "minari":
+            print(f"rotordrop: error: `rotordrop {args.command}` needs minari, the offline extra: "
+                  "python3 -m pip install -c constraints.txt -e \".[rl,offline]\"", file=sys.stderr)
+            return 2
         if exc.name and exc.name.split(".")[0] in OPTIONAL_RL_MODULES:
             print(f"rotordrop: error: `rotordrop {args.command}` needs {exc.name.split('.')[0]}, "
                   "part of the rl extra: python3 -m pip install -c constraints.txt -e \".[rl]\"",
