@@ -4,7 +4,7 @@ over the stator friction mu_st; writes the table docs/physics.md quotes.
     python docs/examples/dry_whirl_onset.py [--out docs/img] [--t-end 1.0]
 
 Writes ``dry-whirl-onset.json`` (per mu_st: the AMB1 metrics of ``rotordrop drop``, with the time
-the run left the stator law's validity) and ``dry-whirl-onset.md`` (the table). A run past a
+the run left the stator law's validity) and ``dry-whirl-onset-table.txt`` (the table). A run past a
 validity bound gets its values before that time, marked, never the values after. ~20 s.
 """
 from __future__ import annotations
@@ -61,7 +61,7 @@ def main() -> None:
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     (out / "dry-whirl-onset.json").write_text(json.dumps(rows, indent=1))
-    (out / "dry-whirl-onset.md").write_text(table(rows))
+    (out / "dry-whirl-onset-table.txt").write_text(table(rows))
     print(table(rows))
 
 
