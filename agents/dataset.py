@@ -22,12 +22,12 @@ What is stored (docs/datasets.md):
   the action space's dtype), ``rewards``, ``terminations``, ``truncations``;
 * ``infos``: one column per scalar number the env reports in ``info``, T+1 rows (row 0 is the
   reset). The columns are chosen on the first episode and kept for all: the keys present at
-  every step (bool columns stay bool, the others become float64), and the keys the env adds
-  at the last step only (the ``kpi_*`` episode KPIs; float64, NaN before the last row). A
-  row where the env did not report a key holds NaN (False for a bool column). Nested dicts
-  (the reset's ``scenario``) go to the episode metadata instead.
+  every step (bool columns stay bool, the others become float64; the environments report the
+  same keys at reset and every step, the ``kpi_*`` as the episode's KPIs so far), and keys an
+  env adds at the last step only (float64, NaN before the last row). A row where the env did
+  not report a key holds NaN (False for a bool column); nested dicts are left out.
 * episode metadata: ``seed`` (Minari's own field: ``env.reset(seed=...)`` of that episode),
-  ``scenario`` (the scene values the episode ran, from the reset's info), ``kpis`` (the
+  ``scenario`` (the scene values the episode ran, ``env.unwrapped.scenario``), ``kpis`` (the
   episode KPIs, ``kpi_`` prefix removed) and ``return``;
 * data set metadata: ``rotordrop`` = policy, its display name, env id, env kwargs, seeds,
   info columns (and their kinds): everything :func:`replay` needs to run the episodes again.
@@ -190,8 +190,8 @@ def run_episode(env, plant, actor, seed: int) -> Collected:
     from .rollout import final_kpis
     return Collected(int(seed), np.asarray(observations, dtype=env.observation_space.dtype),
                      np.asarray(actions, dtype=dtype), np.asarray(rewards, dtype=np.float64),
-                     np.asarray(terms), np.asarray(truncs), infos, info.get("scenario"),
-                     final_kpis(step_info))
+                     np.asarray(terms), np.asarray(truncs), infos,
+                     dict(env.unwrapped.scenario), final_kpis(step_info))
 
 
 def collect(make_actor, env_id: str, env_kwargs: dict, seeds, progress: bool = False):
