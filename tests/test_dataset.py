@@ -2,7 +2,6 @@
 stored episodes equal a replay of the same controller on the same seeds, the seeds and
 scenarios are recorded, bad input is one line naming the parameter, and a cloned policy
 fits its teacher and runs in the benchmark."""
-import math
 
 import numpy as np
 import pytest
