@@ -331,16 +331,24 @@ def stator_motion(y, I, k):
 
 
 @njit
-def sensed_motion(y, P, I, U, k, px, py, vx, vy):
-    """What the sensors of AMB plane k report of its true motion (px, py, vx, vy): delayed by
-    the Pade states, plus the held noise samples (physics/sensor.py, S1). Only called with
-    I[F_SENSOR] set; the velocities carry the delay, not the noise."""
+def delayed_motion(y, P, I, k, px, py, vx, vy):
+    """The true motion (px, py, vx, vy) of AMB plane k as its sensors' delay passes it on (the
+    Pade states, physics/sensor.py S1); unchanged without ``sensor.delay``."""
     i = I[I_SENS]
     if i >= 0:
         i += sensor_mod.STATES_PER_PLANE * k
         tau = P[P_SENS_TAU]
         px, vx = sensor_mod.delayed(px, vx, y[i], y[i + 1], tau)
         py, vy = sensor_mod.delayed(py, vy, y[i + 2], y[i + 3], tau)
+    return px, py, vx, vy
+
+
+@njit
+def sensed_motion(y, P, I, U, k, px, py, vx, vy):
+    """What the sensors of AMB plane k report of its true motion (px, py, vx, vy): delayed, plus
+    the held noise samples U_SENS_NOISE (physics/sensor.py). Only called with I[F_SENSOR] set;
+    the velocities carry the delay, not the noise."""
+    px, py, vx, vy = delayed_motion(y, P, I, k, px, py, vx, vy)
     return px + U[U_SENS_NOISE + 2 * k], py + U[U_SENS_NOISE + 2 * k + 1], vx, vy
 
 
