@@ -8,9 +8,9 @@ This runs ``whirl-brake`` (PD on the raw coil currents, ``RotorDrop-Full-v1``,
 ``command="continuous"``) on the paper scene's drop for each control step ``control_dt``,
 without and with the sensing of the robust suite's middle (``sensor_delay`` 0.1 ms,
 ``sensor_noise`` 0.5 µm: the delay's Padé states and one noise sample per step), and prints the
-medians over ``--repeats`` whole episodes (after a warm-up) of env steps per second and
-simulated seconds per second of CPU (or wall) time, each as a ratio to the 1 ms step's in the
-same run, and (``/none``) to the same step without sensing. Whether the episode re-levitates
+medians over ``--repeats`` whole episodes on one environment (reset, steps and the law's
+actions; after a warm-up) of env steps per second and simulated seconds per second of CPU (or
+wall) time, each as a ratio to the 1 ms step's in the same run, and (``/none``) to the same step without sensing. Whether the episode re-levitates
 is printed too (the law's gains were tuned at 1 ms).
 No timing is asserted anywhere.
 """
@@ -26,7 +26,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from agents.benchmark import controller_env_kwargs  # noqa: E402
 from agents.controllers import BASELINES  # noqa: E402
-from agents.rollout import run_episodes  # noqa: E402
+from agents.plant import Plant  # noqa: E402
+from agents.rollout import _episode, make_env  # noqa: E402
 
 ENV = "RotorDrop-Full-v1"
 LAW = "whirl-brake"
@@ -34,15 +35,19 @@ SENSING = {"none": {}, "delay 0.1 ms + noise 0.5 µm": dict(sensor_delay=1e-4, s
 
 
 def measure(dt: float, sensing: dict, episode_time: float, repeats: int, clock) -> dict:
+    """Median time of whole episodes (reset + steps + the controller's actions) on one env."""
     cls = BASELINES[LAW]
     kw = dict(controller_env_kwargs(cls, ENV), control_dt=dt, episode_time=episode_time,
               terminate_on_failure=False, **sensing)
-    run_episodes(ENV, cls, [0], kw)                           # warm-up: compile, fault state
+    env = make_env(ENV, **kw)
+    plant = Plant.from_env(env)
+    _episode(env, plant, cls(plant), 0, False)                # warm-up: compile, fault state
     times, ep = [], None
     for _ in range(repeats):
         t0 = clock()
-        ep = run_episodes(ENV, cls, [0], kw)[0]
+        ep = _episode(env, plant, cls(plant), 0, False)
         times.append(clock() - t0)
+    env.close()
     t = statistics.median(times)
     return dict(steps=ep.length, steps_per_s=ep.length / t, sim_per_s=ep.length * dt / t,
                 relevitated=bool(ep.kpis.get("relevitated")))
