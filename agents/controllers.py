@@ -341,8 +341,9 @@ class WhirlBrake(Controller):
 
 
 class WhirlBrakeRobust(WhirlBrake):
-    """``whirl-brake`` with its gains re-tuned on the robust distribution (docs/agents.md
-    "Robust suite": 2 µm sensor noise, 1-3 ms latency, actuator spread, plant variation) by
+    """``whirl-brake`` with its gains re-tuned on the robust distribution with the sensing it
+    then had (docs/agents.md "Robust suite": actuator spread, plant variation, and 2 µm sensor
+    noise and 1-3 ms latency on the observation alone) by
     ``rotordrop tune --policy whirl-brake --env RotorDrop-Full-v1 --suite robust`` (20
     generations of 24, 25 min on one core). No gains in the searched ranges re-levitate under
     1-3 ms of latency: the tuned law lowers the force and displacement peaks only."""

@@ -105,7 +105,10 @@ def robust_section(report: dict, source: str) -> list[str]:
            f"`rotordrop benchmark --suite robust{' --quick' if report.get('quick') else ''}` "
            f"(data: `{source}`): {len(report['scenarios'])} drops of `RotorDrop-Full-v1` "
            f"(scenario seeds {seeds[0]}–{seeds[1]}) with {_f(1e6 * d.get('sensor_noise_m', 0), 'g')} µm "
-           f"sensor noise, {'–'.join(str(x) for x in d.get('latency_ms', []))} ms observation "
+           f"sensor noise, "
+           + (f"{'–'.join(f'{1e3 * v:g}' for v in d['sensor_delay_s'])} ms sensor delay (every "
+              "controller), " if d.get("sensor_delay_s") else "")
+           + f"{'–'.join(str(x) for x in d.get('latency_ms', []))} ms observation "
            "latency, actuator spread and plant variation "
            "([what is perturbed](agents.md#robust-suite)).", ""]
     out += leaderboard_table(report["leaderboard"], kind=True, in_out=False) + [""]

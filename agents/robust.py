@@ -3,12 +3,20 @@ sensing, actuator spread and plant variation that the controller does not observ
 
 Every scenario is one drop of ``RotorDrop-Full-v1`` drawn from :data:`ROBUST_RANGES` (friction,
 unbalance mass and phase, housing stiffness ± 30 %, spin speed, power return, coil current limit
-and coil lag; the support's initial damping from the environments' default range), with
-displacement-sensor noise :data:`SENSOR_NOISE` and an observation latency of 1, 2 or 3 ms
-(:data:`LATENCY_MS`, drawn per scenario). The latency is physical time: a controller with
-control step Δt sees the newest measurement that has arrived, ⌈latency / Δt⌉ steps old (1-3
-steps for the 1 ms designed laws, 1 step for the 5 ms learned policies), see
-:func:`agents.benchmark.latency_steps`. The power return is rounded up to the 5 ms grid so that
+and coil lag; the support's initial damping from the environments' default range), under the one
+sensing model of physics/sensor.py that every controller, the built-in PID included, sees:
+displacement-sensor noise :data:`SENSOR_NOISE` (one sample per control step) and a sensor delay
+drawn per scenario from :data:`SENSOR_DELAY_S` (the scene key ``sensor.delay``). On top of that
+the agent's observation gets its own latency of 0 or 1 ms (:data:`LATENCY_MS`, drawn per
+scenario: 0 for a law running in the AMB controller, 1 ms for one transfer to a supervisory
+computer). The latency is physical time: a controller with control step Δt sees the newest
+measurement that has arrived, ⌈latency / Δt⌉ steps old (0-1 steps at 1 ms and at 5 ms), see
+:func:`agents.benchmark.latency_steps`.
+
+Sensing ranges from AMB practice: eddy-current and inductive position sensors resolve 0.1-1 µm
+RMS over the controller's bandwidth (the suite takes the upper end); a digital AMB controller
+sampling at 10-20 kHz has 1-2 samples of delay from sampling, conversion and computation, with
+the sensor's demodulation filter 0.05-0.2 ms in all. The power return is rounded up to the 5 ms grid so that
 every row sees the power at the same instant.
 
 Seeds: the suite's scenarios are drawn with seeds ``SUITE_SEED`` + i (i < 200; ``--quick``: the
@@ -36,8 +44,10 @@ ROBUST_RANGES: dict[str, tuple[float, float]] = {
     "amb.current_limit": (2.4, 3.0),                # the paper's 3 A (= bias current) - 20 %
     "amb.coil_time_constant": (2e-4, 1e-3),         # coil lag L/R (the paper: none)
 }
-SENSOR_NOISE = 2e-6                 # std of the displacement noise [m]
-LATENCY_MS = (1, 3)                 # observation latency [ms], an integer drawn per scenario
+SENSOR_NOISE = 1e-6                 # std of the displacement noise [m] (sensor.noise)
+SENSOR_DELAY_S = (5e-5, 2e-4)       # sensor delay [s] (sensor.delay), uniform per scenario
+LATENCY_MS = (0, 1)                 # the agent's own observation latency [ms], an integer
+                                    # drawn per scenario
 POWER_GRID = 0.005                  # the power return is rounded up to this grid [s]
 SUITE_SEED = 30_000
 SUITE_SCENARIOS = 200
@@ -49,7 +59,9 @@ VALIDATION_SCENARIOS = 20
 def is_robust(env_kwargs: dict) -> bool:
     """Whether environments made with ``env_kwargs`` sense imperfectly (noise or latency)."""
     lat = env_kwargs.get("obs_latency_steps") or 0
-    return bool(env_kwargs.get("sensor_noise")) or bool(max(np.atleast_1d(lat)))
+    return (bool(env_kwargs.get("sensor_noise")) or bool(env_kwargs.get("sensor_delay"))
+            or "sensor.delay" in (env_kwargs.get("randomization") or {})
+            or bool(max(np.atleast_1d(lat))))
 
 
 def draw_scenario(seed: int, name: str | None = None) -> Scenario:
@@ -59,6 +71,7 @@ def draw_scenario(seed: int, name: str | None = None) -> Scenario:
     rng = np.random.default_rng(seed)
     values = sample(ranges, rng)
     latency_ms = int(rng.integers(LATENCY_MS[0], LATENCY_MS[1] + 1))
+    values["sensor.delay"] = float(rng.uniform(*SENSOR_DELAY_S))   # last: the rest as before
     pr = math.ceil(values.pop("power_return_time") / POWER_GRID - 1e-9) * POWER_GRID
     friction = values.pop("contact.friction")
     return Scenario(name or f"#{seed}", float(friction), values, group="in-distribution",
@@ -91,7 +104,9 @@ def training_env_kwargs(control_dt: float = 0.005) -> dict:
     longest, 3 ms, give the range)."""
     from .benchmark import latency_steps
     lo, hi = (latency_steps(1e-3 * m, control_dt) for m in LATENCY_MS)
-    return dict(randomize=True, randomization={k: list(v) for k, v in ROBUST_RANGES.items()},
+    ranges = {k: list(v) for k, v in ROBUST_RANGES.items()}
+    ranges["sensor.delay"] = list(SENSOR_DELAY_S)
+    return dict(randomize=True, randomization=ranges,
                 sensor_noise=SENSOR_NOISE, obs_latency_steps=lo if lo == hi else [lo, hi],
                 control_dt=control_dt)
 
@@ -151,6 +166,7 @@ def robust_benchmark(out, quick: bool = False, policies: list[str] | None = None
     report = dict(suite="robust", quick=quick, episode_time_s=EPISODE_TIME,
                   distribution=dict(ranges={k: list(v) for k, v in ROBUST_RANGES.items()},
                                     sensor_noise_m=SENSOR_NOISE, latency_ms=list(LATENCY_MS),
+                                    sensor_delay_s=list(SENSOR_DELAY_S),
                                     power_grid_s=POWER_GRID, scenario_seeds=[SUITE_SEED, SUITE_SEED + n - 1]),
                   scenarios=[scenario_record(s) for s in scenarios], rows=rows, leaderboard=board,
                   seed_groups=groups, target=target(board, groups), backend=where,
@@ -220,7 +236,9 @@ def robust_markdown(report: dict, scenario_rows: bool = True) -> str:
     lines = [f"# rotordrop benchmark --suite robust{' (quick)' if report['quick'] else ''}", "",
              f"{len(report['scenarios'])} drops of RotorDrop-Full-v1 (scenario seeds "
              f"{d['scenario_seeds'][0]}-{d['scenario_seeds'][1]}) drawn from: {ranges}; "
-             f"displacement-sensor noise {1e6 * d['sensor_noise_m']:g} µm, observation latency "
+             f"displacement-sensor noise {1e6 * d['sensor_noise_m']:g} µm and delay "
+             f"{'-'.join(f'{1e3 * v:g}' for v in d.get('sensor_delay_s', [0.0]))} ms (every "
+             f"controller, the built-in PID included), the agent's observation latency "
              f"{d['latency_ms'][0]}-{d['latency_ms'][1]} ms (whole control steps, rounded up); "
              f"power return on the {1e3 * d['power_grid_s']:g} ms grid. "
              "Score: 100 (1 - sum J / sum J_passive), see docs/agents.md.", ""]

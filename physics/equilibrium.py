@@ -11,7 +11,10 @@ from .ball_bearing import ball_forces
 from .model import (I_PLANES, J_HX, J_SX, N_PLANE_IDX, P_G, P_HALF_PLAY,
                     P_KLIN, P_KS, P_KTOT, P_MH, P_MS, P_NB, P_UB_PHASE, RB_LINEAR, RB_SM, F_RB, F_AMB,
                     AMB_LINEAR, S_PHI, S_VX, S_X, S_W, Model, AMB_ACTUATOR, AMB_AXES, I_AMB_INT,
-                    I_AMB_FILT, I_AMB_COIL, P_AMB_IFF1, I_CS, I_THERM)
+                    I_AMB_FILT, I_AMB_COIL, P_AMB_IFF1, I_CS, I_THERM, I_SENS, P_SENS_TAU,
+                    P_Z_AMB1)
+from .rotor import axis_at
+from .sensor import STATES_PER_PLANE, pade_response, steady_states
 from .amb import actuator_constants, pid_dynamic_stiffness, pid_steady_states
 from .roots import bisect_decreasing
 from .rotor import steady_unbalance_orbit
@@ -48,6 +51,13 @@ def levitated_state(model: Model) -> np.ndarray:
         y[I[S_VX]], y[I[S_VX] + 1] = vel.real, vel.imag
     if I[F_AMB] == AMB_ACTUATOR:
         _actuator_states(model, y, pos, omega)
+    if I[I_SENS] >= 0:                  # sensor delay states on the settled orbit
+        for k in range(2):
+            X = complex(*axis_at(P[P_Z_AMB1 + k], pos.real, pos.imag, 0.0, 0.0))
+            for a, Xa in enumerate((X, -1j * X)):      # y = Re(-i X e^{i omega t})
+                q1, q2 = steady_states(Xa, omega, P[P_SENS_TAU])
+                i = I[I_SENS] + STATES_PER_PLANE * k + 2 * a
+                y[i], y[i + 1] = q1.real, q2.real
     if I[I_CS] >= 0:
         y[I[I_CS]] = y[I[I_CS] + 1] = s.support.damping
     if I[I_THERM] >= 0:                 # sleeve temperatures (effects.thermal)
@@ -68,10 +78,16 @@ def levitated_state(model: Model) -> np.ndarray:
 def _amb_support(model: Model, omega: float) -> tuple[float, float]:
     """Total AMB stiffness and damping (both bearings) that the unbalance orbit sees at omega."""
     a = model.scene.amb
+    H = pade_response(omega, model.scene.sensor.delay)     # the controller sees x delayed
     if model.I[F_AMB] == AMB_LINEAR:
-        return 2 * a.stiffness, 2 * a.damping
+        if H == 1.0:
+            return 2 * a.stiffness, 2 * a.damping
+        K = (a.stiffness + 1j * omega * a.damping) * H
+        return 2 * K.real, 2 * K.imag / omega
     ac = actuator_constants(a, 0.0, 0.0)
     K = pid_dynamic_stiffness(a, ac.current_gain, ac.negative_stiffness, omega)
+    if H != 1.0:                        # K = k_i C L H - k_s
+        K = (K + ac.negative_stiffness) * H - ac.negative_stiffness
     return 2 * K.real, (2 * K.imag / omega if omega > 0.0 else 0.0)
 
 
@@ -80,6 +96,8 @@ def _actuator_states(model: Model, y: np.ndarray, pos: complex, omega: float) ->
     I, P, a = model.I, model.P, model.scene.amb
     for j in range(len(AMB_AXES)):
         X = pos if j % 2 == 0 else -1j * pos          # y = Re(-i pos e^{i omega t})
+        if I[I_SENS] >= 0:                            # the PID sees the delayed orbit
+            X = X * pade_response(omega, P[P_SENS_TAU])
         Z, Q, Ic = pid_steady_states(a, X, omega)
         y[I[I_AMB_INT] + j] = Z.real
         y[I[I_AMB_FILT] + j] = Q.real

@@ -26,6 +26,7 @@ from .contact import (contact_potential, friction_force, geometry, hunt_crossley
 from ._jit import njit, njit_borrow
 from .rotor import axis_at, tilt_accelerations, unbalance_force
 from .scene import Scene
+from . import sensor as sensor_mod
 from .stator import damping_coefficient as stator_damping
 from .stator import stator_force, stator_potential
 from .support import housing_force
@@ -55,6 +56,8 @@ from .support import housing_force
 P_TH_C, P_TH_G, P_TH_A, P_TH_SLOPE, P_TH_RMIN, P_TH_RMAX, P_TH_B, N_P = range(N_P, N_P + 8)
 # stator mount (effects.stator_mount, physics/stator.py): stiffness, damping, mass per AMB plane
 P_STM_K, P_STM_C, P_STM_M, N_P = range(N_P, N_P + 4)
+# position sensing (scene group sensor, physics/sensor.py): delay tau
+P_SENS_TAU, N_P = N_P, N_P + 1
 
 # ------------------------------------------------------------------- flags and indices I --
 (F_GRAV, F_UNB, F_GYRO, F_AMB, F_RB, F_FILM, F_BFRIC, F_HOUSING, F_SLEEVE_J, F_FRIC, F_AUDIT,
@@ -72,6 +75,9 @@ F_STATOR, F_LAW, N_I = range(N_I_BASE, N_I_BASE + 3)
 I_THERM, N_I = N_I, N_I + 1
 # stator on its mount: x, y, vx, vy of AMB1's stator, then AMB2's (-1 without effects.stator_mount)
 I_STM, N_I = N_I, N_I + 1
+# position sensing (physics/sensor.py): on when sensor.delay or sensor.noise > 0; the Pade delay
+# states q1, q2 of AMB1 x, AMB1 y, AMB2 x, AMB2 y (-1 without sensor.delay)
+F_SENSOR, I_SENS, N_I = N_I, N_I + 1, N_I + 2
 AMB_AXES = ("AMB1.x", "AMB1.y", "AMB2.x", "AMB2.y")
 
 AMB_NONE, AMB_LINEAR, AMB_ACTUATOR = 0, 1, 2
@@ -88,8 +94,10 @@ LAW_PAPER, LAW_HERTZ_LINE = 0, 1
 # ``command="supervisor"``) shifts the reference of AMB plane k by U_REF_OFF + 2k (radial) and
 # U_REF_OFF + 2k + 1 (tangential, along a forward orbit) [m] in the frame of the sensed orbit
 # (:func:`orbit_offset`) and scales the three PID gains by U_AMB_GAIN (1 = the scene's gains).
+# With position sensing (I[F_SENSOR]) U_SENS_NOISE + j is the noise sample [m] of AMB axis j
+# (AMB_AXES) that the sensed displacement carries until the next sample (physics/sensor.py).
 (U_AMB_POWER, U_CS1, U_CS2, U_AMB_DIRECT, U_ICMD, U_T_ON, U_REF0, U_REF_OFF, U_AMB_GAIN,
- N_U) = 0, 1, 2, 3, 4, 8, 9, 13, 17, 18
+ U_SENS_NOISE, N_U) = 0, 1, 2, 3, 4, 8, 9, 13, 17, 18, 22
 
 # ------------------------------------------------------------------- diagnostics aux --
 # per plane k at aux[k*N_AUX_PLANE + j]; A_P* are the powers [W] each dissipative element takes
@@ -237,6 +245,13 @@ def build_model(scene: Scene) -> Model:
             for n, sz, obs in (("x", 0.1 * c, c), ("y", 0.1 * c, c), ("vx", 0.01, VELOCITY),
                                ("vy", 0.01, VELOCITY)):
                 add(f"{plane}.stator_{n}", sz, obs)
+    I[F_SENSOR] = s.sensor.delay > 0.0 or s.sensor.noise > 0.0
+    if s.sensor.delay > 0.0:            # Pade delay states q1, q2 per AMB axis (physics/sensor.py)
+        I[I_SENS] = len(names)
+        for ax in AMB_AXES:
+            add(f"{ax}.sensor_q1", c)
+            add(f"{ax}.sensor_q2", c)
+    P[P_SENS_TAU] = s.sensor.delay
 
     # parameters
     g = s.world.gravity if fx.gravity else 0.0
@@ -316,6 +331,28 @@ def stator_motion(y, I, k):
 
 
 @njit
+def delayed_motion(y, P, I, k, px, py, vx, vy):
+    """The true motion (px, py, vx, vy) of AMB plane k as its sensors' delay passes it on (the
+    Pade states, physics/sensor.py S1); unchanged without ``sensor.delay``."""
+    i = I[I_SENS]
+    if i >= 0:
+        i += sensor_mod.STATES_PER_PLANE * k
+        tau = P[P_SENS_TAU]
+        px, vx = sensor_mod.delayed(px, vx, y[i], y[i + 1], tau)
+        py, vy = sensor_mod.delayed(py, vy, y[i + 2], y[i + 3], tau)
+    return px, py, vx, vy
+
+
+@njit
+def sensed_motion(y, P, I, U, k, px, py, vx, vy):
+    """What the sensors of AMB plane k report of its true motion (px, py, vx, vy): delayed, plus
+    the held noise samples U_SENS_NOISE (physics/sensor.py). Only called with I[F_SENSOR] set;
+    the velocities carry the delay, not the noise."""
+    px, py, vx, vy = delayed_motion(y, P, I, k, px, py, vx, vy)
+    return px + U[U_SENS_NOISE + 2 * k], py + U[U_SENS_NOISE + 2 * k + 1], vx, vy
+
+
+@njit
 def housing_motion(y, I, k):
     """Housing (outer ring) position and velocity at retainer plane k; zeros when fixed."""
     base = I_PLANES + k * N_PLANE_IDX
@@ -386,11 +423,15 @@ def rhs(t, y, P, I, U, dy, aux):
         for k in range(2):
             z = P[P_Z_AMB1 + k]
             dx, dyy, ddx, ddy = axis_motion(y, I, z)
-            ox, oy = orbit_offset(dx, dyy, U[U_REF_OFF + 2 * k], U[U_REF_OFF + 2 * k + 1],
+            # the controller's view (physics/sensor.py): the true motion without sensing
+            sx, sy, svx, svy = dx, dyy, ddx, ddy
+            if I[F_SENSOR]:
+                sx, sy, svx, svy = sensed_motion(y, P, I, U, k, dx, dyy, ddx, ddy)
+            ox, oy = orbit_offset(sx, sy, U[U_REF_OFF + 2 * k], U[U_REF_OFF + 2 * k + 1],
                                   y[I[S_W]], P[P_CLR])
             if amb == AMB_LINEAR:
-                fx = amb_mod.linear_force(dx, ddx, P[P_K_AMB], P[P_C_AMB], 0.0)
-                fy = amb_mod.linear_force(dyy, ddy, P[P_K_AMB], P[P_C_AMB], P[P_AMB_BIAS1 + k])
+                fx = amb_mod.linear_force(sx, svx, P[P_K_AMB], P[P_C_AMB], 0.0)
+                fy = amb_mod.linear_force(sy, svy, P[P_K_AMB], P[P_C_AMB], P[P_AMB_BIAS1 + k])
             else:
                 fx = fy = 0.0
                 for a in range(2):                      # x, then y axis of AMB k
@@ -398,7 +439,7 @@ def rhs(t, y, P, I, U, dy, aux):
                     d = dyy if a == 1 else dx
                     i_int, i_q = I[I_AMB_INT] + j, I[I_AMB_FILT] + j
                     i_cmd, e, de_int = _actuator_command(
-                        t, d, y[i_int], y[i_q], U[U_AMB_DIRECT], U[U_AMB_POWER], U[U_ICMD + j],
+                        t, sy if a == 1 else sx, y[i_int], y[i_q], U[U_AMB_DIRECT], U[U_AMB_POWER], U[U_ICMD + j],
                         U[U_T_ON], U[U_REF0 + j], oy if a == 1 else ox, P[P_AMB_ILIM],
                         P[P_AMB_RAMP], P[P_AMB_IFF1 + k] if a == 1 else 0.0,
                         U[U_AMB_GAIN] * P[P_AMB_KP],
@@ -423,6 +464,14 @@ def rhs(t, y, P, I, U, dy, aux):
             Ma += z * fx
             Mb += z * fy
             p_ext += fx * ddx + fy * ddy
+    i_sens = I[I_SENS]
+    if dy is not None and i_sens >= 0:           # sensor delay states (physics/sensor.py, S1)
+        tau = P[P_SENS_TAU]
+        for k in range(2):
+            dx, dyy, _, _ = axis_motion(y, I, P[P_Z_AMB1 + k])
+            i = i_sens + sensor_mod.STATES_PER_PLANE * k
+            dy[i], dy[i + 1] = sensor_mod.pade_rates(dx, y[i], y[i + 1], tau)
+            dy[i + 2], dy[i + 3] = sensor_mod.pade_rates(dyy, y[i + 2], y[i + 3], tau)
 
     # retainer planes: rotor-sleeve contact, sleeve on ball bearing, housing
     twin = False
@@ -754,7 +803,9 @@ def amb_currents(t, y, P, I, U, out):
             out[j] = y[I[I_AMB_COIL] + j]
             continue
         k = j // 2
-        dx, dyy, _, _ = axis_motion(y, I, P[P_Z_AMB1 + k])
+        dx, dyy, ddx, ddy = axis_motion(y, I, P[P_Z_AMB1 + k])
+        if I[F_SENSOR]:
+            dx, dyy, _, _ = sensed_motion(y, P, I, U, k, dx, dyy, ddx, ddy)
         ox, oy = orbit_offset(dx, dyy, U[U_REF_OFF + 2 * k], U[U_REF_OFF + 2 * k + 1], y[I[S_W]],
                               P[P_CLR])
         out[j] = _actuator_command(

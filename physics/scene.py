@@ -235,6 +235,21 @@ class Solver:
 
 
 @dataclass(frozen=True)
+class Sensor:
+    """Position sensing at the AMB planes (physics/sensor.py; docs/physics.md "Position
+    sensing"): what the built-in AMB controller, the supervisor and the environments' observations
+    see. Both zero (default): the true displacement, no state."""
+    delay: float = param(0.0, "s", 0.0, 2e-3,
+                         "transport delay tau of the displacement signal (sensor, anti-alias filter,"
+                         " sampling, controller samples) as a (2,2) Pade approximant: 4 states per"
+                         " AMB plane; 0: no state", "A")
+    noise: float = param(0.0, "m", 0.0, 1e-4,
+                         "standard deviation of the displacement noise: one Gaussian sample per"
+                         " axis and control step, drawn by the environments (the drop driver has"
+                         " no noise source and refuses it)", "A")
+
+
+@dataclass(frozen=True)
 class Effects:
     """Switches: an effect that is off adds no state and no right-hand-side work (spec §8)."""
     gravity: bool = param(True, "-", doc="gravity on all bodies")
@@ -281,7 +296,7 @@ class Effects:
 GROUPS: dict[str, type] = {
     "rotor": Rotor, "positions": Positions, "unbalance": Unbalance, "world": World, "amb": Amb,
     "contact": Contact, "stator": Stator, "sleeve": Sleeve, "thermal": Thermal, "bearing": Bearing,
-    "support": Support,
+    "support": Support, "sensor": Sensor,
     "solver": Solver, "effects": Effects,
 }
 
@@ -301,6 +316,7 @@ class Scene:
     thermal: Thermal = field(default_factory=Thermal)
     bearing: Bearing = field(default_factory=Bearing)
     support: Support = field(default_factory=Support)
+    sensor: Sensor = field(default_factory=Sensor)
     solver: Solver = field(default_factory=Solver)
     effects: Effects = field(default_factory=Effects)
 

@@ -191,6 +191,9 @@ def run_model(model: Model, compile_s: float = 0.0, progress: bool = False) -> R
     """The drop of a built ``model`` whose kernels are loaded (:func:`warm_up`; ``compile_s``:
     the seconds that took, reported apart from the integration's ``wall_time_s``). The single
     drop and the batches of :func:`physics.sweep.run_chunk` both run this, so their numbers are identical."""
+    if model.scene.sensor.noise > 0.0:
+        raise SceneError(f"sensor.noise = {model.scene.sensor.noise:g} m: the drop driver has no "
+                         "noise source (the environments draw it per control step); set it to 0")
     t_end = model.scene.solver.t_end
     t_out = output_times(model)
     n_out = len(t_out)

@@ -25,7 +25,7 @@ from .layout import COMMANDS, action_layout, observation_layout
 from .reward import REWARDS, check_kpi_weights, kpi_step
 from .scenario import (POWER_RETURN, POWER_RETURN_LIMITS, fault_state, layout_base, resolve_ranges,
                        sample, scenario_scene)
-from .sensors import Sensing, check_latency, check_noise
+from .sensors import Sensing, check_delay, check_latency, check_noise
 
 #: the kernel's re-levitation mode of each ``command``
 LEV_CODES = {"discrete": K.LEV_DISCRETE, "continuous": K.LEV_CONTINUOUS,
@@ -48,8 +48,25 @@ FIXED_SETTINGS = frozenset(("control_dt", "dt", "episode_time", "n_steps", "rand
                             "power_return_time", "samples_per_step", "relevitation_hold",
                             "terminate_on_failure", "render_mode", "base_scene", "overrides",
                             "obs_names", "obs_scale", "action_names", "weights",
-                            "sensor_noise", "obs_latency_steps", "supervisor_authority",
+                            "sensor_noise", "sensor_delay", "obs_latency_steps", "supervisor_authority",
                             "damping_action", "reward", "reward_kwargs"))
+
+
+def _sensing_scene(base: Scene, noise: float, delay: float) -> tuple[Scene, float, float]:
+    """The scene with the sensing kwargs in its ``sensor`` group (the one sensing model of
+    physics/sensor.py), and the noise and delay in effect: a kwarg, else the scene's value; a
+    kwarg that contradicts the scene's non-zero value is refused."""
+    values = {}
+    for key, given in (("sensor.noise", noise), ("sensor.delay", delay)):
+        scene_value = base.get(key)
+        kwarg = "sensor_" + key.split(".")[1]
+        if given > 0.0 and scene_value > 0.0 and given != scene_value:
+            raise ValueError(f"{kwarg} = {given:g} contradicts the scene's {key} = "
+                             f"{scene_value:g}; give one of them")
+        values[key] = given or scene_value
+    if any(values[k] != base.get(k) for k in values):
+        base = base.with_overrides(values)
+    return base, values["sensor.noise"], values["sensor.delay"]
 
 
 def _weight(name: str, doc: str) -> property:
@@ -81,9 +98,14 @@ class RotorDropEnv(gym.Env):
     randomization               None        {key: (low, high) | (law, low, high) | None};
                                             needs randomize=True, no range for a fixed key
     full_state                  False       observe the whole state vector (research)
-    sensor_noise                0.0         std of the displacement sensors' Gaussian noise [m]
+    sensor_noise                0.0         std of the displacement sensors' Gaussian noise [m],
+                                            one sample per control step, seen by the built-in
+                                            PID, the supervisor and the observations
                                             (velocities: sqrt(2) x that / 1 ms), see
                                             :mod:`rotordrop_env.sensors`
+    sensor_delay                0.0         delay of the displacement sensors [s], inside the
+                                            physics: the built-in PID, the supervisor and the
+                                            observations see it
     obs_latency_steps           0           k or (low, high): the agent sees the measurement of
                                             k control steps ago, k drawn per episode
     command                     "discrete"  re-levitation envs: "discrete", "continuous" or
@@ -148,7 +170,8 @@ class RotorDropEnv(gym.Env):
                  command: str | None = None, power_return_time: float | None = None,
                  samples_per_step: int = 5, relevitation_hold: float = 0.02,
                  terminate_on_failure: bool = True, sensor_noise: float = 0.0,
-                 obs_latency_steps: int | tuple[int, int] = 0, w_whirl: float = 10.0,
+                 obs_latency_steps: int | tuple[int, int] = 0, sensor_delay: float = 0.0,
+                 w_whirl: float = 10.0,
                  w_contact: float = 0.1, w_displacement: float = 0.1, w_effort: float = 0.01,
                  w_success: float = 10.0, w_failure: float = 10.0, render_mode: str | None = None,
                  supervisor_authority: float = 1.0, damping_action: str = "linear",
@@ -190,9 +213,10 @@ class RotorDropEnv(gym.Env):
         self.full_state = _flag("full_state", full_state)
         self.render_mode = render_mode
         self.weights = weights
-        self.sensor_noise = check_noise(sensor_noise)
+        noise, delay = check_noise(sensor_noise), check_delay(sensor_delay)
         self.obs_latency_steps = check_latency(obs_latency_steps)
         base = self._make_scene(scene, overrides)
+        base, self.sensor_noise, self.sensor_delay = _sensing_scene(base, noise, delay)
         self.ranges, fixed = resolve_ranges(randomization, self._relevitate, type(self).__name__)
         _check_unused_ranges(randomization, self.randomize, overrides, power_return_time)
         self.base_scene = layout_base(base, self.ranges, fixed) if self.randomize else base
@@ -415,7 +439,7 @@ class RotorDropEnv(gym.Env):
             self._reset_view()
             self._record(step=False)
         if self._sensing.active:
-            obs = self._sensing.reset(b.obs, self.np_random)
+            obs = self._sensing.reset(b.obs, self.np_random, b.U)
         else:
             obs = b.obs.astype(np.float32)
         return obs, self._info()
@@ -501,7 +525,7 @@ class RotorDropEnv(gym.Env):
         once per step, it takes the measurement)."""
         if not self._sensing.active:
             return self._b.obs.astype(np.float32)
-        return self._sensing.step(self._b.obs, self.np_random)
+        return self._sensing.step(self._b.obs, self.np_random, self._b.U)
 
     def _action_error(self, err: int, action) -> None:
         """Raise the ValueError of a refused action (``err``: the kernel's ERR_* code)."""

@@ -23,10 +23,11 @@ import numpy as np
 
 from physics._jit import njit, njit_parallel
 from physics.integrate import integrate_segment
-from physics.model import (A_DELTA, A_FR, A_QMAX, A_WS, I_AMB_FILT, I_AMB_INT, I_CS, N_AUX_PLANE,
-                           P_CLR, P_Z_AMB1, P_Z_RB1, S_W, U_AMB_DIRECT, U_AMB_GAIN, U_AMB_POWER,
-                           U_CS1, U_ICMD, U_REF0, U_REF_OFF, U_T_ON, amb_currents, axis_motion,
-                           rhs, sleeve_motion, stator_motion)
+from physics.model import (A_DELTA, A_FR, A_QMAX, A_WS, F_SENSOR, I_AMB_FILT, I_AMB_INT, I_CS,
+                           N_AUX_PLANE, P_CLR, P_Z_AMB1, P_Z_RB1, S_W, U_AMB_DIRECT, U_AMB_GAIN,
+                           U_AMB_POWER, U_CS1, U_ICMD, U_REF0, U_REF_OFF, U_T_ON, amb_currents,
+                           axis_motion, delayed_motion, rhs, sensed_motion, sleeve_motion,
+                           stator_motion)
 
 # ------------------------------------------------------------------------ configuration C --
 (C_DT, C_T_FAULT, C_T_END, C_T_POWER, C_DAMP, C_LEV,
@@ -101,12 +102,15 @@ def first_bad_action(A, C):
 
 @njit
 def _switch_on(t, y, P, I, U):
-    """Engage the built-in PID: ramp the reference from the sensed position, reset integrators."""
+    """Engage the built-in PID: ramp the reference from the sensed position (delayed and noisy
+    with position sensing, physics/sensor.py), reset integrators."""
     U[U_AMB_POWER] = 1.0
     U[U_AMB_DIRECT] = 0.0
     U[U_T_ON] = t
     for j in range(4):
-        px, py, _, _ = axis_motion(y, I, P[P_Z_AMB1 + j // 2])
+        px, py, vx, vy = axis_motion(y, I, P[P_Z_AMB1 + j // 2])
+        if I[F_SENSOR]:
+            px, py, _, _ = sensed_motion(y, P, I, U, j // 2, px, py, vx, vy)
         U[U_REF0 + j] = px if j % 2 == 0 else py
         y[I[I_AMB_INT] + j] = 0.0
         y[I[I_AMB_FILT] + j] = 0.0
@@ -162,8 +166,10 @@ def apply_action(a, y, P, I, U, C, M):
 def orbit_frame(y, P, I, k):
     """Sensed orbit at AMB plane k: radius r [m] and angular rate relative to the spin direction
     [rad/s] (< 0: the orbit turns backwards; 0 below ``SUP_MIN_RADIUS`` x clearance, where the
-    direction of the orbit is noise)."""
+    direction of the orbit is noise). With ``sensor.delay`` of the delayed motion; the noise is
+    added by :mod:`rotordrop_env.sensors`, which recomputes these from the noisy values."""
     px, py, vx, vy = axis_motion(y, I, P[P_Z_AMB1 + k])
+    px, py, vx, vy = delayed_motion(y, P, I, k, px, py, vx, vy)
     spin = 1.0 if y[I[S_W]] >= 0.0 else -1.0
     r = math.sqrt(px * px + py * py)
     rate = spin * (px * vy - py * vx) / (r * r) if r > SUP_MIN_RADIUS * P[P_CLR] else 0.0
@@ -190,8 +196,9 @@ def observe(t, y, P, I, U, C, M, aux, cur, scale, obs):
             obs[n] = y[i]
             n += 1
     else:
-        for k in range(2):
+        for k in range(2):                      # as the sensors report it (delayed)
             px, py, vx, vy = axis_motion(y, I, P[P_Z_AMB1 + k])
+            px, py, vx, vy = delayed_motion(y, P, I, k, px, py, vx, vy)
             obs[n], obs[n + 1], obs[n + 2], obs[n + 3] = px, py, vx, vy
             n += 4
         obs[n] = y[I[S_W]]

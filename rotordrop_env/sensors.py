@@ -1,18 +1,23 @@
-"""Imperfect sensing of the agent's observations: Gaussian sensor noise and observation latency
-(kwargs ``sensor_noise`` and ``obs_latency_steps``; docs/environments.md "Sensor noise and
-latency").
+"""Imperfect sensing: displacement noise and delay, one sensing model for every controller, and
+the agent's own observation latency (kwargs ``sensor_noise``, ``sensor_delay`` and
+``obs_latency_steps``; docs/environments.md "Sensor noise, delay and latency").
 
-Only what the agent (or a designed controller reading the observation) sees is affected. The
-physics step, its built-in position PID (the machine's fast inner loop) and the supervisor's
-orbit frame inside it run on the true state, as a real AMB's analogue or FPGA position loop
-does; the KPIs and rewards are those of the true motion.
+The noise and the delay are the position sensors' (physics/sensor.py, the scene group
+``sensor``): the built-in AMB controller (PID or linear law), the supervisor's orbit frame and
+the observations all see the same sensed displacement; the KPIs and rewards are those of the
+true motion.
 
+* **Delay** τ = ``sensor_delay`` [s]: inside the physics (a Padé approximant per AMB axis); the
+  kernel's observations x1 ... vy2 and orbit entries are the delayed ones.
 * **Noise**: the four displacements x1, y1, x2, y2 get independent Gaussian noise of standard
-  deviation σ = ``sensor_noise`` [m]; the four velocities, which a real machine estimates by
-  differencing the displacement signal, get σ_v = √2 σ / ``VELOCITY_ESTIMATE_DT`` (the noise of
-  a difference over 1 ms, the same for every control step). With ``command="supervisor"`` the
-  orbit radius and rate are computed from the noisy values (the same formula as the kernel's).
-  Spin speeds, damper states and coil currents are not noised.
+  deviation σ = ``sensor_noise`` [m], one sample per control step; the same sample is what the
+  built-in PID and the supervisor's orbit frame see during the next control step (the U entries
+  ``U_SENS_NOISE``: a sample taken at t_n is held until t_n+1). The four velocities, which a
+  real machine estimates by differencing the displacement signal, get σ_v = √2 σ /
+  ``VELOCITY_ESTIMATE_DT`` (the noise of a difference over 1 ms, the same for every control
+  step; observations only). With ``command="supervisor"`` the orbit radius and rate are
+  computed from the noisy values (the same formula as the kernel's). Spin speeds, damper states
+  and coil currents are not noised.
 * **Latency**: the observation returned after control step n is the (noisy) measurement taken
   after step n − k; k is drawn once per episode, uniformly from the integers of
   ``obs_latency_steps = (low, high)``. Every entry is delayed except ``time``, the controller's
@@ -28,12 +33,15 @@ import numbers
 
 import numpy as np
 
+from physics.model import U_SENS_NOISE
+
 from .kernels import SUP_MIN_RADIUS
 from .layout import SUPERVISOR_OBS
 
 #: interval of the velocity estimate that the velocity noise stands for [s]
 VELOCITY_ESTIMATE_DT = 1e-3
-NOISE_LIMITS = (0.0, 1e-4)          # sensor_noise [m]
+NOISE_LIMITS = (0.0, 1e-4)          # sensor_noise [m] (the scene's sensor.noise range)
+DELAY_LIMITS = (0.0, 2e-3)          # sensor_delay [s] (the scene's sensor.delay range)
 LATENCY_LIMITS = (0, 100)           # obs_latency_steps [control steps]
 POSITIONS = ("x1", "y1", "x2", "y2")
 VELOCITIES = ("vx1", "vy1", "vx2", "vy2")
@@ -46,6 +54,16 @@ def check_noise(value) -> float:
             or not (math.isfinite(value) and lo <= value <= hi):
         raise ValueError(f"sensor_noise = {value!r} must be a standard deviation in metres in "
                          f"[{lo:g}, {hi:g}] (e.g. 2e-6 for 2 µm)")
+    return float(value)
+
+
+def check_delay(value) -> float:
+    """``sensor_delay`` as a float in ``DELAY_LIMITS`` (one-line ValueError otherwise)."""
+    lo, hi = DELAY_LIMITS
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real) \
+            or not (math.isfinite(value) and lo <= value <= hi):
+        raise ValueError(f"sensor_delay = {value!r} must be a delay in seconds in "
+                         f"[{lo:g}, {hi:g}] (e.g. 1e-4 for 0.1 ms)")
     return float(value)
 
 
@@ -90,17 +108,20 @@ class Sensing:
         self.k = 0
         self.n = 0                      # measurements taken this episode
 
-    def reset(self, true_obs: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    def reset(self, true_obs: np.ndarray, rng: np.random.Generator,
+              U: np.ndarray | None = None) -> np.ndarray:
         """Start an episode: draw its latency k, take the first measurement."""
         lo, hi = self.latency
         self.k = int(rng.integers(lo, hi + 1)) if hi > lo else lo
         self.n = 0
-        return self.step(true_obs, rng)
+        return self.step(true_obs, rng, U)
 
-    def step(self, true_obs: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    def step(self, true_obs: np.ndarray, rng: np.random.Generator,
+             U: np.ndarray | None = None) -> np.ndarray:
         """Measure ``true_obs`` (normalised, as the kernel wrote it) and return the float32
-        observation the agent sees now."""
-        m = self._measure(true_obs, rng)
+        observation the agent sees now; the displacement noise sample goes to the controls ``U``
+        (the physics' sensed displacement until the next measurement) when given."""
+        m = self._measure(true_obs, rng, U)
         L = len(self.buffer)
         self.buffer[self.n % L] = m
         if self.n == 0:
@@ -110,10 +131,14 @@ class Sensing:
         self.n += 1
         return out
 
-    def _measure(self, true_obs: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    def _measure(self, true_obs: np.ndarray, rng: np.random.Generator,
+                 U: np.ndarray | None) -> np.ndarray:
         m = np.array(true_obs, dtype=np.float64)
         if self.noise > 0.0:
-            m[self.cols] += self.sigma * rng.standard_normal(len(self.cols))
+            z = rng.standard_normal(len(self.cols))
+            m[self.cols] += self.sigma * z
+            if U is not None:                   # x1, y1, x2, y2: the AMB axes' order
+                U[U_SENS_NOISE:U_SENS_NOISE + 4] = self.noise * z[:4]
             if self.orbit is not None:
                 self._orbit(m)
         return m

@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from agents.benchmark import Entry, Scenario, episode_kwargs, latency_steps
-from agents.robust import (LATENCY_MS, ROBUST_RANGES, SENSOR_NOISE, SUITE_SEED, VALIDATION_SEED,
+from agents.robust import (LATENCY_MS, ROBUST_RANGES, SENSOR_DELAY_S, SENSOR_NOISE, SUITE_SEED,
+                           VALIDATION_SEED,
                            draw_scenario, robust_benchmark, robust_scenarios, run_suite,
                            seed_groups, target,
                            training_env_kwargs)
@@ -25,6 +26,7 @@ def test_scenarios_are_reproducible_inside_the_ranges_and_disjoint_from_validati
         steps = s.env_kwargs["power_return_time"] / 0.005
         assert abs(steps - round(steps)) < 1e-9
         assert s.sensor_noise == SENSOR_NOISE and s.tasks == ("full",)
+        assert SENSOR_DELAY_S[0] <= s.overrides["sensor.delay"] <= SENSOR_DELAY_S[1]
         lat.add(round(1e3 * s.latency_s))
     assert lat == set(range(LATENCY_MS[0], LATENCY_MS[1] + 1))
     assert {s.seed for s in a}.isdisjoint(range(VALIDATION_SEED, VALIDATION_SEED + 1000))
@@ -53,9 +55,10 @@ def test_episode_kwargs_take_the_scenarios_sensing_not_the_training_one():
 
 def test_training_kwargs_match_the_suite():
     kw = training_env_kwargs(0.005)
-    assert kw["obs_latency_steps"] == 1 and kw["sensor_noise"] == SENSOR_NOISE
-    assert training_env_kwargs(1e-3)["obs_latency_steps"] == [1, 3]
-    assert kw["randomization"] == {k: list(v) for k, v in ROBUST_RANGES.items()}
+    assert kw["obs_latency_steps"] == [0, 1] and kw["sensor_noise"] == SENSOR_NOISE
+    assert training_env_kwargs(1e-3)["obs_latency_steps"] == [0, 1]
+    assert kw["randomization"] == {**{k: list(v) for k, v in ROBUST_RANGES.items()},
+                                   "sensor.delay": list(SENSOR_DELAY_S)}
 
 
 def test_seed_groups_and_the_target():
@@ -101,9 +104,9 @@ def test_a_small_robust_suite_scores_every_full_row(tmp_path):
     assert all(e["task"] == "full" for e in board.values())
     assert any(e["kind"] == "learned" for e in board.values())
     assert len(report["rows"]) == 2 * len(board) and len(report["scenarios"]) == 2
-    # the fast current loop cannot re-levitate under 1-3 ms of latency; the built-in PID can
-    assert board["pid-relevitate"]["relevitation_rate"] == 0.0
+    # the built-in PID re-levitates through the sensors' delay and noise
     assert board["builtin-relevitate"]["relevitation_rate"] == 1.0
+    assert SENSOR_DELAY_S[0] <= report["scenarios"][0]["overrides"]["sensor.delay"] <= SENSOR_DELAY_S[1]
     assert (tmp_path / "benchmark.json").is_file() and "Target" in (tmp_path / "leaderboard.md").read_text()
     assert report["scenarios"][0]["seed"] == SUITE_SEED
 
