@@ -211,8 +211,11 @@ def register(sub) -> None:
     p.add_argument("--timesteps", type=int, default=None, help="override n_timesteps of the config")
     p.add_argument("--n-envs", type=int, default=None, help="override n_envs of the config")
     p.add_argument("--config", default=None,
+                   metavar="FILE[:ENTRY]",
                    help="YAML with hyperparameters keyed by env id (rl-zoo3 style), applied over "
-                        "the shipped agents/configs/<algo>.yaml")
+                        "the shipped agents/configs/<algo>.yaml; FILE:ENTRY picks a named entry "
+                        "(e.g. agents/configs/ppo.yaml:ppo-full-scratch); a file with base: "
+                        "FILE[:ENTRY] is a delta on that base")
     p.add_argument("--seed", type=_SEED, default=0)
     p.add_argument("--seeds", default=None, metavar="S1,S2,...",
                    help="train one run per seed into --out/seed_<s>, side by side (on --backend "
