@@ -101,11 +101,13 @@ class LearnedPolicy:
                                  f"{what}; {plant.env_id} has {n}: evaluate it on {self.env_id}")
 
     @classmethod
-    def load(cls, path: str | Path, name: str | None = None,
-             env_id: str | None = None) -> "LearnedPolicy":
+    def load(cls, path: str | Path, name: str | None = None, env_id: str | None = None,
+             check_env: bool = True) -> "LearnedPolicy":
         """The policy at ``path``; ``env_id`` names the environment it was trained on when
         nothing next to it records one (a plain SB3 ``model.save`` zip: its env kwargs are then
-        the environment's defaults); a recorded env id other than ``env_id`` is a ValueError."""
+        the environment's defaults); with ``check_env`` a recorded env id other than ``env_id``
+        is a ValueError (evaluate passes False: it may run a policy in another env id with the
+        same spaces)."""
         path = Path(path)
         if env_id is not None:
             import gymnasium as gym
@@ -134,7 +136,7 @@ class LearnedPolicy:
         model = algo_class(algo).load(str(model_path), device="cpu")
         inside = model.policy.rotordrop if is_self_contained(model) else {}
         given, env_id = env_id, meta.get("env_id") or inside.get("env_id")
-        if env_id is not None and given is not None and given != env_id:
+        if check_env and env_id is not None and given is not None and given != env_id:
             raise ValueError(f"{model_path} was trained on {env_id} (recorded next to it or in "
                              f"the zip), not --env {given}: leave out --env or pass {env_id}")
         env_id = env_id or given
@@ -217,9 +219,10 @@ def load_shipped(name: str) -> LearnedPolicy:
     return LearnedPolicy.load(path, name=name)
 
 
-def resolve(spec: str, plant: Plant | None = None):
+def resolve(spec: str, plant: Plant | None = None, env_id: str | None = None):
     """A baseline name, a controller class spec (``module:Class``, ``file.py:Class``), a shipped
-    policy name or a path -> (controller-or-policy, env_id | None).
+    policy name or a path -> (controller-or-policy, env_id | None). ``env_id`` (``--env``): the
+    environment of a path that records none (a plain SB3 zip, :meth:`LearnedPolicy.load`).
 
     Controllers need the ``plant`` of the environment they will drive (without it: None).
     """
@@ -230,7 +233,7 @@ def resolve(spec: str, plant: Plant | None = None):
         pol = load_shipped(spec)
         return (pol.bound(plant) if plant is not None else pol), pol.env_id
     if Path(spec).exists():
-        pol = LearnedPolicy.load(spec)
+        pol = LearnedPolicy.load(spec, env_id=env_id, check_env=False)
         return (pol.bound(plant) if plant is not None else pol), pol.env_id
     raise KeyError(f"--policy {spec!r} is not a baseline ({', '.join(BASELINES)}), a shipped "
                    f"policy ({', '.join(shipped_names()) or 'none shipped'}), an existing path or "
