@@ -235,7 +235,7 @@ def _resolve(algo: str, env_id: str, ref: str, near: Path | None, chain: tuple[s
     shown = f"{name}:{entry}" if entry else name
     if key in chain:
         raise ConfigError(f"config {shown}: its base chain comes back to itself "
-                          f"({' -> '.join([c.rsplit('/', 1)[-1] for c in chain] + [shown])})")
+                          f"({' -> '.join([c.rsplit('/', 1)[-1].rstrip(':') for c in chain] + [shown])})")
     chain = chain + (key,)
     shipped = path.resolve().parent == shipped_dir().resolve() and path.stem in ALGOS
     if shipped and path.stem != algo:
