@@ -25,7 +25,7 @@ from .controllers import BASELINES, controller_class, make_baseline, make_contro
 from .plant import Plant
 from .hyperparams import ALGOS as ALGO_NAMES, algo_class, parse_literal
 from .residual import RESIDUAL_SCALE, residual_action
-from .sb3_policy import export_self_contained, is_self_contained
+from .sb3_policy import current_env_id, export_self_contained, is_self_contained
 from .score import write_json
 
 
@@ -136,6 +136,7 @@ class LearnedPolicy:
         model = algo_class(algo).load(str(model_path), device="cpu")
         inside = model.policy.rotordrop if is_self_contained(model) else {}
         given, env_id = env_id, meta.get("env_id") or inside.get("env_id")
+        env_id = current_env_id(env_id) if env_id is not None else None
         if check_env and env_id is not None and given is not None and given != env_id:
             raise ValueError(f"{model_path} was trained on {env_id} (recorded next to it or in "
                              f"the zip), not --env {given}: leave out --env or pass {env_id}")
