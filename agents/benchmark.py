@@ -203,10 +203,12 @@ def _entries(policies: list[LearnedPolicy], controllers=()) -> list[Entry]:
     return out
 
 
-def robust_entries(policies: list[str] | None) -> tuple[list[Entry], dict]:
+def robust_entries(policies: list[str] | None, env_id: str | None = None,
+                   names: list[str] | None = None) -> tuple[list[Entry], dict]:
     """The Full-task entries of the robust suite (every baseline with channels there, the
-    shipped Full policies, the ``--policy`` extras) and the learned ones by name."""
-    extra, custom = extras(policies or [])
+    shipped Full policies, the ``--policy`` extras, see :func:`extras` for ``env_id`` and
+    ``names``) and the learned ones by name."""
+    extra, custom = extras(policies or [], env_id, names)
     loaded = [p for p in [load_shipped(n) for n in shipped_names()] + extra
               if p.env_id == TASKS["full"]]
     entries = check_unique_names([e for e in _entries(loaded, custom) if e.task == "full"])
@@ -239,10 +241,12 @@ def policy_label(spec: str, policy: LearnedPolicy) -> str:
     return policy.name if spec in shipped_names() else f"{policy.name}@{run_label(spec)}"
 
 
-def extras(specs: list[str]) -> tuple[list[LearnedPolicy], list]:
+def extras(specs: list[str], env_id: str | None = None,
+           names: list[str] | None = None) -> tuple[list[LearnedPolicy], list]:
     """The ``--policy`` extras: learned policies given by path, named ``name@run``
-    (:func:`policy_label`, as in evaluate and ride-through), and controller classes; the
-    baselines and shipped policies are in already."""
+    (:func:`policy_label`, as in evaluate and ride-through) or by ``names`` (``--name``, one per
+    path, in order), and controller classes; the baselines and shipped policies are in already.
+    ``env_id`` (``--env``): the environment of a path that records none (a plain SB3 zip)."""
     policies, classes = [], []
     for spec in dict.fromkeys(specs):
         if spec in shipped_names() or spec in BASELINES:
@@ -251,9 +255,17 @@ def extras(specs: list[str]) -> tuple[list[LearnedPolicy], list]:
         if cls is not None:
             classes.append(cls)
             continue
-        policy = LearnedPolicy.load(spec)
+        policy = LearnedPolicy.load(spec, env_id=env_id)
         policy.name = policy_label(spec, policy)
         policies.append(policy)
+    if names:
+        if len(names) != len(policies):
+            raise ValueError(f"--name: {len(names)} name(s) for {len(policies)} --policy model(s) "
+                             f"given by path; give one --name per model, in the same order")
+        for policy, name in zip(policies, names):
+            if not name.strip() or any(c.isspace() or c in "|`" for c in name):
+                raise ValueError(f"--name {name!r}: a leaderboard name without spaces, '|' or '`'")
+            policy.name = name
     return policies, classes
 
 
@@ -312,7 +324,7 @@ def latency_steps(latency_s: float, control_dt: float) -> int:
 def benchmark(out: str | Path, quick: bool = False, policies: list[str] | None = None,
               max_scenarios: int | None = None, episodes: int | None = None,
               progress: bool = True, plots: bool = True, power_return: float | None = None,
-              backend=None) -> dict:
+              backend=None, env_id: str | None = None, names: list[str] | None = None) -> dict:
     """Run the suite and write benchmark.json, leaderboard.md and the plots into ``out``;
     ``power_return`` [s]: see :func:`scenario_suite`. On ``backend`` ray every friction of the
     threshold sweep and every controller is one Ray task (learned policies travel as their
@@ -328,7 +340,7 @@ def benchmark(out: str | Path, quick: bool = False, policies: list[str] | None =
     phases = QUICK_PHASES if quick else PHASES
     if episodes is not None:
         phases = PHASES[:max(1, min(episodes, len(PHASES)))]
-    extra, custom = extras(policies or [])
+    extra, custom = extras(policies or [], env_id, names)
     loaded = [load_shipped(n) for n in shipped_names()] + extra
     entries = check_unique_names(_entries(loaded, custom))
     users = {c.name for c in custom}

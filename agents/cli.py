@@ -116,7 +116,8 @@ def cmd_evaluate(args) -> int:
 def cmd_export_policy(args) -> int:
     from .policies import export_policy, export_zoo
     try:
-        path = export_zoo(args.source, args.zoo) if args.zoo else export_policy(args.source, args.out)
+        path = (export_zoo(args.source, args.zoo, args.env) if args.zoo
+                else export_policy(args.source, args.out, args.env))
     except ERRORS as exc:
         return _fail("export-policy", exc)
     print(f"wrote {path}" + (f" and its config.yml: python -m rl_zoo3.enjoy --algo "
@@ -132,7 +133,7 @@ def cmd_benchmark(args) -> int:
         run_suite(args.suite, args.out, quick=args.quick, policies=args.policy,
                   max_scenarios=args.scenarios, episodes=args.episodes, progress=not args.quiet,
                   plots=not args.no_plots, power_return=_power_return_s(args),
-                  backend=Backend.from_args(args))
+                  backend=Backend.from_args(args), env_id=args.env, names=args.name)
     except ERRORS as exc:
         return _fail("benchmark", exc)
     return 0
@@ -227,8 +228,11 @@ def register(sub) -> None:
     p.add_argument("--timesteps", type=int, default=None, help="override n_timesteps of the config")
     p.add_argument("--n-envs", type=int, default=None, help="override n_envs of the config")
     p.add_argument("--config", default=None,
+                   metavar="FILE[:ENTRY]",
                    help="YAML with hyperparameters keyed by env id (rl-zoo3 style), applied over "
-                        "the shipped agents/configs/<algo>.yaml")
+                        "the shipped agents/configs/<algo>.yaml; FILE:ENTRY picks a named entry "
+                        "(e.g. agents/configs/ppo.yaml:ppo-full-scratch); a file with base: "
+                        "FILE[:ENTRY] is a delta on that base")
     p.add_argument("--seed", type=_SEED, default=0)
     p.add_argument("--seeds", default=None, metavar="S1,S2,...",
                    help="train one run per seed into --out/seed_<s>, side by side (on --backend "
@@ -264,6 +268,9 @@ def register(sub) -> None:
     where = p.add_mutually_exclusive_group(required=True)
     where.add_argument("--out", help="the zip to write")
     where.add_argument("--zoo", metavar="DIR", help="write an rl-zoo3 run folder for rl_zoo3.enjoy")
+    p.add_argument("--env", default=None,
+                   help="the environment id a plain SB3 zip (model.save) was trained on; runs of "
+                        "rotordrop train record theirs")
     p.set_defaults(func=cmd_export_policy)
 
     p = sub.add_parser("evaluate", help="KPIs and plots of a policy or baseline controller")
@@ -327,6 +334,12 @@ def register(sub) -> None:
                    help="extra policies or controllers to include (repeatable): a training "
                         "directory or model .zip (shown as name@run), or your own controller "
                         "class as package.module:Class or file.py:Class (see docs/agents.md)")
+    p.add_argument("--env", default=None,
+                   help="the environment id a --policy model was trained on when nothing records "
+                        "it (a plain SB3 zip from model.save)")
+    p.add_argument("--name", action="append", default=None,
+                   help="the leaderboard name of a --policy model given by path (repeatable: one "
+                        "per model, in order; default name@run)")
     p.add_argument("--power-return-ms", type=float, default=None,
                    help="power-return delay of the re-levitation tasks [ms] (default: the "
                         "environments' 50 ms; the 'power back at 0.15 s' scenario keeps its own)")

@@ -48,7 +48,7 @@ def _actor(spec: str, env_id: str | None):
             raise ValueError(f"--env is required for the controller {spec!r}")
         return ((lambda plant: make_controller(cls, plant)), env_id, controller_env_kwargs(cls, env_id),
                 cls.name)
-    policy, trained_on = resolve(spec)
+    policy, trained_on = resolve(spec, env_id=env_id)
     return policy.bound, env_id or trained_on, dict(policy.env_kwargs), policy_label(spec, policy)
 
 

@@ -1,8 +1,13 @@
 """Hyperparameters: rl-zoo3-style YAML files keyed by environment id.
 
-``agents/configs/<algo>.yaml`` holds the shipped defaults; ``--config FILE`` overrides them with a
-file of the same format (a block for the env id, or a flat mapping applied to it). Besides the
-algorithm's constructor arguments a block may hold:
+``agents/configs/<algo>.yaml`` holds the shipped defaults (a block per env id) and one entry per
+shipped policy that shares an env id with another (keyed by the policy's name; its
+``agents/policies/<name>.json`` names the env id). ``--config`` is ``FILE`` or ``FILE:ENTRY``: the
+block of an rl-zoo3-style file (for the env id, or the named entry; a flat mapping is the block
+for the env id) over the shipped default block, or a delta, a block with ``base: FILE[:ENTRY]``
+and the keys that differ, over its resolved base (:func:`load_hyperparams`; the experiment
+variants in ``docs/experiments/configs/`` are deltas). Besides the algorithm's constructor
+arguments a block may hold:
 
 =================  ===========================================================================
 ``n_timesteps``    training steps (``--timesteps`` overrides)
@@ -143,10 +148,15 @@ def algo_class(algo: str):
     return {"ppo": sb3.PPO, "sac": sb3.SAC, "td3": sb3.TD3}[algo]
 
 
+def shipped_dir() -> Path:
+    """The directory of the shipped hyperparameter files (``agents/configs``)."""
+    return Path(str(resources.files("agents") / "configs"))
+
+
 def default_config_path(algo: str) -> Path:
     if algo not in ALGOS:
         raise ConfigError(f"algo must be one of {', '.join(ALGOS)}, got {algo!r}")
-    return Path(str(resources.files("agents") / "configs" / f"{algo}.yaml"))
+    return shipped_dir() / f"{algo}.yaml"
 
 
 def read_yaml(path: str | Path) -> dict:
@@ -162,32 +172,124 @@ def read_yaml(path: str | Path) -> dict:
     return data
 
 
-def load_hyperparams(algo: str, env_id: str, config: str | Path | None = None) -> dict:
-    """The hyperparameters for (algo, env id): shipped defaults, then ``config`` on top (both
-    read with :func:`project_keys`; a ``vec_env_wrapper`` / ``callback`` entry of ``config``
-    replaces what the defaults' entries set)."""
-    shipped = read_yaml(default_config_path(algo))
-    if env_id not in shipped:
-        raise ConfigError(f"no {algo} hyperparameters for {env_id} in {default_config_path(algo)}; "
-                          f"known ids: {', '.join(shipped)}")
-    hp = project_keys(copy.deepcopy(shipped[env_id]))
-    if config is not None:
-        user = read_yaml(config)
-        block = user.get(env_id, user if not any(k.startswith("RotorDrop-") for k in user) else None)
-        if block is None:
-            raise ConfigError(f"config file {config} has no block for {env_id} (has {', '.join(user)})")
-        if not isinstance(block, dict):
-            raise ConfigError(f"config file {config}: the {env_id} block must be a mapping")
-        for entry, keys in (("vec_env_wrapper", WRAPPER_KEYS), ("callback", CALLBACK_KEYS)):
-            if entry in block:
-                for key in keys:
-                    hp.pop(key, None)
-        for key, value in project_keys(block).items():
-            if key == "env_kwargs" and isinstance(value, dict):
-                hp.setdefault("env_kwargs", {}).update(value)
-            else:
-                hp[key] = value
+def split_ref(ref: str | Path) -> tuple[str, str | None]:
+    """``"FILE:ENTRY"`` -> (FILE, ENTRY); ``"FILE"`` -> (FILE, None)."""
+    text = str(ref)
+    head, sep, tail = text.rpartition(":")
+    if sep and tail and "/" not in tail and head.endswith((".yaml", ".yml")):
+        return head, tail
+    return text, None
+
+
+def _locate(name: str, near: Path | None) -> Path:
+    """A config file: relative to ``near`` (the file naming it as its base) or, without ``near``,
+    to the current directory; then the shipped file of that name (``ppo.yaml``,
+    ``agents/configs/ppo.yaml`` from any directory)."""
+    path = Path(name)
+    if path.is_absolute():
+        return path
+    here = (near / path) if near is not None else path
+    if here.is_file():
+        return here
+    shipped = shipped_dir() / path.name
+    if shipped.is_file() and path.parent in (Path("."), Path("agents/configs")):
+        return shipped
+    return here
+
+
+def _layer(hp: dict, block: dict) -> dict:
+    """``block`` (read with :func:`project_keys`) over ``hp``: ``env_kwargs`` merged key by key, a
+    ``vec_env_wrapper`` / ``callback`` entry replacing what ``hp``'s entries set, others replaced."""
+    hp = copy.deepcopy(hp)
+    for entry, keys in (("vec_env_wrapper", WRAPPER_KEYS), ("callback", CALLBACK_KEYS)):
+        if entry in block:
+            for key in keys:
+                hp.pop(key, None)
+    for key, value in project_keys(block).items():
+        if key == "env_kwargs" and isinstance(value, dict):
+            hp.setdefault("env_kwargs", {}).update(copy.deepcopy(value))
+        else:
+            hp[key] = copy.deepcopy(value)
     return hp
+
+
+def _entry_env(path: Path, entry: str) -> str | None:
+    """The env id an entry trains: the entry itself if it is an env id, else the ``env_id`` of the
+    shipped policy of that name (``agents/policies/<entry>.json``) when it is a shipped file."""
+    if entry.startswith("RotorDrop-"):
+        return entry
+    if path.parent.resolve() == shipped_dir().resolve():
+        meta = Path(str(resources.files("agents") / "policies" / f"{entry}.json"))
+        if meta.is_file():
+            import json
+            return json.loads(meta.read_text()).get("env_id")
+    return None
+
+
+def _resolve(algo: str, env_id: str, ref: str, near: Path | None, chain: tuple[str, ...]) -> dict:
+    """The hyperparameters ``ref`` (``FILE`` or ``FILE:ENTRY``) stands for (module docstring)."""
+    name, entry = split_ref(ref)
+    path = _locate(name, near)
+    data = read_yaml(path)
+    key = f"{path.resolve()}:{entry or ''}"
+    shown = f"{name}:{entry}" if entry else name
+    if key in chain:
+        raise ConfigError(f"config {shown}: its base chain comes back to itself "
+                          f"({' -> '.join([c.rsplit('/', 1)[-1].rstrip(':') for c in chain] + [shown])})")
+    chain = chain + (key,)
+    shipped = path.resolve().parent == shipped_dir().resolve() and path.stem in ALGOS
+    if shipped and path.stem != algo:
+        raise ConfigError(f"config {shown} holds {path.stem} hyperparameters: train it with "
+                          f"--algo {path.stem}, not --algo {algo}")
+    if "base" in data:                                        # a delta file: one flat block
+        if entry is not None:
+            raise ConfigError(f"config {name} is a delta on base {data['base']!r} (one block, no "
+                              f"entries): name it without :{entry}")
+        block = data
+    else:
+        want = entry or env_id
+        if want in data:
+            block = data[want]
+        elif entry is None and not any(k.startswith("RotorDrop-") for k in data) and not shipped:
+            block = data                                      # a flat mapping for --env
+        else:
+            raise ConfigError(f"config file {path} has no block for {want} (has {', '.join(map(str, data))})")
+        if not isinstance(block, dict):
+            raise ConfigError(f"config file {path}: the {want} block must be a mapping")
+        if entry is not None:
+            pinned = _entry_env(path, entry)
+            if pinned is not None and pinned != env_id:
+                raise ConfigError(f"config {shown} trains {pinned}; pass --env {pinned}, "
+                                  f"not --env {env_id}")
+    if "base" in block:
+        base = block["base"]
+        if not isinstance(base, str) or not base:
+            raise ConfigError(f"config {shown}: base must name a file (FILE or FILE:ENTRY), got {base!r}")
+        hp = _resolve(algo, env_id, base, path.parent, chain)
+        return _layer(hp, {k: v for k, v in block.items() if k != "base"})
+    if shipped and entry in (None, env_id):
+        return project_keys(copy.deepcopy(block))             # a shipped default: the bottom
+    return _layer(_resolve(algo, env_id, str(default_config_path(algo)), None, chain), block)
+
+
+def load_hyperparams(algo: str, env_id: str, config: str | Path | None = None) -> dict:
+    """The hyperparameters for (algo, env id). Without ``config``: the shipped default block
+    (``agents/configs/<algo>.yaml``, key ``env_id``). ``config`` is ``FILE`` or ``FILE:ENTRY``:
+
+    * an rl-zoo3 file: its block for ``env_id`` (or ``ENTRY``; a flat mapping is the block for
+      ``env_id``) read over the shipped default block;
+    * a block (or a whole file) with a ``base:`` key (``FILE`` or ``FILE:ENTRY``, a path relative
+      to the file that names it, or a shipped file's name such as ``ppo.yaml``): that base,
+      resolved the same way, with the block's keys on top (a delta).
+
+    ``env_kwargs`` merge key by key, a ``vec_env_wrapper`` / ``callback`` entry replaces what the
+    entries below it set, any other key replaces its value. A base chain that comes back to a
+    file it has read, an algorithm or env id other than the one trained, or a missing file or
+    entry are ConfigErrors."""
+    if algo not in ALGOS:
+        raise ConfigError(f"algo must be one of {', '.join(ALGOS)}, got {algo!r}")
+    ref = str(default_config_path(algo)) if config is None else str(config)
+    return _resolve(algo, env_id, ref, None, ())
 
 
 def project_keys(block: dict) -> dict:

@@ -286,7 +286,9 @@ def search_scenario(sc: Scenario, phase: float, passive: dict, population: int, 
     passive)`` drops the sequence must suit as well: a candidate's cost is its mean over the
     scenario and its copies (a search blind to what tells them apart, e.g. a friction change
     no sensor resolves); J is then that mean and ``kpis`` the scenario's own."""
+    import warnings
     from rotordrop_env import BatchedRotorDropVecEnv
+    from rotordrop_env.vec_env import TorchThreadsWarning
     from .search import cross_entropy
     drops = [(sc, phase, passive), *copies]
     venvs: dict[tuple[int, int], object] = {}
@@ -298,8 +300,10 @@ def search_scenario(sc: Scenario, phase: float, passive: dict, population: int, 
         own: list[dict] = []
         for c, (drop, drop_phase, drop_passive) in enumerate(drops):
             if (c, n) not in venvs:
-                venvs[c, n] = BatchedRotorDropVecEnv(ENV_ID, n, seed=0,
-                                                     **search_kwargs(drop, drop_phase))
+                with warnings.catch_warnings():     # no network here: torch's threads are idle
+                    warnings.simplefilter("ignore", TorchThreadsWarning)
+                    venvs[c, n] = BatchedRotorDropVecEnv(ENV_ID, n, seed=0,
+                                                         **search_kwargs(drop, drop_phase))
             kpis = rollout(venvs[c, n], thetas, drop.env_kwargs["power_return_time"])
             for m, k in enumerate(kpis):
                 row = kpi_row(k)

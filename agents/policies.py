@@ -25,7 +25,7 @@ from .controllers import BASELINES, controller_class, make_baseline, make_contro
 from .plant import Plant
 from .hyperparams import ALGOS as ALGO_NAMES, algo_class, parse_literal
 from .residual import RESIDUAL_SCALE, residual_action
-from .sb3_policy import export_self_contained, is_self_contained
+from .sb3_policy import current_env_id, export_self_contained, is_self_contained
 from .score import write_json
 
 
@@ -52,13 +52,14 @@ class LearnedPolicy:
     residual_scale: float = RESIDUAL_SCALE
     base: object | None = None
     source: str | None = None            # the path it was loaded from
+    given_env_id: str | None = None      # the env id given at load (a plain SB3 zip records none)
 
     def __reduce__(self):
         """Pickled as where it was loaded from (SB3 models and their statistics do not pickle):
         a Ray task of ``rotordrop benchmark --backend ray`` loads it again on its node."""
         if self.source is None:
             raise TypeError(f"policy {self.name} was not loaded from a file and cannot be pickled")
-        return _reload, (self.source, self.name)
+        return _reload, (self.source, self.name, self.given_env_id)
 
     def bound(self, plant: Plant) -> "LearnedPolicy":
         """Ready to drive the environment described by ``plant`` (checks that its observations
@@ -92,13 +93,29 @@ class LearnedPolicy:
                                ("actions", self.model.action_space,
                                 2 if plant.discrete else len(plant.action_names))):
             size = space.shape[0] if space.shape else space.n
+            if size != n and self.given_env_id is not None and plant.env_id == self.env_id:
+                raise ValueError(f"policy {self.name} has {size} {what}, --env {self.env_id} has "
+                                 f"{n}: pass the --env the model was trained on")
             if size != n:
                 raise ValueError(f"policy {self.name} was trained on {self.env_id} with {size} "
                                  f"{what}; {plant.env_id} has {n}: evaluate it on {self.env_id}")
 
     @classmethod
-    def load(cls, path: str | Path, name: str | None = None) -> "LearnedPolicy":
+    def load(cls, path: str | Path, name: str | None = None, env_id: str | None = None,
+             check_env: bool = True) -> "LearnedPolicy":
+        """The policy at ``path``; ``env_id`` names the environment it was trained on when
+        nothing next to it records one (a plain SB3 ``model.save`` zip: its env kwargs are then
+        the environment's defaults); with ``check_env`` a recorded env id other than ``env_id``
+        is a ValueError (evaluate passes False: it may run a policy in another env id with the
+        same spaces)."""
         path = Path(path)
+        if env_id is not None:
+            import gymnasium as gym
+            import rotordrop_env  # noqa: F401  (registers the ids)
+            if env_id not in gym.registry:
+                known = sorted(k for k in gym.registry if k.startswith("RotorDrop-"))
+                raise ValueError(f"--env {env_id!r} is not a registered environment; one of "
+                                 f"{', '.join(known)}")
         if path.is_dir() and not (path / "model.zip").is_file() and (path / "best_model.zip").is_file():
             path = path / "best_model.zip"                  # a run's best/
         if path.is_dir():
@@ -118,10 +135,16 @@ class LearnedPolicy:
         algo = meta.get("algo") or _algo_from_zip(model_path)
         model = algo_class(algo).load(str(model_path), device="cpu")
         inside = model.policy.rotordrop if is_self_contained(model) else {}
-        env_id = meta.get("env_id") or inside.get("env_id")
+        given, env_id = env_id, meta.get("env_id") or inside.get("env_id")
+        env_id = current_env_id(env_id) if env_id is not None else None
+        if check_env and env_id is not None and given is not None and given != env_id:
+            raise ValueError(f"{model_path} was trained on {env_id} (recorded next to it or in "
+                             f"the zip), not --env {given}: leave out --env or pass {env_id}")
+        env_id = env_id or given
         if env_id is None:
             raise FileNotFoundError(f"cannot tell which environment {model_path} was trained on: "
-                                    f"no config.yaml or .json next to it")
+                                    f"no config.yaml or .json next to it; pass --env ID (e.g. "
+                                    f"--env RotorDrop-Damping-v1)")
         hp = meta.get("hyperparams", {})
         env_kwargs = dict(meta.get("env_kwargs") or hp.get("env_kwargs")
                           or inside.get("env_kwargs") or {})
@@ -133,11 +156,11 @@ class LearnedPolicy:
         return cls(name or meta.get("name") or f"{algo}-{task}", algo, env_id, env_kwargs, model,
                    vn, meta, settings.get("residual"),
                    float(settings.get("residual_scale") or RESIDUAL_SCALE),
-                   source=str(path.resolve()))
+                   source=str(path.resolve()), given_env_id=given)
 
 
-def _reload(source: str, name: str) -> LearnedPolicy:
-    return LearnedPolicy.load(source, name=name)
+def _reload(source: str, name: str, env_id: str | None = None) -> LearnedPolicy:
+    return LearnedPolicy.load(source, name=name, env_id=env_id)
 
 
 def _stats_candidates(model_zip: Path) -> list[Path]:
@@ -197,9 +220,10 @@ def load_shipped(name: str) -> LearnedPolicy:
     return LearnedPolicy.load(path, name=name)
 
 
-def resolve(spec: str, plant: Plant | None = None):
+def resolve(spec: str, plant: Plant | None = None, env_id: str | None = None):
     """A baseline name, a controller class spec (``module:Class``, ``file.py:Class``), a shipped
-    policy name or a path -> (controller-or-policy, env_id | None).
+    policy name or a path -> (controller-or-policy, env_id | None). ``env_id`` (``--env``): the
+    environment of a path that records none (a plain SB3 zip, :meth:`LearnedPolicy.load`).
 
     Controllers need the ``plant`` of the environment they will drive (without it: None).
     """
@@ -210,28 +234,31 @@ def resolve(spec: str, plant: Plant | None = None):
         pol = load_shipped(spec)
         return (pol.bound(plant) if plant is not None else pol), pol.env_id
     if Path(spec).exists():
-        pol = LearnedPolicy.load(spec)
+        pol = LearnedPolicy.load(spec, env_id=env_id, check_env=False)
         return (pol.bound(plant) if plant is not None else pol), pol.env_id
     raise KeyError(f"--policy {spec!r} is not a baseline ({', '.join(BASELINES)}), a shipped "
                    f"policy ({', '.join(shipped_names()) or 'none shipped'}), an existing path or "
                    f"a controller class (package.module:Class, file.py:Class)")
 
 
-def export_policy(source: str | Path, out: str | Path) -> Path:
+def export_policy(source: str | Path, out: str | Path, env_id: str | None = None) -> Path:
     """``rotordrop export-policy``: the policy at ``source`` (a run directory, its ``best/``, a
-    checkpoint or model zip with its statistics next to it, or a shipped name) as one
-    self-contained zip (:func:`agents.sb3_policy.export_self_contained`) at ``out``."""
-    pol = load_shipped(str(source)) if str(source) in shipped_names() else LearnedPolicy.load(source)
+    checkpoint or model zip with its statistics next to it, a plain SB3 zip with ``env_id``, or a
+    shipped name) as one self-contained zip (:func:`agents.sb3_policy.export_self_contained`) at
+    ``out``."""
+    pol = (load_shipped(str(source)) if str(source) in shipped_names()
+           else LearnedPolicy.load(source, env_id=env_id))
     return export_learned(pol, out)
 
 
-def export_zoo(source: str | Path, folder: str | Path) -> Path:
+def export_zoo(source: str | Path, folder: str | Path, env_id: str | None = None) -> Path:
     """The policy at ``source`` (as :func:`export_policy`) laid out as an rl-zoo3 run in
     ``folder`` (``<algo>/<env id>.zip`` and ``<algo>/<env id>/config.yml`` with its env kwargs),
     so that ``python -m rl_zoo3.enjoy --algo ALGO --env ID --gym-packages rotordrop_env -f
     FOLDER --exp-id -1`` plays it. The zip is self-contained: no VecNormalize is applied."""
     from .hyperparams import dump_yaml
-    pol = load_shipped(str(source)) if str(source) in shipped_names() else LearnedPolicy.load(source)
+    pol = (load_shipped(str(source)) if str(source) in shipped_names()
+           else LearnedPolicy.load(source, env_id=env_id))
     run = Path(folder) / pol.algo
     (run / pol.env_id).mkdir(parents=True, exist_ok=True)
     dump_yaml({"env_kwargs": pol.env_kwargs, "normalize": False}, run / pol.env_id / "config.yml")

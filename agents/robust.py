@@ -114,24 +114,25 @@ def training_env_kwargs(control_dt: float = 0.005) -> dict:
 def run_suite(suite: str, out, quick: bool = False, policies: list[str] | None = None,
               max_scenarios: int | None = None, episodes: int | None = None,
               progress: bool = True, plots: bool = True, power_return: float | None = None,
-              backend=None) -> dict:
+              backend=None, env_id: str | None = None, names: list[str] | None = None) -> dict:
     """``rotordrop benchmark --suite SUITE``: the nominal suite (:func:`agents.benchmark.benchmark`)
     or the robust one (:func:`robust_benchmark`, where ``episodes`` and ``power_return`` do not
     apply: its scenarios draw the power return, one episode each)."""
     from .benchmark import benchmark, check_suite
     if check_suite(suite) == "nominal":
         return benchmark(out, quick, policies, max_scenarios, episodes, progress, plots,
-                         power_return, backend)
+                         power_return, backend, env_id, names)
     for flag, value in (("--episodes", episodes), ("--power-return-ms", power_return)):
         if value is not None:
             raise ValueError(f"{flag} does not apply to --suite robust (its scenarios draw the "
                              "power return; one episode each)")
-    return robust_benchmark(out, quick, policies, max_scenarios, progress, plots, backend)
+    return robust_benchmark(out, quick, policies, max_scenarios, progress, plots, backend,
+                            env_id, names)
 
 
 def robust_benchmark(out, quick: bool = False, policies: list[str] | None = None,
                      max_scenarios: int | None = None, progress: bool = True, plots: bool = True,
-                     backend=None) -> dict:
+                     backend=None, env_id: str | None = None, names: list[str] | None = None) -> dict:
     """``rotordrop benchmark --suite robust``: every Full-task row (baselines, shipped and
     ``--policy`` policies) on the robust scenarios (module doc); writes benchmark.json,
     leaderboard.md and the plots into ``out`` in the nominal benchmark's format."""
@@ -151,7 +152,7 @@ def robust_benchmark(out, quick: bool = False, policies: list[str] | None = None
     if max_scenarios is not None:
         n = max(1, min(n, max_scenarios))
     scenarios = robust_scenarios(n)
-    entries, learned = robust_entries(policies)
+    entries, learned = robust_entries(policies, env_id, names)
     with backend.session() as session:
         bar = tqdm(total=len(entries) * n, desc="robust suite", unit="ep", disable=not progress)
         rows = entry_rows(session, entries, scenarios, (0.0,), bar)

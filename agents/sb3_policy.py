@@ -105,7 +105,7 @@ class SelfContained:
             from .controllers import make_baseline
             from .plant import plant_of
             self._base = make_baseline(self.rotordrop["residual"],
-                                       plant_of(self.rotordrop["env_id"],
+                                       plant_of(current_env_id(self.rotordrop["env_id"]),
                                                 **self.rotordrop.get("env_kwargs", {})))
         return self._base
 
@@ -155,6 +155,15 @@ PLAIN_MODULES = {"stable_baselines3.common.policies": "ppo", "stable_baselines3.
 #: the self-contained policy classes -> their algorithm
 EXPORTED_ALGOS = {"RotorDropActorCriticPolicy": "ppo", "RotorDropSACPolicy": "sac",
                   "RotorDropTD3Policy": "td3", "RotorDropTQCPolicy": "tqc"}
+
+
+def current_env_id(env_id: str) -> str:
+    """The registered id of a task: a zip exported under a retired version (``RotorDrop-Full-v0``,
+    which Gymnasium refuses as deprecated) names the current version of the same task, whose
+    observations and actions are the same (docs/environments.md, version history)."""
+    import re
+    m = re.fullmatch(r"(RotorDrop-[A-Za-z]+)-v0", str(env_id))
+    return f"{m[1]}-v1" if m else env_id
 
 
 def zip_algo(path: str | Path) -> str | None:

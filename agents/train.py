@@ -629,9 +629,11 @@ def set_threads(threads: int) -> None:
     the batched physics step on a few shared cores (numba's OpenMP threads oversubscribe)."""
     import numba
     import torch
+    from rotordrop_env import vec_env
     n = max(1, int(threads))
     torch.set_num_threads(n)
     numba.set_num_threads(min(n, numba.config.NUMBA_NUM_THREADS))
+    vec_env.TORCH_THREADS_QUIET = max(vec_env.TORCH_THREADS_QUIET, n)   # --threads N is a choice
 
 
 def _action_noise(meta: dict, dim: int):

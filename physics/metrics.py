@@ -45,6 +45,8 @@ PRE_FAULT_KEYS = ("pre_fault_peak_contact_force_N",)    # invalid only if it lef
 STATOR_INVALID_KEYS = ("max_displacement_um", "stator_peak_force_N", "stator_contact_time_s",
                        "stator_penetration_um", "max_stator_displacement_um")
 BEFORE_INVALID = "_before_invalid"                 # suffix of their values up to that time
+SLIDING_SLIP = 0.1              # |1 - omega_s R / (Omega r)| at the end above which a sleeve slides
+SLIDING_WINDOW = 5e-3           # s: a plane counts as in contact at the end if it was in this window
 
 
 def per_plane(result: Result, compute) -> dict:
@@ -444,12 +446,47 @@ def warnings_of(m: dict, scene) -> list[str]:
                          for d in m["sampled_peaks_missed"])
         out.append(f"the output samples miss impact peaks by more than {PEAK_TOLERANCE:.0%}: {miss} "
                    f"(step_resolved_peaks in metrics.json); raise solver.output_rate")
+    if sliding_warning(m):
+        out.append(sliding_warning(m))
     for p, v in m["planes"].items():
         if v["whirl_sampling_aliased"]:
             out.append(f"{p}: the orbit turns more than {ALIAS_ANGLE / math.pi:g}π between output "
                        "samples (whirl_sampling_aliased): whirl detection and frequency are unreliable; "
                        "raise solver.output_rate")
     return out
+
+
+def final_slip(result: Result) -> dict:
+    """The slip ratio 1 - omega_s R / (Omega r) of each retainer plane at the last sample (sleeve
+    surface speed over the rotor's, R the sleeve bore, r the journal radius): 0 when the sleeve
+    rolls with the rotor, 1 when it stands. None for a plane out of contact over the last
+    :data:`SLIDING_WINDOW` (re-levitated, or no drop) or a rotor at rest. ``final_slip_ratio``
+    has every plane, ``sleeves_still_sliding`` those beyond :data:`SLIDING_SLIP`."""
+    scene = result.model.scene
+    r = scene.rotor.journal_radius
+    bore = r + scene.contact.clearance
+    rotor = float(result.rotor_speed[-1]) * r
+    tail = result.t >= result.t[-1] - SLIDING_WINDOW
+    slip = {}
+    for p in PLANES:
+        touching = result.t_fault is not None and bool((result.contact_force(p)[tail] > 0).any())
+        slip[p] = (float(1.0 - result.sleeve_speed(p)[-1] * bore / rotor)
+                   if touching and abs(rotor) > 1e-9 else None)
+    return dict(final_slip_ratio=slip,
+                sleeves_still_sliding={p: v for p, v in slip.items()
+                                       if v is not None and abs(v) > SLIDING_SLIP})
+
+
+def sliding_warning(m: dict) -> str | None:
+    """The warning of a run that ends with a sleeve still sliding (:func:`final_slip`)."""
+    sliding = m.get("sleeves_still_sliding")
+    if not sliding:
+        return None
+    slips = ", ".join(f"{p} {v:.2f}" for p, v in sliding.items())
+    return (f"the run ends with the sleeves still sliding (slip 1 - omega_s R / (Omega r) at t_end "
+            f"= {m['t_end']:g} s: {slips}; rolling is 0): the final state is not a settled rolling "
+            f"state, and whirl and final speeds describe the transient only (raise --t-end / "
+            f"solver.t_end)")
 
 
 def validity_warning(m: dict, scene) -> str:
@@ -489,6 +526,7 @@ def compute_metrics(result: Result) -> dict:
     out["rating_pressure_MPa"] = rating_pressure(result.model.scene.bearing) * 1e-6 if balls else None
     out.update(check_metrics(result, out))
     out["dissipation"] = dissipation_check(result)
+    out.update(final_slip(result))
     out["warnings"] = warnings_of(out, result.model.scene)
     return out
 

@@ -21,6 +21,37 @@ from .batch import (ENVS_PER_THREAD, RECHOOSE_EVERY, TRIAL_STEPS, Batch, ThreadC
                     auto_threads)
 from .info import PEAK_KEYS, row_info
 
+#: torch threads above which the SB3 VecEnv warns (once per process, :func:`check_torch_threads`)
+TORCH_THREADS_QUIET = 1
+_warned_threads = False
+
+
+class TorchThreadsWarning(UserWarning):
+    """torch trains the small networks of these tasks on several threads: usually slower."""
+
+
+def check_torch_threads() -> bool:
+    """Warn once per process (:class:`TorchThreadsWarning`) when torch is imported and runs on
+    more than :data:`TORCH_THREADS_QUIET` threads as an SB3 VecEnv is made: the networks that
+    train on these environments (two layers of 64) are several times faster on one thread on a
+    small CPU, and the batch's numba threads compete with torch's. Only the SB3 VecEnv checks
+    (it exists to train), not the environments. True when it warned."""
+    import sys
+    import warnings
+    global _warned_threads
+    torch = sys.modules.get("torch")
+    if _warned_threads or torch is None:
+        return False
+    n = torch.get_num_threads()
+    if n <= TORCH_THREADS_QUIET:
+        return False
+    _warned_threads = True
+    warnings.warn(f"torch runs on {n} threads: for the small networks of rotordrop tasks "
+                  f"torch.set_num_threads(1) before training is usually several times faster "
+                  f"(silence: warnings.filterwarnings('ignore', category="
+                  f"rotordrop_env.vec_env.TorchThreadsWarning))", TorchThreadsWarning, stacklevel=3)
+    return True
+
 
 class BatchedRotorDropVecEnv(VecEnv):
     """``n_envs`` copies of ``env_id`` (with ``env_kwargs``) stepped together.
@@ -39,6 +70,7 @@ class BatchedRotorDropVecEnv(VecEnv):
         if "max_episode_steps" in env_kwargs:     # gym.make's TimeLimit: .unwrapped drops it
             raise ValueError("max_episode_steps does not apply to the batched VecEnv; set the "
                              "episode length with episode_time (= steps x control_dt)")
+        check_torch_threads()
         self.batch = Batch([gym.make(env_id, **env_kwargs).unwrapped for _ in range(int(n_envs))],
                            n_threads)
         self.envs = self.batch.envs

@@ -17,6 +17,30 @@ def test_three_policies_ship_with_their_recipe():
         assert f"--seed {pol.meta['seed']}" in pol.meta["command"] and pol.meta["learning_curve"]
 
 
+@pytest.mark.parametrize("name", shipped_names())
+def test_shipped_policy_command_names_the_config_that_gave_its_hyperparameters(name):
+    """The command of a shipped policy's JSON, parsed as rotordrop train parses it, resolves to
+    the hyperparameters its run recorded (agents/configs/<algo>.yaml, an env-id block or the
+    policy's named entry)."""
+    import argparse
+    import ast
+    import shlex
+    from agents.cli import build_parser
+    from agents.hyperparams import RUN_DEFAULTS
+    from agents.train import resolve_config
+    pol = load_shipped(name)
+    argv = shlex.split(pol.meta["command"].split("#")[0])
+    assert argv[:2] == ["rotordrop", "train"] and "--config" in argv
+    args = build_parser().parse_args(argv[1:])
+    assert args.config.startswith(f"agents/configs/{pol.algo}.yaml") and args.seed == pol.meta["seed"]
+    hp = resolve_config(args.env, args.algo, args.config, args.timesteps, args.n_envs,
+                        eval_freq=args.eval_freq, n_eval_episodes=args.eval_episodes,
+                        checkpoint_freq=args.save_freq)
+    recorded = pol.meta["hyperparams"]
+    recorded = ast.literal_eval(recorded) if isinstance(recorded, str) else recorded
+    assert {**RUN_DEFAULTS, **hp} == {**RUN_DEFAULTS, **recorded}
+
+
 @pytest.mark.parametrize("name", ["ppo-damping", "ppo-relevitate", "ppo-full", "ppo-full-scratch",
                                   "sac-full-scratch", "sac-robust-full-scratch",
                                   "ppo-robust-full-scratch"])

@@ -109,7 +109,7 @@ def test_tqc_hyperparameters_are_checked_like_sacs(tmp_path):
     cfg.write_text(TINY.replace("top_quantiles_to_drop_per_net", "top_quantile_to_drop"))
     with pytest.raises(ConfigError, match="tqc config: unknown key 'top_quantile_to_drop'"):
         train(ENV, "tqc", tmp_path / "run", config=cfg, progress=False)
-    meta, kwargs = split(load_hyperparams("tqc", ENV, "agents/configs/tqc-currents.yaml"))
+    meta, kwargs = split(load_hyperparams("tqc", ENV, "docs/experiments/configs/tqc-currents.yaml"))
     assert meta["env_kwargs"]["command"] == "continuous" and kwargs["policy_kwargs"]["n_quantiles"] == 25
     with pytest.raises(ConfigError, match="--algo tqc needs continuous actions"):
         cfg.write_text(TINY + "    command: discrete\n")

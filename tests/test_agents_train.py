@@ -26,22 +26,74 @@ def test_shipped_configs_parse(algo):
             assert isinstance(env.action_space, Box), (algo, env_id)
 
 
-CONFIG_FILES = sorted(Path(__file__).resolve().parents[1].glob("agents/configs/*-*.yaml"))
+ROOT = Path(__file__).resolve().parents[1]
+#: the experiment variants: deltas on a shipped entry or on each other (docs/experiments/configs)
+DELTAS = sorted((ROOT / "docs/experiments/configs").glob("*.yaml"))
+#: the named entries of the shipped files (one per shipped policy that shares an env id)
+ENTRIES = [(algo, key) for algo in ("ppo", "sac", "td3", "tqc")
+           for key in read_yaml(ROOT / f"agents/configs/{algo}.yaml") if not key.startswith("RotorDrop-")]
 
 
-@pytest.mark.parametrize("cfg", CONFIG_FILES, ids=lambda p: p.stem)
-def test_every_experiment_config_passes_the_checks_rotordrop_train_makes(cfg):
-    """The documented experiment configs (agents/configs/<algo>-<name>.yaml, applied with
-    --config over <algo>.yaml) pass the checks a run makes before it writes anything."""
+def _check(algo, env_id, config):
     from agents.hyperparams import check_sb3
     from agents.train import check_env, resolve_config
+    meta, kwargs = split(resolve_config(env_id, algo, config))
+    check_sb3(algo, env_id, meta, kwargs)
+    check_env(env_id, algo, meta)
+
+
+def test_the_package_ships_one_file_per_algorithm():
+    assert sorted(p.name for p in (ROOT / "agents/configs").iterdir()) == \
+        ["ppo.yaml", "sac.yaml", "td3.yaml", "tqc.yaml"]
+    assert len(DELTAS) >= 20 and ENTRIES
+
+
+@pytest.mark.parametrize("algo,entry", ENTRIES, ids=lambda x: x)
+def test_every_shipped_entry_passes_the_checks_rotordrop_train_makes(algo, entry):
+    """A named entry trains the env id of the shipped policy of its name."""
+    env_id = json.loads((ROOT / f"agents/policies/{entry}.json").read_text())["env_id"]
+    _check(algo, env_id, f"agents/configs/{algo}.yaml:{entry}")
+
+
+@pytest.mark.parametrize("cfg", DELTAS, ids=lambda p: p.stem)
+def test_every_experiment_delta_passes_the_checks_rotordrop_train_makes(cfg):
+    """The experiment variants (docs/experiments/configs/<algo>-<name>.yaml: a base and the keys
+    that differ) resolve and pass the checks a run makes before it writes anything."""
+    data = read_yaml(cfg)
+    assert "base" in data and len(data) <= 13, "a delta names its base and only what differs"
     algo = cfg.stem.split("-")[0]
-    env_ids = [k for k in read_yaml(cfg) if k.startswith("RotorDrop-")]
-    assert env_ids, cfg
-    for env_id in env_ids:
-        meta, kwargs = split(resolve_config(env_id, algo, cfg))
-        check_sb3(algo, env_id, meta, kwargs)
-        check_env(env_id, algo, meta)
+    env_id = "RotorDrop-Relevitate-v1" if "currents" in cfg.stem else "RotorDrop-Full-v1"
+    _check(algo, env_id, cfg)
+
+
+def test_a_delta_is_its_base_with_its_keys_on_top(tmp_path):
+    base = load_hyperparams("ppo", "RotorDrop-Full-v1", "agents/configs/ppo.yaml:ppo-full-scratch")
+    (tmp_path / "a.yaml").write_text("base: ppo.yaml:ppo-full-scratch\nn_steps: 64\n"
+                                     "env_kwargs: {damping_action: linear}\n")
+    (tmp_path / "b.yaml").write_text("base: a.yaml\nlearning_rate: 1e-4\n")    # a sibling delta
+    hp = load_hyperparams("ppo", "RotorDrop-Full-v1", tmp_path / "b.yaml")
+    assert hp["n_steps"] == 64 and hp["learning_rate"] == 1e-4
+    assert hp["env_kwargs"] == {**base["env_kwargs"], "damping_action": "linear"}
+    assert {k: v for k, v in hp.items() if k not in ("n_steps", "learning_rate", "env_kwargs")} == \
+        {k: v for k, v in base.items() if k not in ("n_steps", "learning_rate", "env_kwargs")}
+    assert hp["residual"] is None                   # the entry's, not the Full-v1 default's residual
+    (tmp_path / "c.yaml").write_text("base: d.yaml\n")
+    (tmp_path / "d.yaml").write_text("base: c.yaml\n")
+    with pytest.raises(ConfigError, match="comes back to itself") as err:
+        load_hyperparams("ppo", "RotorDrop-Full-v1", tmp_path / "c.yaml")
+    assert "\n" not in str(err.value)
+    with pytest.raises(ConfigError, match="pass --env RotorDrop-Full-v1"):
+        load_hyperparams("ppo", "RotorDrop-Damping-v1", "agents/configs/ppo.yaml:ppo-full-scratch")
+    with pytest.raises(ConfigError, match="--algo sac"):
+        load_hyperparams("ppo", "RotorDrop-Full-v1", "agents/configs/sac.yaml:sac-full-scratch")
+    with pytest.raises(ConfigError, match="no block for nope"):
+        load_hyperparams("ppo", "RotorDrop-Full-v1", "ppo.yaml:nope")
+    (tmp_path / "e.yaml").write_text("base: missing.yaml\n")
+    with pytest.raises(ConfigError, match="missing.yaml does not exist"):
+        load_hyperparams("ppo", "RotorDrop-Full-v1", tmp_path / "e.yaml")
+    (tmp_path / "f.yaml").write_text("base: [ppo.yaml]\n")
+    with pytest.raises(ConfigError, match="base must name a file"):
+        load_hyperparams("ppo", "RotorDrop-Full-v1", tmp_path / "f.yaml")
 
 
 def test_config_override_and_literals(tmp_path):

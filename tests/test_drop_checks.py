@@ -49,7 +49,7 @@ def test_a_soft_housing_that_sags_into_the_rotor_is_contact_before_the_fault(tmp
 
 
 def test_a_clean_drop_has_no_pre_fault_contact_and_no_warning(tmp_path, capsys):
-    rc, m, out, _ = _drop(tmp_path, capsys, "--t-end", "0.15")
+    rc, m, out, _ = _drop(tmp_path, capsys, "--t-end", "1.0")   # settled: rolling
     assert rc == 0 and m["fault_simulated"] and not m["contact_before_fault"]
     assert all(v["pre_fault_peak_contact_force_N"] == 0.0 for v in m["planes"].values())
     assert m["warnings"] == [] and "warning" not in out

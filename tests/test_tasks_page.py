@@ -1,0 +1,50 @@
+"""docs/tasks.md states each task's standing from the committed data: every score it quotes for a
+row, the oracle margins, the robust target and the hard benchmark's reference must match
+docs/data/*.json (re-running a benchmark without updating the page fails here)."""
+import json
+import re
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+DATA = ROOT / "docs" / "data"
+SECTIONS = {"Damping": ("nominal", "damping"), "Re-levitation": ("nominal", "relevitate"),
+            "Full: damping and re-levitation": ("nominal", "full"), "Robust suite": ("robust", "full")}
+
+
+def _sections() -> dict[str, str]:
+    parts = re.split(r"^## (.+)$", (ROOT / "docs" / "tasks.md").read_text(), flags=re.M)
+    return dict(zip(parts[1::2], parts[2::2]))
+
+
+def _load(name):
+    return json.loads((DATA / f"{name}.json").read_text())
+
+
+def test_every_quoted_row_score_is_the_committed_one():
+    sections, checked = _sections(), 0
+    for title, (suite, task) in SECTIONS.items():
+        board = {e["controller"]: e["score"] for e in _load(f"leaderboard-{suite}")["leaderboard"]
+                 if e["task"] == task}
+        status = sections[title].split("**Status", 1)[1]
+        for name, score in re.findall(r"`([\w-]+)` (-?\d+\.\d\d)\b", status):
+            assert name in board, (title, name)
+            assert f"{board[name]:.2f}" == score, (title, name, board[name], score)
+            checked += 1
+    assert checked >= 8
+
+
+def test_oracle_margins_robust_target_and_hard_reference():
+    sections = _sections()
+    nominal = {r["controller"]: r["score"] for r in _load("oracle-nominal")["summary"]}
+    full = sections["Full: damping and re-levitation"]
+    assert f"{nominal['oracle']:.2f}" in full and f"{nominal['whirl-brake']:.2f}" in full
+    assert f"+{nominal['oracle'] - nominal['whirl-brake']:.2f} points" in full
+    robust = {r["controller"]: r["score"] for r in _load("oracle-robust")["summary"]}
+    best_designed = max(v for k, v in robust.items() if k != "oracle")
+    text = sections["Robust suite"]
+    assert f"{robust['oracle']:.2f}" in text and f"{robust['oracle'] - best_designed:.2f}" in text
+    target = _load("leaderboard-robust")["target"]
+    assert ("not met" in text) == (not target["met"]) and f"+{target['margin']:g}" in text
+    hard = _load("hard-pid-relevitate")
+    n, rate = hard["summary"]["episodes"], hard["summary"]["relevitation_success_rate"]
+    assert f"{round(rate * n)} / {n}" in sections["Hard benchmark: raw currents"]
