@@ -132,7 +132,7 @@ def cmd_benchmark(args) -> int:
         run_suite(args.suite, args.out, quick=args.quick, policies=args.policy,
                   max_scenarios=args.scenarios, episodes=args.episodes, progress=not args.quiet,
                   plots=not args.no_plots, power_return=_power_return_s(args),
-                  backend=Backend.from_args(args))
+                  backend=Backend.from_args(args), score=args.score)
     except ERRORS as exc:
         return _fail("benchmark", exc)
     return 0
@@ -322,7 +322,12 @@ def register(sub) -> None:
     p.add_argument("--suite", default="nominal",
                    help="nominal (default: the fixed scenario suite) or robust (200 drawn drops "
                         "under sensor noise, latency, actuator spread and plant variation, Full "
-                        "task; docs/agents.md 'Robust suite')")
+                        "task; docs/agents.md 'Robust suite'), or robust-legacy (the robust "
+                        "suite's earlier test drops, seeds 30000-30199, to reproduce old numbers)")
+    p.add_argument("--score", default="severity",
+                   help="severity (default: the whirl verdict plus its severity, the peak "
+                        "backward revolutions against the passive drop's) or legacy (the whirl "
+                        "verdict alone); docs/agents.md 'Score'")
     p.add_argument("--policy", action="append", default=None,
                    help="extra policies or controllers to include (repeatable): a training "
                         "directory or model .zip (shown as name@run), or your own controller "
