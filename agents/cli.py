@@ -341,8 +341,9 @@ def register(sub) -> None:
     p.add_argument("--episodes", type=int, default=None, help=argparse.SUPPRESS)
     p.set_defaults(func=cmd_benchmark)
 
-    p = sub.add_parser("oracle", help="per-scenario optimised command sequences of the supervisor "
-                                      "interface: the score no controller can beat by much")
+    p = sub.add_parser("oracle", help="per-scenario searched open-loop command sequences of the "
+                                      "supervisor interface: a score reachable on each drop (a "
+                                      "lower bound, not a ceiling)")
     p.add_argument("--scenarios", type=at_least(1), default=20, help="drawn scenarios (default 20)")
     p.add_argument("--population", type=at_least(2), default=24,
                    help="command sequences per generation (one batched rollout)")

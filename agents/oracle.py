@@ -1,5 +1,7 @@
-"""``rotordrop oracle``: the best any command sequence of the supervisor interface reaches, per
-scenario, as a bound for learned and designed controllers on the same scenarios.
+"""``rotordrop oracle``: a searched open-loop command sequence of the supervisor interface per
+scenario, scored beside learned and designed controllers on the same scenarios. Its score is
+reachable on each drop (a lower bound on what the interface can reach), not a ceiling: the
+search is local, over a few open-loop segments, and cannot express raw coil currents.
 
 For each of ``--scenarios`` drops drawn where whirl is decided (``ORACLE_RANGES``: friction
 0.38-0.6 unless ``--friction LO:HI`` says otherwise, power back 30-70 ms rounded up to the 5 ms control grid, any unbalance phase, the
@@ -430,7 +432,7 @@ def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iteration
     lo, hi = ranges["contact.friction"]
     where = ("the robust suite's first, sensor noise and latency" if suite == "robust" else
              "power back 30-70 ms")
-    print(f"{'oracle bound' if search else 'rows'}, {ENV_ID}, {scenarios} scenarios "
+    print(f"{'oracle (searched plans)' if search else 'rows'}, {ENV_ID}, {scenarios} scenarios "
           f"({where}, friction {lo:g}-{hi:g}, seeds from {settings['scenario_seed']}):")
     print("| controller | score | whirl rate | whirl where passive whirls | re-levitated |")
     print("|---|---:|---:|---:|---:|")
