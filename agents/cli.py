@@ -197,7 +197,8 @@ def cmd_oracle(args) -> int:
                         search=not args.no_search, scenario_seed=args.scenario_seed,
                         friction=args.friction, friction_bins=args.friction_bins,
                         suite=args.suite, constants=args.constant,
-                        start_from_constants=args.start_from_constants)
+                        start_from_constants=args.start_from_constants,
+                        interface=args.interface)
     except ERRORS as exc:
         return _fail("oracle", exc)
     _wrote(args.out, ["oracle.json", *report.get("figures", [])], report["wall_time_s"])
@@ -355,7 +356,7 @@ def register(sub) -> None:
                         "robust`: sensor noise, latency, actuator spread, plant variation)")
     p.add_argument("--scenario-seed", type=_SEED, default=None,
                    help="seed of the first drawn scenario (default 10000, with --suite robust "
-                        "the suite's 30000; scenario i uses it + i)")
+                        "the suite's 50000; scenario i uses it + i)")
     p.add_argument("--no-search", action="store_true",
                    help="score the rows only (no oracle search), e.g. on 200 scenarios")
     p.add_argument("--friction", type=_number_list(":", 2), default=None, metavar="LO:HI",
@@ -377,6 +378,10 @@ def register(sub) -> None:
     p.add_argument("--start-from-constants", action="store_true",
                    help="start each scenario's search from the best of inner-loop and the "
                         "--constant rows there (default: from inner-loop)")
+    p.add_argument("--interface", default="supervisor",
+                   help="what the search commands: supervisor (default: the supervisor "
+                        "interface's segments) or currents (open-loop corrections of "
+                        "whirl-brake's coil currents after the power return, 1 ms steps)")
     _output_args(p, "out/oracle")
     p.set_defaults(func=cmd_oracle)
 

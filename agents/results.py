@@ -318,8 +318,10 @@ def readme_block(root: Path = ROOT) -> str:
         return "No benchmark data committed yet: see docs/results.md."
     full = [e for e in nominal["leaderboard"] if e["task"] == "full"]
     return "\n".join([f"`rotordrop benchmark`, damping and re-levitation together "
-                      f"(`RotorDrop-Full-v1`, passive threshold μ\\* = {_f(nominal['passive_threshold'], 'g')}); "
-                      "every table: [docs/results.md](docs/results.md).", ""]
+                      f"(`RotorDrop-Full-v1`, passive threshold μ\\* = {_f(nominal['passive_threshold'], 'g')}"
+                      + (f", {nominal['score']} score; SE and Δ: paired bootstrap over the drops against "
+                         "the best designed row" if nominal.get("score") else "")
+                      + "); every table: [docs/results.md](docs/results.md).", ""]
                      + leaderboard_table(full))
 
 
