@@ -59,7 +59,7 @@ from .controllers import BASELINES, Passive
 from .plant import plant_of
 from .policies import load_shipped, shipped_names
 from .rollout import final_kpis, run_episodes
-from .score import overall_score, row_cost, write_json
+from .score import DEFAULT_SCORE, overall_score, row_cost, write_json
 
 ENV_ID = TASKS["full"]
 COMMAND = "supervisor"
@@ -515,7 +515,7 @@ def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iteration
 SETTINGS_ORDER = ("env_id", "command", "suite", "scenarios", "population", "iterations", "seed",
                   "scenario_seed", "ranges", "sensor_noise_m", "latency_ms", "segment_edges_ms",
                   "segment_actions", "max_delay_s", "control_dt", "shaping", "episode_time_s",
-                  "search_start", "interface", "current_baseline", "current_segments",
+                  "search_start", "score", "interface", "current_baseline", "current_segments",
                   "current_steps")
 
 
@@ -531,7 +531,8 @@ def suite_settings(suite: str, friction, scenario_seed: int | None) -> tuple[dic
     with the full suite, whose range it sets)."""
     settings = dict(env_id=ENV_ID, command=COMMAND, segment_edges_ms=list(SEGMENT_EDGES_MS),
                     segment_actions=list(SEGMENT_ACTIONS), max_delay_s=MAX_DELAY,
-                    control_dt=CONTROL_DT, shaping=SHAPING, episode_time_s=EPISODE_TIME)
+                    control_dt=CONTROL_DT, shaping=SHAPING, episode_time_s=EPISODE_TIME,
+                    score=DEFAULT_SCORE)
     if check_suite(suite) == "robust":
         from .robust import LATENCY_MS, ROBUST_RANGES, SENSOR_NOISE, SUITE_SEED
         if friction is not None:

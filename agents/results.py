@@ -183,7 +183,8 @@ def oracle_section(reports: list[tuple[str, dict, str]], root: Path) -> list[str
         seed = s.get("scenario_seed")
         out += [f"### {title}", "",
                 f"{s.get('scenarios')} drops (scenario seeds {seed}–{seed + s.get('scenarios', 1) - 1}), "
-                f"search {s.get('population')} × {s.get('iterations')} per drop (data: `{src}`)."
+                f"search {s.get('population')} × {s.get('iterations')} per drop, "
+                f"{s.get('score', 'legacy')} score (data: `{src}`)."
                 + (f" Searched plan over the best designed row (`{best['controller']}`): "
                    f"**{oracle['score'] - best['score']:+.2f}** points." if oracle and best else ""), "",
                 "| row | score | whirl rate | whirl where passive whirls | re-levitated | mean J |",
