@@ -230,7 +230,8 @@ def robust_markdown(report: dict, scenario_rows: bool = True) -> str:
     from .score import fmt_or_dash
     d = report["distribution"]
     ranges = ", ".join(f"{k} {lo:g}-{hi:g}" for k, (lo, hi) in d["ranges"].items())
-    lines = [f"# rotordrop benchmark --suite robust{' (quick)' if report['quick'] else ''}", "",
+    lines = [f"# rotordrop benchmark --suite {report.get('suite', 'robust')}"
+             f"{' (quick)' if report['quick'] else ''}", "",
              f"{len(report['scenarios'])} drops of RotorDrop-Full-v1 (scenario seeds "
              f"{d['scenario_seeds'][0]}-{d['scenario_seeds'][1]}) drawn from: {ranges}; "
              f"displacement-sensor noise {1e6 * d['sensor_noise_m']:g} µm, observation latency "
