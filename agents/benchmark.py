@@ -319,9 +319,10 @@ def benchmark(out: str | Path, quick: bool = False, policies: list[str] | None =
               progress: bool = True, plots: bool = True, power_return: float | None = None,
               backend=None, score: str = DEFAULT_SCORE) -> dict:
     """Run the suite and write benchmark.json, leaderboard.md and the plots into ``out``;
-    ``power_return`` [s]: see :func:`scenario_suite`; ``score``: :data:`agents.score.SCORES`. On ``backend`` ray every friction of the
-    threshold sweep and every controller is one Ray task (learned policies travel as their
-    paths and are loaded again on the node). The robust suite: :mod:`agents.robust`."""
+    ``power_return`` [s]: see :func:`scenario_suite`; ``score``: :data:`agents.score.SCORES`.
+    On ``backend`` ray every friction of the threshold sweep and every controller is one Ray
+    task (learned policies travel as their paths and are loaded again on the node). The robust
+    suite: :mod:`agents.robust`."""
     from physics.backend import Backend
     backend = backend if backend is not None else Backend()
     check_score(score)
