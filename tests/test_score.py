@@ -177,3 +177,10 @@ def test_the_legacy_score_reproduces_a_benchmark_run_before_the_severity_score()
     assert {(e["task"], e["controller"]): e["score"] for e in d["scores"]} == new
     severity = leaderboard(d["rows"], [], d["passive_threshold"])
     assert {(e["task"], e["controller"]): e["score"] for e in severity} != new
+
+
+def test_the_severity_reference_must_be_positive():
+    from rotordrop_env.reward import check_kpi_weights
+    with pytest.raises(ValueError, match=r"reward_kwargs.whirl_ref_revs must be a finite number > 0"):
+        check_kpi_weights({"whirl_ref_revs": 0.0})
+    assert check_kpi_weights({"w_severity": 0.0})["w_severity"] == 0.0
