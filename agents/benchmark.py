@@ -19,7 +19,10 @@
    they were trained with.
    Episodes last ``EPISODE_TIME`` and are not cut short at the stator (``terminate_on_failure =
    False``) so that whirl is measured as ``rotordrop drop`` measures it.
-4. **Score** (:mod:`agents.score`): per task, 100 (1 − Σ J / Σ J_passive) over the suite.
+4. **Score** (:mod:`agents.score`): per task, 100 (1 − Σ J / Σ J_passive) over the suite;
+   ``score`` picks J (``severity``, the default, or ``legacy``). Every leaderboard row carries
+   a paired bootstrap over the drops (scenario × phase episodes, the same for every row) of its
+   score and of its difference to the best designed row of its task (:func:`add_uncertainty`).
 
 Outputs: ``benchmark.json`` (threshold sweep, scenarios, one row per controller and scenario,
 leaderboard), ``leaderboard.md``, ``score.png``, ``whirl_map.png``, ``peak_force.png``.
@@ -37,7 +40,9 @@ import numpy as np
 from .controllers import BASELINES, Passive, command_for, controller_class, make_controller
 from .policies import LearnedPolicy, load_shipped, shipped_names
 from .rollout import check_actor, run_episodes
-from .score import fmt_or_dash, overall_score, row_cost, summarize, write_json
+from .score import (BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, DEFAULT_SCORE, bootstrap_scores,
+                    check_score, drop_costs, fmt_or_dash, overall_score, row_cost, summarize,
+                    write_json)
 
 EPISODE_TIME = 0.3
 EVAL_KWARGS = dict(episode_time=EPISODE_TIME, terminate_on_failure=False, randomize=False)
@@ -50,7 +55,7 @@ TASKS = {"damping": "RotorDrop-Damping-v1", "relevitate": "RotorDrop-Relevitate-
          "full": "RotorDrop-Full-v1"}
 RELEVITATION_ENVS = (TASKS["relevitate"], TASKS["full"])
 #: ``--suite``: the fixed nominal suite, or the robust one (:mod:`agents.robust`)
-SUITES = ("nominal", "robust")
+SUITES = ("nominal", "robust", "robust-legacy")
 
 
 def check_suite(suite: str) -> str:
@@ -303,7 +308,8 @@ def episode_kwargs(entry: Entry, scenario: Scenario, phase: float) -> dict:
     that has arrived)."""
     kw = {k: v for k, v in entry.env_kwargs.items()
           if k not in ("randomize", "randomization", "overrides", "terminate_on_failure",
-                       "episode_time", "samples_per_step", "sensor_noise", "obs_latency_steps")}
+                       "episode_time", "samples_per_step", "sensor_noise", "obs_latency_steps",
+                       "sensor_delay")}
     kw.update(EVAL_KWARGS)
     kw.update(monitor_kwargs(kw))
     kw["overrides"] = {**(entry.env_kwargs.get("overrides") or {}), **scenario.scene_overrides(phase)}
@@ -324,13 +330,16 @@ def latency_steps(latency_s: float, control_dt: float) -> int:
 def benchmark(out: str | Path, quick: bool = False, policies: list[str] | None = None,
               max_scenarios: int | None = None, episodes: int | None = None,
               progress: bool = True, plots: bool = True, power_return: float | None = None,
-              backend=None, env_id: str | None = None, names: list[str] | None = None) -> dict:
+              backend=None, env_id: str | None = None, names: list[str] | None = None,
+              score: str = DEFAULT_SCORE) -> dict:
     """Run the suite and write benchmark.json, leaderboard.md and the plots into ``out``;
-    ``power_return`` [s]: see :func:`scenario_suite`. On ``backend`` ray every friction of the
-    threshold sweep and every controller is one Ray task (learned policies travel as their
-    paths and are loaded again on the node). The robust suite: :mod:`agents.robust`."""
+    ``power_return`` [s]: see :func:`scenario_suite`; ``score``: :data:`agents.score.SCORES`.
+    On ``backend`` ray every friction of the threshold sweep and every controller is one Ray
+    task (learned policies travel as their paths and are loaded again on the node). The robust
+    suite: :mod:`agents.robust`."""
     from physics.backend import Backend
     backend = backend if backend is not None else Backend()
+    check_score(score)
     if power_return is not None:
         check_power_return(power_return, "--power-return-ms")
     from tqdm.auto import tqdm
@@ -361,9 +370,15 @@ def benchmark(out: str | Path, quick: bool = False, policies: list[str] | None =
         rows = entry_rows(session, entries, scenarios, phases, bar)
         bar.close()
         where = session.describe()
-    board = leaderboard(rows, scenarios, sweep["threshold"])
+    board = leaderboard(rows, scenarios, sweep["threshold"], score=score)
+    learned = {p.name: p for p in loaded}
+    for e in board:
+        e["kind"] = "learned" if e["controller"] in learned else "designed"
+    from .robust import seed_groups
     from rotordrop_env.env import DEFAULT_POWER_RETURN
-    report = dict(quick=quick, episode_time_s=EPISODE_TIME, phases_deg=list(phases),
+    report = dict(quick=quick, score=score, bootstrap=bootstrap_record(),
+                  seed_groups=seed_groups(board, learned),
+                  episode_time_s=EPISODE_TIME, phases_deg=list(phases),
                   power_return_s=DEFAULT_POWER_RETURN if power_return is None else power_return,
                   threshold_sweep=sweep, passive_threshold=sweep["threshold"],
                   scenarios=[dict(name=s.name, friction=s.friction, overrides=s.overrides,
@@ -449,12 +464,36 @@ def _row(entry: Entry, sc: Scenario, eps) -> dict:
                 relevitation_time_s=s["relevitation_time_s"],
                 control_effort=s["control_effort"],
                 stator_contact=float(np.mean([bool(d.get("stator_contact")) for d in k])),
-                episodes=len(eps))
+                episodes=len(eps),
+                # per-episode KPIs (in phase order): the drops of the leaderboard's bootstrap
+                drops={key: [_plain(d.get(key)) for d in k] for key in DROP_KEYS})
+
+
+#: the per-episode KPIs a row keeps (``drops``) for :func:`agents.score.drop_costs`
+DROP_KEYS = ("backward_whirl", "peak_whirl_revolutions", "peak_contact_force_N",
+             "max_displacement_um", "relevitated", "relevitation_time_s")
+
+
+def _plain(v):
+    if v is None:
+        return None
+    if isinstance(v, (bool, np.bool_)):
+        return bool(v)
+    return float(v)
+
+
+def bootstrap_record() -> dict:
+    """How the leaderboard's uncertainties were computed (recorded in benchmark.json)."""
+    return dict(method="paired bootstrap over drops (scenario x phase episodes)",
+                resamples=BOOTSTRAP_RESAMPLES, seed=BOOTSTRAP_SEED, interval="95 % percentile",
+                reference="the best designed row (baseline controller, not passive) of the task "
+                          "by point score")
 
 
 def leaderboard(rows: list[dict], scenarios: list[Scenario], threshold,
-                any_friction: bool = False) -> list[dict]:
-    """Per task and controller: overall score, whirl and force criteria (see agents.score).
+                any_friction: bool = False, score: str = DEFAULT_SCORE) -> list[dict]:
+    """Per task and controller: overall score (``score``: :data:`agents.score.SCORES`) with its
+    bootstrap uncertainty (:func:`add_uncertainty`), whirl and force criteria (see agents.score).
     The whirl rate "where passive whirls" counts the scenarios where the passive drop whirls
     at μ* + 0.05 or above (``threshold`` = μ*), or at any friction with ``any_friction``
     (the robust suite's drawn scenarios)."""
@@ -462,10 +501,10 @@ def leaderboard(rows: list[dict], scenarios: list[Scenario], threshold,
     for task in dict.fromkeys(r["task"] for r in rows):
         passive = {r["scenario"]: r for r in rows if r["task"] == task and r["controller"] == "passive"}
         relev = task != "damping"
-        p_costs = {n: row_cost(r, r, EPISODE_TIME, relev) for n, r in passive.items()}
+        p_costs = {n: row_cost(r, r, EPISODE_TIME, relev, score) for n, r in passive.items()}
         for name in dict.fromkeys(r["controller"] for r in rows if r["task"] == task):
             mine = [r for r in rows if r["task"] == task and r["controller"] == name]
-            costs = {r["scenario"]: row_cost(r, passive[r["scenario"]], EPISODE_TIME, relev)
+            costs = {r["scenario"]: row_cost(r, passive[r["scenario"]], EPISODE_TIME, relev, score)
                      for r in mine}
             for r in mine:
                 r["cost"] = costs[r["scenario"]]
@@ -494,8 +533,43 @@ def leaderboard(rows: list[dict], scenarios: list[Scenario], threshold,
                                             if relev else None),
                          stator_contact_rate=float(np.mean([r["stator_contact"] for r in mine])))
             board.append(entry)
+        add_uncertainty([e for e in board if e["task"] == task],
+                        [r for r in rows if r["task"] == task], passive, relev, score)
     board.sort(key=lambda e: (list(TASKS).index(e["task"]), -e["score"]))
     return board
+
+
+def add_uncertainty(entries: list[dict], rows: list[dict], passive: dict, relev: bool,
+                    score: str = DEFAULT_SCORE) -> None:
+    """Add to the leaderboard entries of one task the paired bootstrap over its drops
+    (:func:`agents.score.bootstrap_scores`): ``score_se``, ``reference`` (the best designed
+    row: a baseline of agents.controllers other than passive, by point score),
+    ``diff_vs_reference``, ``diff_se`` and ``diff_ci95``. Rows without per-episode KPIs, or
+    that did not run the passive row's drops, get none."""
+    names = [e["controller"] for e in entries]
+    by = {(r["controller"], r["scenario"]): r for r in rows}
+    order = list(passive)
+    try:
+        p_cost = np.concatenate([drop_costs(passive[s]["drops"], passive[s], EPISODE_TIME, relev,
+                                            score) for s in order])
+        costs = np.array([np.concatenate([drop_costs(by[(n, s)]["drops"], passive[s],
+                                                     EPISODE_TIME, relev, score) for s in order])
+                          for n in names])
+    except (KeyError, ValueError):
+        return
+    if costs.ndim != 2 or costs.shape[1] != p_cost.size:
+        return
+    designed = [i for i, n in enumerate(names) if n in BASELINES and n != "passive"]
+    pool = designed if designed else ([names.index("passive")] if "passive" in names else [])
+    if not pool:
+        return
+    ref = max(pool, key=lambda i: entries[i]["score"])
+    b = bootstrap_scores(costs, p_cost, ref)
+    for i, e in enumerate(entries):
+        e.update(score_se=float(b["score_se"][i]), reference=names[ref],
+                 diff_vs_reference=float(b["diff"][i]), diff_se=float(b["diff_se"][i]),
+                 diff_ci95=[float(b["diff_ci_low"][i]), float(b["diff_ci_high"][i])],
+                 drops=int(p_cost.size))
 
 
 def _group_score(mine, costs, p_costs, group):
@@ -513,27 +587,60 @@ def leaderboard_markdown(report: dict) -> str:
              f"unbalance phases, {report['episode_time_s']:g} s after the fault; re-levitation "
              f"tasks: power back {1e3 * report['power_return_s']:g} ms after the fault unless "
              f"the scenario says otherwise). "
-             f"Score: 100 (1 - sum J / sum J_passive), see docs/agents.md.", ""]
+             f"{score_sentence(report)}", ""]
     return "\n".join(lines + leaderboard_tables(report))
+
+
+def score_sentence(report: dict) -> str:
+    """What the leaderboard's score and uncertainty columns are (one markdown paragraph)."""
+    b = report.get("bootstrap") or {}
+    text = (f"Score ({report.get('score', 'legacy')}): 100 (1 - sum J / sum J_passive), see "
+            "docs/agents.md.")
+    if b:
+        text += (f" SE: paired bootstrap over the drops ({b['resamples']} resamples, seed "
+                 f"{b['seed']}); Δ: score minus the best designed row's of the task, with its SE "
+                 "and 95 % interval.")
+    return text
+
+
+def uncertainty_cells(e: dict) -> list[str]:
+    """The SE of the score and the difference to the reference row (± SE, [95 % interval])."""
+    if e.get("score_se") is None:
+        return ["-", "-"]
+    lo, hi = e["diff_ci95"]
+    return [f"{e['score_se']:.2f}", f"{e['diff_vs_reference']:+.2f} ± {e['diff_se']:.2f} "
+                                    f"[{lo:+.2f}, {hi:+.2f}]"]
 
 
 def leaderboard_tables(report: dict, scenario_rows: bool = True) -> list[str]:
     """The markdown leaderboard per task (and, with ``scenario_rows``, every row's KPIs)."""
     lines = []
     for task in dict.fromkeys(e["task"] for e in report["leaderboard"]):
+        ref = next((e.get("reference") for e in report["leaderboard"]
+                    if e["task"] == task and e.get("reference")), None)
         lines += [f"## {task}", "",
-                  "| rank | controller | score | in-dist. | out-of-dist. | whirl rate | whirl where "
+                  f"| rank | controller | score | SE | Δ vs {ref or 'best designed'} ± SE [95 %] | "
+                  "in-dist. | out-of-dist. | whirl rate | whirl where "
                   "passive whirls | peak F / passive (mean, max) | disp. / passive | relevitated | "
                   "stator contact |",
-                  "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+                  "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
         for i, e in enumerate([e for e in report["leaderboard"] if e["task"] == task], 1):
             lines.append(f"| {i} | {e['controller']} | {e['score']:.2f} | "
+                         f"{' | '.join(uncertainty_cells(e))} | "
                          f"{fmt_or_dash(e['in_distribution_score'], '.2f')} | "
                          f"{fmt_or_dash(e['out_of_distribution_score'], '.2f')} | {e['whirl_rate']:.2f} | "
                          f"{fmt_or_dash(e['whirl_rate_where_passive_whirls'], '.2f')} | "
                          f"{e['force_ratio']:.2f}, {e['max_force_ratio']:.2f} | "
                          f"{e['displacement_ratio']:.2f} | {fmt_or_dash(e['relevitation_rate'], '.2f')} | "
                          f"{e['stator_contact_rate']:.2f} |")
+        groups = [g for g in report.get("seed_groups") or []
+                  if any(e["task"] == task and e["controller"] in g["members"]
+                         for e in report["leaderboard"])]
+        if groups and report.get("suite") is None:        # the robust report lists its own
+            lines += ["", "| learned configuration (seeds) | scores | mean ± std |",
+                      "|---|---|---:|"]
+            lines += [f"| {', '.join(g['members'])} | {', '.join(f'{x:.2f}' for x in g['scores'])} "
+                      f"| {g['mean']:.2f} ± {g['std']:.2f} |" for g in groups]
         if not scenario_rows:
             lines.append("")
             continue

@@ -133,7 +133,8 @@ def cmd_benchmark(args) -> int:
         run_suite(args.suite, args.out, quick=args.quick, policies=args.policy,
                   max_scenarios=args.scenarios, episodes=args.episodes, progress=not args.quiet,
                   plots=not args.no_plots, power_return=_power_return_s(args),
-                  backend=Backend.from_args(args), env_id=args.env, names=args.name)
+                  backend=Backend.from_args(args), env_id=args.env, names=args.name,
+                  score=args.score)
     except ERRORS as exc:
         return _fail("benchmark", exc)
     return 0
@@ -198,7 +199,8 @@ def cmd_oracle(args) -> int:
                         search=not args.no_search, scenario_seed=args.scenario_seed,
                         friction=args.friction, friction_bins=args.friction_bins,
                         suite=args.suite, constants=args.constant,
-                        start_from_constants=args.start_from_constants)
+                        start_from_constants=args.start_from_constants,
+                        interface=args.interface)
     except ERRORS as exc:
         return _fail("oracle", exc)
     _wrote(args.out, ["oracle.json", *report.get("figures", [])], report["wall_time_s"])
@@ -329,7 +331,12 @@ def register(sub) -> None:
     p.add_argument("--suite", default="nominal",
                    help="nominal (default: the fixed scenario suite) or robust (200 drawn drops "
                         "under sensor noise, latency, actuator spread and plant variation, Full "
-                        "task; docs/agents.md 'Robust suite')")
+                        "task; docs/agents.md 'Robust suite'), or robust-legacy (the robust "
+                        "suite's earlier test drops, seeds 30000-30199, to reproduce old numbers)")
+    p.add_argument("--score", default="severity",
+                   help="severity (default: the whirl verdict plus its severity, the peak "
+                        "backward revolutions against the passive drop's) or legacy (the whirl "
+                        "verdict alone); docs/agents.md 'Score'")
     p.add_argument("--policy", action="append", default=None,
                    help="extra policies or controllers to include (repeatable): a training "
                         "directory or model .zip (shown as name@run), or your own controller "
@@ -349,8 +356,9 @@ def register(sub) -> None:
     p.add_argument("--episodes", type=int, default=None, help=argparse.SUPPRESS)
     p.set_defaults(func=cmd_benchmark)
 
-    p = sub.add_parser("oracle", help="per-scenario optimised command sequences of the supervisor "
-                                      "interface: the score no controller can beat by much")
+    p = sub.add_parser("oracle", help="per-scenario searched open-loop command sequences of the "
+                                      "supervisor interface: a score reachable on each drop (a "
+                                      "lower bound, not a ceiling)")
     p.add_argument("--scenarios", type=at_least(1), default=20, help="drawn scenarios (default 20)")
     p.add_argument("--population", type=at_least(2), default=24,
                    help="command sequences per generation (one batched rollout)")
@@ -362,7 +370,7 @@ def register(sub) -> None:
                         "robust`: sensor noise, latency, actuator spread, plant variation)")
     p.add_argument("--scenario-seed", type=_SEED, default=None,
                    help="seed of the first drawn scenario (default 10000, with --suite robust "
-                        "the suite's 30000; scenario i uses it + i)")
+                        "the suite's 50000; scenario i uses it + i)")
     p.add_argument("--no-search", action="store_true",
                    help="score the rows only (no oracle search), e.g. on 200 scenarios")
     p.add_argument("--friction", type=_number_list(":", 2), default=None, metavar="LO:HI",
@@ -384,6 +392,10 @@ def register(sub) -> None:
     p.add_argument("--start-from-constants", action="store_true",
                    help="start each scenario's search from the best of inner-loop and the "
                         "--constant rows there (default: from inner-loop)")
+    p.add_argument("--interface", default="supervisor",
+                   help="what the search commands: supervisor (default: the supervisor "
+                        "interface's segments) or currents (open-loop corrections of "
+                        "whirl-brake's coil currents after the power return, 1 ms steps)")
     _output_args(p, "out/oracle")
     p.set_defaults(func=cmd_oracle)
 

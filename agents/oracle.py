@@ -1,5 +1,7 @@
-"""``rotordrop oracle``: the best any command sequence of the supervisor interface reaches, per
-scenario, as a bound for learned and designed controllers on the same scenarios.
+"""``rotordrop oracle``: a searched open-loop command sequence of the supervisor interface per
+scenario, scored beside learned and designed controllers on the same scenarios. Its score is
+reachable on each drop (a lower bound on what the interface can reach), not a ceiling: the
+search is local, over a few open-loop segments, and cannot express raw coil currents.
 
 For each of ``--scenarios`` drops drawn where whirl is decided (``ORACLE_RANGES``: friction
 0.38-0.6 unless ``--friction LO:HI`` says otherwise, power back 30-70 ms rounded up to the 5 ms control grid, any unbalance phase, the
@@ -57,7 +59,7 @@ from .controllers import BASELINES, Passive
 from .plant import plant_of
 from .policies import load_shipped, shipped_names
 from .rollout import final_kpis, run_episodes
-from .score import overall_score, row_cost, write_json
+from .score import DEFAULT_SCORE, overall_score, row_cost, write_json
 
 ENV_ID = TASKS["full"]
 COMMAND = "supervisor"
@@ -73,6 +75,20 @@ SHAPING = 0.25
 WHIRL_REVOLUTIONS = 3.0
 #: ``--suite``: drops drawn from ``ORACLE_RANGES`` (full) or the robust suite's (robust)
 SUITES = ("full", "robust")
+#: ``--interface``: what the search commands (supervisor sequences, or raw-current corrections)
+INTERFACES = ("supervisor", "currents")
+#: the raw-current search: open-loop corrections of ``CURRENT_BASELINE``'s coil currents,
+#: piecewise constant over ``CURRENT_SEGMENTS`` x ``CURRENT_STEPS`` control steps from the
+#: power return (its 1 ms step), in [-2, 2] current limits (so it can override the baseline)
+CURRENT_BASELINE = "whirl-brake"
+CURRENT_SEGMENTS = 16
+CURRENT_STEPS = 2
+
+
+def check_interface(interface: str) -> str:
+    if interface not in INTERFACES:
+        raise ValueError(f"--interface = {interface!r} must be one of {', '.join(INTERFACES)}")
+    return interface
 
 
 def check_suite(suite: str) -> str:
@@ -335,6 +351,45 @@ def search_scenario(sc: Scenario, phase: float, passive: dict, population: int, 
                               generation_best=h["generation_best"]) for h in history])
 
 
+def search_currents(sc: Scenario, phase: float, passive: dict, population: int, iterations: int,
+                    seed: int, progress: bool) -> dict:
+    """Cross-entropy search of an open-loop correction of ``CURRENT_BASELINE``'s coil currents
+    on one drop (``--interface currents``; the correction of
+    :class:`agents.research.whirl_bound.OpenLoopCorrection`), for the benchmark's J with the
+    supervisor search's shaping; starts from no correction (the baseline itself), so its J is
+    never above the baseline's on the drop. One episode per candidate (no batching)."""
+    from rotordrop_env.layout import CURRENT_ACTIONS
+    from .benchmark import controller_entry
+    from .controllers import controller_class
+    from .research.whirl_bound import OpenLoopCorrection
+    from .search import cross_entropy
+    entry = controller_entry(controller_class(CURRENT_BASELINE), ENV_ID)
+    kw = episode_kwargs(entry, sc, phase)
+    seen: dict[bytes, tuple[float, dict]] = {}
+
+    def cost(theta: np.ndarray) -> float:
+        kpis = run_episodes(ENV_ID, lambda plant: OpenLoopCorrection(
+            plant, CURRENT_BASELINE, CURRENT_STEPS, theta), [sc.seed], kw)[0].kpis
+        row = kpi_row(kpis)
+        j = episode_cost(row, passive)
+        seen[np.asarray(theta, dtype=float).tobytes()] = (float(j), row)
+        return j + SHAPING * min(row["peak_whirl_revolutions"] / WHIRL_REVOLUTIONS, 1.0)
+
+    mean = np.zeros((CURRENT_SEGMENTS, len(CURRENT_ACTIONS)))
+    t0 = time.perf_counter()
+    best, theta, history = cross_entropy(
+        cost, mean, np.full(mean.shape, 0.5), -2.0, 2.0, iterations, population,
+        max(2, population // 5), np.random.default_rng(seed), min_std=0.05, progress=progress,
+        desc=f"oracle currents {sc.name}")
+    key = min(seen, key=lambda k: seen[k][0])
+    j, row = seen[key]
+    return dict(theta=np.frombuffer(key, dtype=float).reshape(mean.shape).tolist(),
+                search_cost=best, J=j, kpis=row, start_J=seen[mean.tobytes()][0],
+                start=mean.tolist(), rollouts=len(seen), wall_time_s=time.perf_counter() - t0,
+                history=[dict(iteration=h["iteration"], best_cost=h["best_cost"],
+                              generation_best=h["generation_best"]) for h in history])
+
+
 def row_entries(policies: list[str] | None, suite: str = "full") -> list[Entry]:
     """Every baseline with channels in the Full task, the shipped Full policies and the
     ``--policy`` extras (paths or controller classes), as the benchmark builds them (with
@@ -369,7 +424,8 @@ def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iteration
            seed: int = 0, policies: list[str] | None = None, progress: bool = True,
            plots: bool = True, search: bool = True, scenario_seed: int | None = None,
            friction: tuple[float, float] | None = None, friction_bins=None,
-           suite: str = "full", constants=None, start_from_constants: bool = False) -> dict:
+           suite: str = "full", constants=None, start_from_constants: bool = False,
+           interface: str = "supervisor") -> dict:
     """Search the command sequence of each scenario, score every row on the same scenarios and
     write ``oracle.json`` (and ``oracle.png``) into ``out`` (module doc). ``search=False``
     scores the rows only (no oracle row): the same comparison on many more scenarios.
@@ -379,14 +435,22 @@ def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iteration
     ``scenario_seed`` defaults to its ``SUITE_SEED``); ``constants``: (gain, radial offset)
     pairs scored as extra designed rows (:func:`constant_entry`, ``--constant``); with
     ``start_from_constants`` each scenario's search starts from the best of ``inner-loop`` and
-    these rows there (so that the oracle is never worse than any of them)."""
+    these rows there (so that the oracle is never worse than any of them); ``interface``
+    ``currents``: search open-loop corrections of whirl-brake's coil currents instead
+    (:func:`search_currents`)."""
     from tqdm.auto import tqdm
     from .score import fmt_or_dash
     if scenarios < 1 or population < 2 or iterations < 0:
         raise ValueError(f"need --scenarios >= 1, --population >= 2, --iterations >= 0 (got "
                          f"{scenarios}, {population}, {iterations})")
     constants = check_constants(constants)
+    if check_interface(interface) == "currents" and start_from_constants:
+        raise ValueError("--start-from-constants applies to --interface supervisor only (the "
+                         "current search starts from whirl-brake)")
     settings, ranges = suite_settings(suite, friction, scenario_seed)
+    if interface == "currents":
+        settings.update(interface=interface, current_baseline=CURRENT_BASELINE,
+                        current_segments=CURRENT_SEGMENTS, current_steps=CURRENT_STEPS)
     edges = friction_edges(ranges["contact.friction"], friction_bins)
     settings.update(scenarios=scenarios, population=population, iterations=iterations, seed=seed)
     if start_from_constants:
@@ -415,9 +479,13 @@ def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iteration
             row["J"] = episode_cost(row, rows["passive"])
         found = None
         if search:
-            found = done.get(i) or search_scenario(
-                sc, phase, rows["passive"], population, iterations, seed + i, progress,
-                best_start(rows, constants) if start_from_constants else None)
+            if interface == "currents":
+                found = done.get(i) or search_currents(sc, phase, rows["passive"], population,
+                                                       iterations, seed + i, progress)
+            else:
+                found = done.get(i) or search_scenario(
+                    sc, phase, rows["passive"], population, iterations, seed + i, progress,
+                    best_start(rows, constants) if start_from_constants else None)
             rows["oracle"] = dict(found["kpis"], J=found["J"])
         per_scenario.append(dict(index=i, scenario=values, rows=rows, search=found))
         report = _report(settings, per_scenario, [e.name for e in entries], t0, search,
@@ -434,7 +502,7 @@ def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iteration
     lo, hi = ranges["contact.friction"]
     where = ("the robust suite's first, sensor noise and latency" if suite == "robust" else
              "power back 30-70 ms")
-    print(f"{'oracle bound' if search else 'rows'}, {ENV_ID}, {scenarios} scenarios "
+    print(f"{f'oracle (searched {interface} plans)' if search else 'rows'}, {ENV_ID}, {scenarios} scenarios "
           f"({where}, friction {lo:g}-{hi:g}, seeds from {settings['scenario_seed']}):")
     print("| controller | score | whirl rate | whirl where passive whirls | re-levitated |")
     print("|---|---:|---:|---:|---:|")
@@ -451,7 +519,8 @@ def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iteration
 SETTINGS_ORDER = ("env_id", "command", "suite", "scenarios", "population", "iterations", "seed",
                   "scenario_seed", "ranges", "sensor_noise_m", "latency_ms", "segment_edges_ms",
                   "segment_actions", "max_delay_s", "control_dt", "shaping", "episode_time_s",
-                  "search_start")
+                  "search_start", "score", "interface", "current_baseline", "current_segments",
+                  "current_steps")
 
 
 def best_start(rows: dict, constants: list[tuple[float, float]]) -> np.ndarray:
@@ -466,7 +535,8 @@ def suite_settings(suite: str, friction, scenario_seed: int | None) -> tuple[dic
     with the full suite, whose range it sets)."""
     settings = dict(env_id=ENV_ID, command=COMMAND, segment_edges_ms=list(SEGMENT_EDGES_MS),
                     segment_actions=list(SEGMENT_ACTIONS), max_delay_s=MAX_DELAY,
-                    control_dt=CONTROL_DT, shaping=SHAPING, episode_time_s=EPISODE_TIME)
+                    control_dt=CONTROL_DT, shaping=SHAPING, episode_time_s=EPISODE_TIME,
+                    score=DEFAULT_SCORE)
     if check_suite(suite) == "robust":
         from .robust import LATENCY_MS, ROBUST_RANGES, SENSOR_NOISE, SUITE_SEED
         if friction is not None:

@@ -59,8 +59,13 @@ def _f(x, spec: str = ".2f") -> str:
 
 
 def leaderboard_table(entries: list[dict], kind: bool = False, in_out: bool = True) -> list[str]:
-    """One markdown leaderboard (the columns of ``rotordrop benchmark``'s leaderboard.md)."""
+    """One markdown leaderboard (the columns of ``rotordrop benchmark``'s leaderboard.md); the
+    bootstrap columns (SE of the score, difference to the best designed row ± SE and its 95 %
+    interval) where the data have them."""
+    se = any(e.get("score_se") is not None for e in entries)
+    ref = next((e["reference"] for e in entries if e.get("reference")), None)
     head = ["rank", "controller"] + (["kind"] if kind else []) + ["score"]
+    head += ["SE", f"Δ vs `{ref}` ± SE [95 %]"] if se else []
     head += (["in-dist.", "out-of-dist."] if in_out else [])
     head += ["whirl rate", "whirl where passive whirls", "peak F / passive (mean, max)",
              "disp. / passive", "relevitated", "stator contact"]
@@ -69,6 +74,12 @@ def leaderboard_table(entries: list[dict], kind: bool = False, in_out: bool = Tr
     for i, e in enumerate(entries, 1):
         cells = [str(i), f"`{e['controller']}`"] + ([e.get("kind", "")] if kind else [])
         cells.append(_f(e["score"]))
+        if se:
+            ci = e.get("diff_ci95") or [None, None]
+            cells += [_f(e.get("score_se")),
+                      "–" if e.get("diff_se") is None else
+                      f"{e['diff_vs_reference']:+.2f} ± {e['diff_se']:.2f} "
+                      f"[{ci[0]:+.2f}, {ci[1]:+.2f}]"]
         if in_out:
             cells += [_f(e.get("in_distribution_score")), _f(e.get("out_of_distribution_score"))]
         cells += [_f(e["whirl_rate"]), _f(e.get("whirl_rate_where_passive_whirls")),
@@ -90,12 +101,40 @@ def nominal_section(report: dict, source: str) -> list[str]:
            f"{len(report['scenarios'])} scenarios at {len(report['phases_deg'])} unbalance "
            f"phases, {report['episode_time_s']:g} s after the fault; re-levitation tasks with "
            f"the power back {1e3 * report['power_return_s']:g} ms after the fault unless the "
-           "scenario says otherwise. Score: 100 (1 − Σ J / Σ J_passive); passive scores 0 "
-           "([how it is scored](agents.md#benchmark-rotordrop-benchmark)).", ""]
+           f"scenario says otherwise. {score_words(report)}", ""]
     for task in _tasks(report):
         out += [f"### {TASK_TITLES.get(task, task)}", ""]
         out += leaderboard_table([e for e in report["leaderboard"] if e["task"] == task]) + [""]
+        out += seed_table([g for g in report.get("seed_groups") or []
+                           if any(e["task"] == task and e["controller"] in g["members"]
+                                  for e in report["leaderboard"])])
     return out
+
+
+def score_words(report: dict) -> str:
+    """What the score and its uncertainty columns are."""
+    name = report.get("score")
+    text = (f"Score{f' ({name})' if name else ''}: 100 (1 − Σ J / Σ J_passive); passive scores 0 "
+            "([how it is scored](agents.md#benchmark-rotordrop-benchmark)).")
+    b = report.get("bootstrap")
+    if b:
+        text += (f" SE: paired bootstrap over the drops ({b['resamples']} resamples, seed "
+                 f"{b['seed']}); Δ: the score minus the best designed row's, with its SE and 95 % "
+                 "interval.")
+    return text
+
+
+def seed_table(groups: list[dict]) -> list[str]:
+    """Learned configurations trained with several seeds: their scores, mean ± std."""
+    if not groups:
+        return []
+    out = ["Learned configurations trained with several seeds:", "",
+           "| configuration (seeds) | scores | mean ± std | mean − std |", "|---|---|---:|---:|"]
+    for g in groups:
+        out.append(f"| {', '.join(f'`{m}`' for m in g['members'])} | "
+                   f"{', '.join(_f(s) for s in g['scores'])} | {_f(g['mean'])} ± {_f(g['std'])} | "
+                   f"{_f(g['mean_minus_std'])} |")
+    return out + [""]
 
 
 def robust_section(report: dict, source: str) -> list[str]:
@@ -110,18 +149,10 @@ def robust_section(report: dict, source: str) -> list[str]:
               "controller), " if d.get("sensor_delay_s") else "")
            + f"{'–'.join(str(x) for x in d.get('latency_ms', []))} ms observation "
            "latency, actuator spread and plant variation "
-           "([what is perturbed](agents.md#robust-suite)).", ""]
+           "([what is perturbed](agents.md#robust-suite))."
+           + (f" {score_words(report)}" if report.get("score") else ""), ""]
     out += leaderboard_table(report["leaderboard"], kind=True, in_out=False) + [""]
-    groups = report.get("seed_groups") or []
-    if groups:
-        out += ["Learned configurations trained with several seeds:", "",
-                "| configuration (seeds) | scores | mean | std | mean − std |",
-                "|---|---|---:|---:|---:|"]
-        for g in groups:
-            out.append(f"| {', '.join(f'`{m}`' for m in g['members'])} | "
-                       f"{', '.join(_f(s) for s in g['scores'])} | {_f(g['mean'])} | "
-                       f"{_f(g['std'])} | {_f(g['mean_minus_std'])} |")
-        out.append("")
+    out += seed_table(report.get("seed_groups") or [])
     return out
 
 
@@ -133,14 +164,15 @@ def _learned_names(root: Path) -> set[str]:
 
 
 def oracle_section(reports: list[tuple[str, dict, str]], root: Path) -> list[str]:
-    """The per-drop bound of the supervisor interface (``rotordrop oracle``) against the designed
-    rows scored on the same drops. Learned rows are left out here (policies are replaced; their
+    """The per-drop searched plan of the supervisor interface (``rotordrop oracle``) against the
+    designed rows scored on the same drops. Learned rows are left out here (policies are replaced; their
     standing is in the leaderboards above)."""
     learned = _learned_names(root)
-    out = ["## Oracle bound", "",
-           "`rotordrop oracle` searches, per drop, the best open-loop command sequence of the "
-           "supervisor interface, knowing the drop in advance: it bounds what any policy of that "
-           "interface reaches on those drops, within the search's budget "
+    out = ["## Oracle (searched open-loop plans)", "",
+           "`rotordrop oracle` searches, per drop and knowing the drop in advance, an open-loop "
+           "command sequence of the supervisor interface (a local search over a few segments "
+           "from the best designed row's plan): its score is reachable on those drops, a lower "
+           "bound on what that interface can reach, not a ceiling; a policy may do better "
            "([how](agents.md#the-supervisor-interface)). Designed rows scored on the same drops; a "
            "row `constant g=G r=R` is `inner-loop` with the constant gain action G and radial "
            "offset R clearance (`inner-loop-lift` is g=0.5 r=-0.5).", ""]
@@ -154,8 +186,9 @@ def oracle_section(reports: list[tuple[str, dict, str]], root: Path) -> list[str
         seed = s.get("scenario_seed")
         out += [f"### {title}", "",
                 f"{s.get('scenarios')} drops (scenario seeds {seed}–{seed + s.get('scenarios', 1) - 1}), "
-                f"search {s.get('population')} × {s.get('iterations')} per drop (data: `{src}`)."
-                + (f" Oracle over the best designed row (`{best['controller']}`): "
+                f"search {s.get('population')} × {s.get('iterations')} per drop, "
+                f"{s.get('score', 'legacy')} score (data: `{src}`)."
+                + (f" Searched plan over the best designed row (`{best['controller']}`): "
                    f"**{oracle['score'] - best['score']:+.2f}** points." if oracle and best else ""), "",
                 "| row | score | whirl rate | whirl where passive whirls | re-levitated | mean J |",
                 "|---|---:|---:|---:|---:|---:|"]
@@ -289,8 +322,10 @@ def readme_block(root: Path = ROOT) -> str:
         return "No benchmark data committed yet: see docs/results.md."
     full = [e for e in nominal["leaderboard"] if e["task"] == "full"]
     return "\n".join([f"`rotordrop benchmark`, damping and re-levitation together "
-                      f"(`RotorDrop-Full-v1`, passive threshold μ\\* = {_f(nominal['passive_threshold'], 'g')}); "
-                      "every table: [docs/results.md](docs/results.md).", ""]
+                      f"(`RotorDrop-Full-v1`, passive threshold μ\\* = {_f(nominal['passive_threshold'], 'g')}"
+                      + (f", {nominal['score']} score; SE and Δ: paired bootstrap over the drops against "
+                         "the best designed row" if nominal.get("score") else "")
+                      + "); every table: [docs/results.md](docs/results.md).", ""]
                      + leaderboard_table(full))
 
 

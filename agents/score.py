@@ -13,6 +13,17 @@ overall score of a controller over a scenario suite is
 
 so the passive drop scores 0, a controller that halves the passive cost scores 50, and a
 controller worse than passive scores below 0.
+
+That is the ``legacy`` score. The default score (``severity``) splits the whirl term into the
+onset verdict and the whirl's severity,
+
+    W(c, s)  ->  ½ W(c, s) + ½ N(c, s) / max(N(passive, s), N_0)
+
+with N the peak net backward orbit revolutions after the fault (the quantity whose reaching
+N_0 = 3 revolutions is the whirl verdict; the environments' monitor accumulates it at every
+KPI sample) averaged over the scenario's episodes. The passive drop of a whirling scenario
+still costs 1 there; a controller that stops a whirl after 4 revolutions where the passive
+drop makes 60 costs ½ + ½·4/60 instead of 1. :func:`check_score` names the scores.
 """
 from __future__ import annotations
 
@@ -21,6 +32,19 @@ import math
 from pathlib import Path
 
 import numpy as np
+
+from physics.metrics import WHIRL_MIN_REVOLUTIONS
+
+#: the benchmark's scores (``rotordrop benchmark --score``): the default first
+SCORES = ("severity", "legacy")
+DEFAULT_SCORE = SCORES[0]
+
+
+def check_score(score: str) -> str:
+    """``score``, or ValueError naming the allowed scores."""
+    if score not in SCORES:
+        raise ValueError(f"--score = {score!r} must be one of {', '.join(SCORES)}")
+    return score
 
 def fmt_or_dash(v, fmt: str) -> str:
     """``format(v, fmt)``, or "-" for a missing value (tables of evaluate and benchmark)."""
@@ -83,13 +107,24 @@ def summarize(episodes) -> dict:
     return out
 
 
-def row_cost(row: dict, passive: dict, episode_time: float, relevitation: bool) -> float:
+def whirl_reference(passive: dict) -> float:
+    """The severity term's normaliser: the passive drop's peak net backward revolutions in the
+    scenario, at least the verdict's ``WHIRL_MIN_REVOLUTIONS``."""
+    return max(float(passive["peak_whirl_revolutions"]), float(WHIRL_MIN_REVOLUTIONS))
+
+
+def row_cost(row: dict, passive: dict, episode_time: float, relevitation: bool,
+             score: str = DEFAULT_SCORE) -> float:
     """J(c, s) of the module docstring for one benchmark row against its passive row.
 
-    Rows hold the scenario means ``backward_whirl`` (rate), ``peak_contact_force_N``,
-    ``max_displacement_um``, ``relevitated`` (rate) and ``relevitation_time_s`` (mean over the
-    successful episodes)."""
-    cost = float(row["backward_whirl"])
+    Rows hold the scenario means ``backward_whirl`` (rate), ``peak_whirl_revolutions``
+    (``severity`` score), ``peak_contact_force_N``, ``max_displacement_um``, ``relevitated``
+    (rate) and ``relevitation_time_s`` (mean over the successful episodes)."""
+    if check_score(score) == "legacy":
+        cost = float(row["backward_whirl"])
+    else:
+        cost = 0.5 * float(row["backward_whirl"])
+        cost += 0.5 * float(row["peak_whirl_revolutions"]) / whirl_reference(passive)
     cost += 0.5 * row["peak_contact_force_N"] / max(passive["peak_contact_force_N"], 1e-9)
     cost += 0.5 * row["max_displacement_um"] / max(passive["max_displacement_um"], 1e-9)
     if relevitation:
@@ -100,5 +135,62 @@ def row_cost(row: dict, passive: dict, episode_time: float, relevitation: bool) 
     return cost
 
 
+def drop_costs(drops: dict, passive: dict, episode_time: float, relevitation: bool,
+               score: str = DEFAULT_SCORE) -> np.ndarray:
+    """The cost of each drop (episode) of a row: ``drops`` maps the per-episode KPIs
+    (``backward_whirl``, ``peak_whirl_revolutions``, ``peak_contact_force_N``,
+    ``max_displacement_um``, ``relevitated``, ``relevitation_time_s``) to equal-length lists,
+    ``passive`` is the scenario's passive row (its means). J is linear in the episode KPIs, so
+    the mean of these costs is the row's :func:`row_cost`."""
+    d = {k: np.asarray(v, dtype=float) for k, v in drops.items()
+         if k not in ("relevitated", "relevitation_time_s")}
+    if check_score(score) == "legacy":
+        cost = d["backward_whirl"].copy()
+    else:
+        cost = 0.5 * d["backward_whirl"] + 0.5 * d["peak_whirl_revolutions"] / whirl_reference(passive)
+    cost += 0.5 * d["peak_contact_force_N"] / max(passive["peak_contact_force_N"], 1e-9)
+    cost += 0.5 * d["max_displacement_um"] / max(passive["max_displacement_um"], 1e-9)
+    if relevitation:
+        ok = np.array([bool(x) for x in drops["relevitated"]])
+        t = np.array([float(x) if x is not None and o else episode_time
+                      for x, o in zip(drops["relevitation_time_s"], ok)])
+        cost += (~ok).astype(float) + t / episode_time
+    return cost
+
+
 def overall_score(costs: list[float], passive_costs: list[float]) -> float:
     return 100.0 * (1.0 - sum(costs) / sum(passive_costs))
+
+
+#: the paired bootstrap of the leaderboards: resamples and seed (deterministic)
+BOOTSTRAP_RESAMPLES = 2000
+BOOTSTRAP_SEED = 20_261_127
+
+
+def bootstrap_scores(costs: np.ndarray, passive: np.ndarray, reference: int,
+                     resamples: int = BOOTSTRAP_RESAMPLES, seed: int = BOOTSTRAP_SEED) -> dict:
+    """Paired bootstrap over drops of the scores of K rows that ran the same n drops.
+
+    ``costs`` (K, n): each row's cost per drop; ``passive`` (n,): the passive drop's; the score
+    of a row is 100 (1 − Σ costs / Σ passive). Every resample draws n drops with replacement,
+    the same drops for every row (paired), and recomputes every score; ``reference`` is the
+    row the others are compared with. Returns per row (arrays of K): ``score``, ``score_se``,
+    ``diff`` (score − the reference's), ``diff_se`` and the 95 % percentile interval
+    ``diff_ci_low``, ``diff_ci_high`` of the difference. Vectorised: the resamples are a
+    (resamples, n) matrix of drop counts."""
+    costs = np.atleast_2d(np.asarray(costs, dtype=float))
+    passive = np.asarray(passive, dtype=float)
+    k, n = costs.shape
+    if passive.shape != (n,):
+        raise ValueError(f"passive has {passive.shape} costs, the rows {n} drops")
+    score = 100.0 * (1.0 - costs.sum(axis=1) / passive.sum())
+    rng = np.random.default_rng(seed)
+    idx = rng.integers(0, n, size=(resamples, n))
+    counts = np.bincount((np.arange(resamples)[:, None] * n + idx).ravel(),
+                         minlength=resamples * n).reshape(resamples, n).astype(float)
+    boot = 100.0 * (1.0 - (counts @ costs.T) / (counts @ passive)[:, None])      # (B, K)
+    diff = boot - boot[:, [reference]]
+    lo, hi = np.percentile(diff, [2.5, 97.5], axis=0)
+    return dict(score=score, score_se=boot.std(axis=0, ddof=1),
+                diff=score - score[reference], diff_se=diff.std(axis=0, ddof=1),
+                diff_ci_low=lo, diff_ci_high=hi)

@@ -5,12 +5,16 @@ effort). The benchmark scores episode *maxima* instead: the whirl verdict, the p
 force and the maximum displacement. The KPI reward is the decrease of a potential built from
 the running episode KPIs,
 
-    Φ_t = w_whirl · min(n*_t, 3) / 3 + w_verdict · [n*_t ≥ 3] + w_force · F*_t / force_ref
-          + w_disp · D*_t / disp_ref_um,
+    Φ_t = w_whirl · min(n*_t, 3) / 3 + w_verdict · [n*_t ≥ 3] + w_severity · n*_t / whirl_ref_revs
+          + w_force · F*_t / force_ref + w_disp · D*_t / disp_ref_um,
     r_t = −(Φ_t − Φ_{t−1}),   Φ_0 = 0,
 
 with n*_t the peak net backward orbit revolutions (3 make a backward whirl), F*_t the peak
-contact force [N] and D*_t the maximum displacement [µm] so far. An episode's return is −Φ_T:
+contact force [N] and D*_t the maximum displacement [µm] so far. The first two terms are the
+whirl's onset (a ramp to the verdict, and the verdict), the third its severity: it does not
+saturate, so a whirl stopped after a few revolutions pays far less than one that lasts the
+episode, as in the benchmark's default score (``whirl_ref_revs`` stands in for the passive
+drop's revolutions, about 20 in the paper scene's 0.3 s episode). An episode's return is −Φ_T:
 minus the benchmark cost of its KPIs, and the reward is dense (it arrives in the step in which a
 new peak or a backward revolution happens). Re-levitation tasks add ``w_relevitate`` once, in
 the step of re-levitation, and ``−w_time · control_dt / episode_time`` in every step before it
@@ -34,9 +38,10 @@ from . import kernels as K
 from .info import PEAK_KEYS  # noqa: F401  (the info entries the potential is built from)
 
 #: the ``reward_kwargs`` of ``reward="kpi"`` and their defaults
-KPI_WEIGHTS = dict(w_whirl=1.0, w_verdict=0.0, w_force=0.5, w_disp=0.5, force_ref=1e4,
-                   disp_ref_um=800.0, w_relevitate=1.0, w_time=1.0)
-REFERENCES = ("force_ref", "disp_ref_um")
+KPI_WEIGHTS = dict(w_whirl=0.5, w_verdict=0.0, w_severity=0.5, w_force=0.5, w_disp=0.5,
+                   force_ref=1e4, disp_ref_um=800.0, whirl_ref_revs=20.0, w_relevitate=1.0,
+                   w_time=1.0)
+REFERENCES = ("force_ref", "disp_ref_um", "whirl_ref_revs")
 REWARDS = ("default", "kpi")
 
 
@@ -59,12 +64,15 @@ def check_kpi_weights(kwargs: dict | None) -> dict:
 
 
 def kpi_potential(revs, force_N, disp_um, w_whirl: float, w_force: float, w_disp: float,
-                  force_ref: float, disp_ref_um: float, w_verdict: float = 0.0, **_):
+                  force_ref: float, disp_ref_um: float, w_verdict: float = 0.0,
+                  w_severity: float = 0.0, whirl_ref_revs: float = 20.0, **_):
     """Φ of the module docstring from the peak net backward revolutions, the peak contact force
-    [N] and the maximum displacement [µm] (floats or arrays; other weights are ignored)."""
+    [N] and the maximum displacement [µm] (floats or arrays; other weights are ignored; the
+    environments pass every weight, the defaults here are those of a bare call)."""
     revs = np.asarray(revs, dtype=float)
     return (w_whirl * np.minimum(revs, WHIRL_MIN_REVOLUTIONS) / WHIRL_MIN_REVOLUTIONS
             + w_verdict * (revs >= WHIRL_MIN_REVOLUTIONS)
+            + w_severity * revs / whirl_ref_revs
             + w_force * np.asarray(force_N) / force_ref + w_disp * np.asarray(disp_um) / disp_ref_um)
 
 

@@ -205,7 +205,8 @@ def test_evaluate_a_trained_policy_against_passive(trained, tmp_path):
 
 
 #: non-default KPI-reward weights, so the tests also see them reach the wrapper
-W = dict(w_whirl=2.0, w_verdict=0.5, w_force=0.25, w_disp=0.75, force_ref=5e3, disp_ref_um=600.0)
+W = dict(w_whirl=2.0, w_verdict=0.5, w_severity=0.3, w_force=0.25, w_disp=0.75, force_ref=5e3,
+         disp_ref_um=600.0, whirl_ref_revs=10.0)
 
 
 def test_kpi_potential_charges_the_whirl_verdict_at_three_revolutions():

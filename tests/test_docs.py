@@ -37,7 +37,7 @@ def test_results_command_stores_benchmark_output_and_regenerates(tmp_path):
     oracle.write_text((ROOT / "docs/data/oracle-robust.json").read_text())
     assert results.main(["--root", str(root), "--oracle-robust", str(oracle)]) == 0
     page = (root / "docs/results.md").read_text()
-    assert "## Oracle bound" in page and "| `oracle` |" in page
+    assert "## Oracle (searched open-loop plans)" in page and "| `oracle` |" in page
     (root / "docs/results.md").write_text("edited by hand\n")
     assert results.main(["--root", str(root), "--check"]) == 1
 

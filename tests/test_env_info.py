@@ -133,7 +133,8 @@ def test_the_cost_counts_stator_contact_and_bearing_overload():
 
 
 # ----------------------------------------------------------------------- KPI reward --
-W = dict(w_whirl=2.0, w_verdict=0.5, w_force=0.25, w_disp=0.75, force_ref=5e3, disp_ref_um=600.0)
+W = dict(w_whirl=2.0, w_verdict=0.5, w_severity=0.3, w_force=0.25, w_disp=0.75, force_ref=5e3,
+         disp_ref_um=600.0, whirl_ref_revs=10.0)
 
 
 @pytest.mark.parametrize("env_id,command", MODES)

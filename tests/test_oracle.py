@@ -189,3 +189,17 @@ def test_inner_loop_lift_is_the_oracles_constant_row(tmp_path):
     entry = controller_entry(InnerLoopLift, ENV_ID)
     ctrl = kpi_row(run_episodes(ENV_ID, entry.make, [sc.seed], episode_kwargs(entry, sc, phase))[0].kpis)
     assert seq == ctrl
+
+
+def test_the_raw_current_oracle_searches_whirl_brake_corrections_and_never_loses_to_it(tmp_path):
+    """--interface currents: open-loop corrections of whirl-brake's coil currents, started from
+    no correction, so the searched plan's J is at most whirl-brake's on every drop."""
+    from agents.oracle import oracle
+    rep = oracle(tmp_path, scenarios=1, population=3, iterations=1, progress=False, plots=False,
+                 interface="currents")
+    assert rep["settings"]["interface"] == "currents"
+    s = rep["per_scenario"][0]
+    assert s["rows"]["oracle"]["J"] <= s["rows"]["whirl-brake"]["J"] + 1e-12
+    assert s["search"]["rollouts"] >= 4 and np.shape(s["search"]["theta"]) == (16, 4)
+    with pytest.raises(ValueError, match=r"--interface = 'x' must be one of supervisor, currents"):
+        oracle(tmp_path, interface="x")

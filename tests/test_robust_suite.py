@@ -121,3 +121,23 @@ def test_robust_quick_end_to_end(tmp_path):
     rows = {e["controller"]: e for e in report["leaderboard"]}
     assert rows["passive"]["whirl_rate_where_passive_whirls"] == 1.0
     assert np.isfinite(rows["inner-loop"]["score"])
+
+
+def test_the_test_drops_are_fresh_and_the_legacy_ones_stay_reproducible():
+    """The test set shares no seed with the validation drops or the earlier test set, which
+    --suite robust-legacy still draws."""
+    from agents.robust import LEGACY_SUITE_SEED, SUITE_SCENARIOS, VALIDATION_SCENARIOS
+    test = set(range(SUITE_SEED, SUITE_SEED + SUITE_SCENARIOS))
+    assert test.isdisjoint(range(VALIDATION_SEED, VALIDATION_SEED + VALIDATION_SCENARIOS))
+    assert test.isdisjoint(range(LEGACY_SUITE_SEED, LEGACY_SUITE_SEED + SUITE_SCENARIOS))
+    assert robust_scenarios(1, LEGACY_SUITE_SEED)[0] == draw_scenario(30_000, "#0")
+    assert robust_scenarios(1)[0].seed == SUITE_SEED != LEGACY_SUITE_SEED
+
+
+def test_robust_legacy_runs_the_earlier_test_drops(tmp_path):
+    report = run_suite("robust-legacy", tmp_path, max_scenarios=1, progress=False, plots=False,
+                       score="legacy")
+    assert report["suite"] == "robust-legacy" and report["score"] == "legacy"
+    assert report["scenarios"][0]["seed"] == 30_000
+    assert report["distribution"]["scenario_seeds"] == [30_000, 30_000]
+    assert "--suite robust-legacy" in (tmp_path / "leaderboard.md").read_text()
