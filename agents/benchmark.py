@@ -374,7 +374,7 @@ def benchmark(out: str | Path, quick: bool = False, policies: list[str] | None =
     learned = {p.name: p for p in loaded}
     for e in board:
         e["kind"] = "learned" if e["controller"] in learned else "designed"
-    from .robust import seed_groups
+    from .score import seed_groups
     from rotordrop_env.env import DEFAULT_POWER_RETURN
     report = dict(quick=quick, score=score, bootstrap=bootstrap_record(),
                   seed_groups=seed_groups(board, learned),

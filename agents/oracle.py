@@ -254,12 +254,15 @@ def sequence_actions(thetas: np.ndarray, t: float, power_return: float,
     return np.clip(a, -1.0, 1.0)
 
 
-def rollout(venv, thetas: np.ndarray, power_return: float) -> list[dict]:
-    """Episode KPIs of each command sequence on the (identical) environments of ``venv``."""
+def rollout(venv, thetas: np.ndarray, power_return: float, seed: int) -> list[dict]:
+    """Episode KPIs of each command sequence on the (identical) environments of ``venv``, each
+    reset with ``seed``: the benchmark's episode seed of the drop, so every candidate meets the
+    sensor noise the benchmark's rows meet there (common random numbers)."""
     names = list(venv.envs[0].action_names)
     n_steps = venv.envs[0].n_steps
     dt = venv.envs[0].dt
-    venv.reset()
+    for e in range(venv.num_envs):
+        venv.batch.reset_env(e, int(seed))
     kpis: list[dict] = []
     for k in range(n_steps):
         _, _, dones, infos = venv.step(sequence_actions(thetas, k * dt, power_return, names))
@@ -320,7 +323,7 @@ def search_scenario(sc: Scenario, phase: float, passive: dict, population: int, 
                     warnings.simplefilter("ignore", TorchThreadsWarning)
                     venvs[c, n] = BatchedRotorDropVecEnv(ENV_ID, n, seed=0,
                                                          **search_kwargs(drop, drop_phase))
-            kpis = rollout(venvs[c, n], thetas, drop.env_kwargs["power_return_time"])
+            kpis = rollout(venvs[c, n], thetas, drop.env_kwargs["power_return_time"], drop.seed)
             for m, k in enumerate(kpis):
                 row = kpi_row(k)
                 j = episode_cost(row, drop_passive)
@@ -355,13 +358,13 @@ def search_currents(sc: Scenario, phase: float, passive: dict, population: int, 
                     seed: int, progress: bool) -> dict:
     """Cross-entropy search of an open-loop correction of ``CURRENT_BASELINE``'s coil currents
     on one drop (``--interface currents``; the correction of
-    :class:`agents.research.whirl_bound.OpenLoopCorrection`), for the benchmark's J with the
+    :class:`agents.open_loop.OpenLoopCorrection`), for the benchmark's J with the
     supervisor search's shaping; starts from no correction (the baseline itself), so its J is
     never above the baseline's on the drop. One episode per candidate (no batching)."""
     from rotordrop_env.layout import CURRENT_ACTIONS
     from .benchmark import controller_entry
     from .controllers import controller_class
-    from .research.whirl_bound import OpenLoopCorrection
+    from .open_loop import OpenLoopCorrection
     from .search import cross_entropy
     entry = controller_entry(controller_class(CURRENT_BASELINE), ENV_ID)
     kw = episode_kwargs(entry, sc, phase)

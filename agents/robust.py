@@ -155,7 +155,7 @@ def robust_benchmark(out, quick: bool = False, policies: list[str] | None = None
 
     from .benchmark import EPISODE_TIME, entry_rows, leaderboard, robust_entries
     from .benchmark import bootstrap_record
-    from .score import DEFAULT_SCORE, check_score, write_json
+    from .score import DEFAULT_SCORE, check_score, seed_groups, write_json
     score = check_score(score if score is not None else DEFAULT_SCORE)
     backend = backend if backend is not None else Backend()
     out = Path(out)
@@ -202,28 +202,6 @@ def scenario_record(s: Scenario) -> dict:
     return dict(name=s.name, seed=s.seed, friction=s.friction, overrides=s.overrides,
                 env_kwargs=s.env_kwargs, sensor_noise_m=s.sensor_noise,
                 latency_ms=round(1e3 * s.latency_s, 9))
-
-
-def seed_groups(board: list[dict], learned: dict) -> list[dict]:
-    """Learned rows trained with the same algorithm and hyperparameters (the seeds of one
-    configuration): mean, standard deviation (over seeds, ddof = 1) and mean − std of their
-    scores; groups of one row are left out."""
-    import json
-    keys: dict[str, list[str]] = {}
-    for name, pol in learned.items():
-        key = json.dumps([pol.algo, pol.env_id, pol.meta.get("hyperparams") or pol.env_kwargs],
-                         sort_keys=True, default=str)
-        keys.setdefault(key, []).append(name)
-    score = {e["controller"]: e["score"] for e in board}
-    out = []
-    for names in keys.values():
-        if len(names) < 2:
-            continue
-        s = np.array([score[n] for n in names])
-        out.append(dict(members=names, scores=s.tolist(), mean=float(s.mean()),
-                        std=float(s.std(ddof=1)), mean_minus_std=float(s.mean() - s.std(ddof=1))))
-    out.sort(key=lambda g: -g["mean_minus_std"])
-    return out
 
 
 def target(board: list[dict], groups: list[dict], margin: float = 3.0) -> dict:

@@ -194,3 +194,25 @@ def bootstrap_scores(costs: np.ndarray, passive: np.ndarray, reference: int,
     return dict(score=score, score_se=boot.std(axis=0, ddof=1),
                 diff=score - score[reference], diff_se=diff.std(axis=0, ddof=1),
                 diff_ci_low=lo, diff_ci_high=hi)
+
+
+def seed_groups(board: list[dict], learned: dict) -> list[dict]:
+    """Learned rows trained with the same algorithm and hyperparameters (the seeds of one
+    configuration): mean, standard deviation (over seeds, ddof = 1) and mean − std of their
+    scores; groups of one row are left out."""
+    import json
+    keys: dict[str, list[str]] = {}
+    for name, pol in learned.items():
+        key = json.dumps([pol.algo, pol.env_id, pol.meta.get("hyperparams") or pol.env_kwargs],
+                         sort_keys=True, default=str)
+        keys.setdefault(key, []).append(name)
+    score = {e["controller"]: e["score"] for e in board}
+    out = []
+    for names in keys.values():
+        if len(names) < 2:
+            continue
+        s = np.array([score[n] for n in names])
+        out.append(dict(members=names, scores=s.tolist(), mean=float(s.mean()),
+                        std=float(s.std(ddof=1)), mean_minus_std=float(s.mean() - s.std(ddof=1))))
+    out.sort(key=lambda g: -g["mean_minus_std"])
+    return out

@@ -47,8 +47,8 @@ def test_batched_rollout_of_the_inner_loop_sequence_is_the_inner_loop_row():
     kw = episode_kwargs(entry, sc, phase)
     venv = BatchedRotorDropVecEnv(ENV_ID, 2, seed=0, **kw)
     rows = [kpi_row(k) for k in rollout(venv, np.stack([inner_loop_theta()] * 2), sc.env_kwargs[
-        "power_return_time"])]
-    ref = kpi_row(run_episodes(ENV_ID, InnerLoop, [0], kw)[0].kpis)
+        "power_return_time"], sc.seed)]
+    ref = kpi_row(run_episodes(ENV_ID, InnerLoop, [sc.seed], kw)[0].kpis)
     assert rows[0] == rows[1] == ref
 
 
@@ -121,7 +121,7 @@ def test_robust_suite_searches_the_robust_scenario_with_its_sensing(tmp_path):
     from agents.benchmark import leaderboard, suite_rows
     from agents.controllers import Passive
     from agents.oracle import search_kwargs, suite_scenarios
-    from agents.robust import SENSOR_NOISE, SUITE_SEED, draw_scenario
+    from agents.robust import SENSOR_DELAY_S, SENSOR_NOISE, SUITE_SEED, draw_scenario
     from rotordrop_env import BatchedRotorDropVecEnv
     sc, phase, record = suite_scenarios("robust", 1, SUITE_SEED)[0]
     assert sc == draw_scenario(SUITE_SEED, "#0")
@@ -130,7 +130,9 @@ def test_robust_suite_searches_the_robust_scenario_with_its_sensing(tmp_path):
     venv.reset()
     env = venv.envs[0]
     assert env.sensor_noise == SENSOR_NOISE == record["sensor_noise"]
-    assert env._sensing.k == int(np.ceil(sc.latency_s / CONTROL_DT - 1e-9)) >= 1    # 1-3 ms
+    assert env._sensing.k == int(np.ceil(sc.latency_s / CONTROL_DT - 1e-9))          # 0-1 ms
+    lo, hi = SENSOR_DELAY_S                     # the sensor delay every controller sees
+    assert lo <= env.scene.sensor.delay == sc.overrides["sensor.delay"] <= hi
     assert env.scene.amb.current_limit == pytest.approx(sc.overrides["amb.current_limit"])
     assert env.scene.amb.coil_time_constant == pytest.approx(
         sc.overrides["amb.coil_time_constant"])
@@ -184,7 +186,7 @@ def test_inner_loop_lift_is_the_oracles_constant_row(tmp_path):
     sc, phase, _ = suite_scenarios("robust", 1, 30_000)[0]
     venv = BatchedRotorDropVecEnv(ENV_ID, 1, seed=0, **search_kwargs(sc, phase))
     seq = kpi_row(rollout(venv, constant_theta(0.5, -0.5)[None], sc.env_kwargs[
-        "power_return_time"])[0])
+        "power_return_time"], sc.seed)[0])
     venv.close()
     entry = controller_entry(InnerLoopLift, ENV_ID)
     ctrl = kpi_row(run_episodes(ENV_ID, entry.make, [sc.seed], episode_kwargs(entry, sc, phase))[0].kpis)

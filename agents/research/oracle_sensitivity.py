@@ -80,7 +80,8 @@ def replay(sc, phase: float, thetas: np.ndarray) -> tuple[list[float], list[bool
     passive = passive_row(sc, phase)
     venv = BatchedRotorDropVecEnv(ENV_ID, len(thetas), seed=0, **search_kwargs(sc, phase))
     try:
-        rows = [kpi_row(k) for k in rollout(venv, thetas, sc.env_kwargs["power_return_time"])]
+        rows = [kpi_row(k) for k in rollout(venv, thetas, sc.env_kwargs["power_return_time"],
+                                            sc.seed)]
     finally:
         venv.close()
     return ([episode_cost(r, passive) for r in rows], [bool(r["backward_whirl"]) for r in rows],
