@@ -184,10 +184,14 @@ def oracle_section(reports: list[tuple[str, dict, str]], root: Path) -> list[str
         oracle = next((e for e in rows if e["controller"] == "oracle"), None)
         best = max(designed, key=lambda e: e["score"]) if designed else None
         seed = s.get("scenario_seed")
+        from rotordrop_env import ENV_IDS
         out += [f"### {title}", "",
                 f"{s.get('scenarios')} drops (scenario seeds {seed}–{seed + s.get('scenarios', 1) - 1}), "
                 f"search {s.get('population')} × {s.get('iterations')} per drop, "
-                f"{s.get('score', 'legacy')} score (data: `{src}`)."
+                f"{s.get('score', 'legacy')} score, on `{s.get('env_id', 'RotorDrop-Full-v0')}`"
+                + (" (an earlier environment version: its numbers are not comparable with the"
+                   " leaderboards above)" if s.get("env_id", "RotorDrop-Full-v0") not in ENV_IDS
+                   else "") + f" (data: `{src}`)."
                 + (f" Searched plan over the best designed row (`{best['controller']}`): "
                    f"**{oracle['score'] - best['score']:+.2f}** points." if oracle and best else ""), "",
                 "| row | score | whirl rate | whirl where passive whirls | re-levitated | mean J |",
