@@ -7,10 +7,11 @@ import numpy as np
 import pytest
 
 from agents.benchmark import Entry, Scenario, episode_kwargs, latency_steps
+from agents.score import seed_groups
 from agents.robust import (LATENCY_MS, ROBUST_RANGES, SENSOR_DELAY_S, SENSOR_NOISE, SUITE_SEED,
                            VALIDATION_SEED,
                            draw_scenario, robust_benchmark, robust_scenarios, run_suite,
-                           seed_groups, target,
+                           target,
                            training_env_kwargs)
 
 
