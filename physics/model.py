@@ -439,7 +439,8 @@ def rhs(t, y, P, I, U, dy, aux):
                     d = dyy if a == 1 else dx
                     i_int, i_q = I[I_AMB_INT] + j, I[I_AMB_FILT] + j
                     i_cmd, e, de_int = _actuator_command(
-                        t, sy if a == 1 else sx, y[i_int], y[i_q], U[U_AMB_DIRECT], U[U_AMB_POWER], U[U_ICMD + j],
+                        t, sy if a == 1 else sx, y[i_int], y[i_q], U[U_AMB_DIRECT],
+                        U[U_AMB_POWER], U[U_ICMD + j],
                         U[U_T_ON], U[U_REF0 + j], oy if a == 1 else ox, P[P_AMB_ILIM],
                         P[P_AMB_RAMP], P[P_AMB_IFF1 + k] if a == 1 else 0.0,
                         U[U_AMB_GAIN] * P[P_AMB_KP],
