@@ -29,6 +29,12 @@ from .sb3_policy import current_env_id, export_self_contained, is_self_contained
 from .score import write_json
 
 
+#: the training schedules a zip pickles with the Python it was saved under; acting needs none of
+#: them, and replacing them keeps a load from warning that it cannot unpickle them (SB3's
+#: documented way to load a model for inference)
+ACTING_ONLY = {"learning_rate": 0.0, "lr_schedule": lambda _: 0.0, "clip_range": lambda _: 0.0}
+
+
 def shipped_dir() -> Path:
     return Path(str(resources.files("agents") / "policies"))
 
@@ -133,7 +139,7 @@ class LearnedPolicy:
             raise FileNotFoundError(f"no model at {model_path}" + (
                 " (nor best_model.zip: a run's best/)" if path.is_dir() else ""))
         algo = meta.get("algo") or _algo_from_zip(model_path)
-        model = algo_class(algo).load(str(model_path), device="cpu")
+        model = algo_class(algo).load(str(model_path), device="cpu", custom_objects=ACTING_ONLY)
         inside = model.policy.rotordrop if is_self_contained(model) else {}
         given, env_id = env_id, meta.get("env_id") or inside.get("env_id")
         env_id = current_env_id(env_id) if env_id is not None else None
