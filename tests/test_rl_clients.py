@@ -114,3 +114,23 @@ def test_skrl_ppo_trains_on_the_vector_env(tmp_path):
     assert any(not torch.equal(a, b) for a, b in zip(models["policy"].parameters(), before))
     assert venv.unwrapped.get_attr("time")[0] < 0.05               # 300 steps: 6 episodes each
     venv.close()
+
+
+def test_a_cleanrl_style_ppo_loop_trains_on_the_vector_env():
+    """docs/examples/cleanrl_ppo.py: one-file PPO (no RL library) on gym.make_vec's
+    vector_entry_point with the KPI reward; the SAME_STEP autoreset hands over each ended
+    episode's KPIs in final_info and its final observation for the truncation bootstrap."""
+    import importlib.util
+    from pathlib import Path
+    import numpy as np
+    path = Path(__file__).resolve().parents[1] / "docs" / "examples" / "cleanrl_ppo.py"
+    spec = importlib.util.spec_from_file_location("cleanrl_ppo", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    hist = mod.train("RotorDrop-Damping-v1", num_envs=8, total_timesteps=2048, num_steps=64,
+                     seed=0, episode_time=0.05, log=lambda *_: None)
+    assert len(hist["losses"]) == 4 and np.isfinite(hist["losses"]).all()
+    ended = [k for ks in hist["kpis"] for k in ks]
+    assert len(ended) >= 8                                   # every env finished episodes
+    assert all(np.isfinite(list(k.values())).all() and "kpi_backward_whirl" in k for k in ended)
+    assert all(r is None or np.isfinite(r) for r in hist["returns"])
