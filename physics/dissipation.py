@@ -50,8 +50,9 @@ def dissipation_powers(result: Result) -> dict[str, np.ndarray]:
     return out
 
 
-def _created(t: np.ndarray, power: np.ndarray) -> float:
-    """Energy [J] an element created: the trapezoidal integral of its negative power."""
+def created_energy(t: np.ndarray, power: np.ndarray) -> float:
+    """Energy [J] an element created over the samples ``t``: the trapezoidal integral of its
+    negative power (0.0 for an element that dissipates)."""
     neg = np.minimum(power, 0.0)
     return 0.0 - float(np.sum(0.5 * (neg[1:] + neg[:-1]) * np.diff(t))) if len(t) > 1 else 0.0
 
@@ -65,7 +66,7 @@ def dissipation_check(result: Result) -> dict:
     scale = max((float(np.abs(p).max()) for p in powers.values() if len(p)), default=0.0)
     for name, power in powers.items():
         lo = float(power.min()) if len(power) else 0.0
-        terms[name] = dict(min_power_W=lo, created_energy_J=_created(result.t, power))
+        terms[name] = dict(min_power_W=lo, created_energy_J=created_energy(result.t, power))
         if lo < -ROUNDOFF * scale:
             negative.append(name)
     return dict(ok=not negative, negative=negative,

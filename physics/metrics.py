@@ -16,7 +16,7 @@ import numpy as np
 from .amb import weight_shares
 from .ball_bearing import film_thickness, max_contact_pressure, static_max_ball_load
 from .contact import effective_modulus
-from .dissipation import dissipation_check
+from .dissipation import created_energy, dissipation_check
 from .integrate import P_FR, P_LOAD, P_QMAX
 from .model import F_FILM, F_RB, F_STATOR, P_FILM, PLANES, RB_SM
 from .results import AMB_PLANES, Result
@@ -120,9 +120,7 @@ def friction_energy_created(result: Result, plane: str, post: slice) -> float:
     """Energy [J] the rotor-sleeve friction created over the samples ``post``: the integral of its
     negative power. Zero for a law that dissipates; the paper's slip law creates energy whenever
     it pushes along the sliding (``friction_heat_J`` is then a net figure)."""
-    p, t = result.friction_power(plane)[post], result.t[post]
-    neg = np.minimum(p, 0.0)
-    return 0.0 - float(np.sum(0.5 * (neg[1:] + neg[:-1]) * np.diff(t))) if len(t) > 1 else 0.0
+    return created_energy(result.t[post], result.friction_power(plane)[post])
 
 
 @functools.lru_cache(maxsize=64)
