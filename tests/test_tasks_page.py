@@ -23,12 +23,13 @@ def _load(name):
 def test_every_quoted_row_score_is_the_committed_one():
     sections, checked = _sections(), 0
     for title, (suite, task) in SECTIONS.items():
-        board = {e["controller"]: e["score"] for e in _load(f"leaderboard-{suite}")["leaderboard"]
-                 if e["task"] == task}
+        rows = {e["controller"]: e for e in _load(f"leaderboard-{suite}")["leaderboard"]
+                if e["task"] == task}
         status = sections[title].split("**Status", 1)[1]
-        for name, score in re.findall(r"`([\w-]+)` (-?\d+\.\d\d)\b", status):
-            assert name in board, (title, name)
-            assert f"{board[name]:.2f}" == score, (title, name, board[name], score)
+        for name, score, se in re.findall(r"`([\w-]+)` (-?\d+\.\d\d)\b(?: ± (\d+\.\d\d))?", status):
+            assert name in rows, (title, name)
+            assert f"{rows[name]['score']:.2f}" == score, (title, name, rows[name]["score"], score)
+            assert se == f"{rows[name]['score_se']:.2f}", (title, name, "SE", se)   # quoted with it
             checked += 1
     assert checked >= 8
 
