@@ -39,7 +39,7 @@ def test_oracle_margins_robust_target_and_hard_reference():
     nominal = {r["controller"]: r["score"] for r in _load("oracle-nominal")["summary"]}
     full = sections["Full: damping and re-levitation"]
     assert f"{nominal['oracle']:.2f}" in full and f"{nominal['whirl-brake']:.2f}" in full
-    assert f"+{nominal['oracle'] - nominal['whirl-brake']:.2f} points" in full
+    assert f"{nominal['oracle'] - nominal['whirl-brake']:+.2f} points" in full
     robust = {r["controller"]: r["score"] for r in _load("oracle-robust")["summary"]}
     best_designed = max(v for k, v in robust.items() if k != "oracle")
     text = sections["Robust suite"]
