@@ -161,9 +161,10 @@ def current_env_id(env_id: str) -> str:
     """The registered id of a task: a zip exported under a retired version (``RotorDrop-Full-v0``,
     which Gymnasium refuses as deprecated) names the current version of the same task, whose
     observations and actions are the same (docs/environments.md, version history)."""
-    import re
-    m = re.fullmatch(r"(RotorDrop-[A-Za-z]+)-v0", str(env_id))
-    return f"{m[1]}-v1" if m else env_id
+    from rotordrop_env import ENV_IDS
+    task = str(env_id).rsplit("-v", 1)[0]
+    current = [i for i in ENV_IDS if i.rsplit("-v", 1)[0] == task]
+    return current[0] if env_id not in ENV_IDS and current else env_id
 
 
 def zip_algo(path: str | Path) -> str | None:

@@ -47,24 +47,25 @@ POSITIONS = ("x1", "y1", "x2", "y2")
 VELOCITIES = ("vx1", "vy1", "vx2", "vy2")
 
 
-def check_noise(value) -> float:
-    """``sensor_noise`` as a float in ``NOISE_LIMITS`` (one-line ValueError otherwise)."""
-    lo, hi = NOISE_LIMITS
+def _check_real(name: str, value, limits: tuple[float, float], what: str, example: str) -> float:
+    """``value`` as a float in ``limits`` (one-line ValueError naming ``name`` otherwise)."""
+    lo, hi = limits
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real) \
             or not (math.isfinite(value) and lo <= value <= hi):
-        raise ValueError(f"sensor_noise = {value!r} must be a standard deviation in metres in "
-                         f"[{lo:g}, {hi:g}] (e.g. 2e-6 for 2 µm)")
+        raise ValueError(f"{name} = {value!r} must be {what} in [{lo:g}, {hi:g}] ({example})")
     return float(value)
+
+
+def check_noise(value) -> float:
+    """``sensor_noise`` as a float in ``NOISE_LIMITS``."""
+    return _check_real("sensor_noise", value, NOISE_LIMITS, "a standard deviation in metres",
+                       "e.g. 2e-6 for 2 µm")
 
 
 def check_delay(value) -> float:
-    """``sensor_delay`` as a float in ``DELAY_LIMITS`` (one-line ValueError otherwise)."""
-    lo, hi = DELAY_LIMITS
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real) \
-            or not (math.isfinite(value) and lo <= value <= hi):
-        raise ValueError(f"sensor_delay = {value!r} must be a delay in seconds in "
-                         f"[{lo:g}, {hi:g}] (e.g. 1e-4 for 0.1 ms)")
-    return float(value)
+    """``sensor_delay`` as a float in ``DELAY_LIMITS``."""
+    return _check_real("sensor_delay", value, DELAY_LIMITS, "a delay in seconds",
+                       "e.g. 1e-4 for 0.1 ms")
 
 
 def check_latency(value) -> tuple[int, int]:
