@@ -31,6 +31,9 @@ arguments a block may hold:
                    phases the benchmark does not use) instead of the highest evaluation reward
 ``action_log_std`` PPO: initial log std of named action entries, e.g. ``{gain: -1.0}``; the
                    others keep ``log_std_init`` (:mod:`agents.exploration`)
+``frame_stack``    memory: the policy sees the last N (normalised) observations, newest last, as
+                   rl-zoo3's ``frame_stack`` (``VecFrameStack``); the saved policy stacks them
+                   itself (:class:`agents.sb3_policy.FrameStack`; default 1)
 =================  ===========================================================================
 
 The same file trains with rl-zoo3 (``python -m rl_zoo3.train --algo ppo --env ID --gym-packages
@@ -78,7 +81,7 @@ CONTRIB_ALGOS = ("tqc",)
 META_KEYS = ("n_timesteps", "n_envs", "policy", "policy_kwargs", "normalize", "env_kwargs",
              "eval_freq", "n_eval_episodes", "checkpoint_freq", "noise_type", "noise_std",
              "reward", "reward_kwargs", "residual", "residual_scale", "validation",
-             "action_log_std")
+             "action_log_std", "frame_stack")
 REWARDS = ("env", "kpi")
 #: evaluation and checkpoint intervals [environment steps] and evaluation episodes of a run
 #: when neither the command line nor the config sets them (rl-zoo3's eval_freq too)
@@ -93,7 +96,7 @@ CALLBACK_KEYS = ("validation", "action_log_std")
 WRAPPER_KEYS = ("residual", "residual_scale", "reward", "reward_kwargs")
 #: rl-zoo3 keys rotordrop train cannot honour (the batched VecEnv steps unwrapped envs)
 ZOO_ONLY = {"env_wrapper": "gym wrappers around each environment",
-            "frame_stack": "frame stacking", "monitor_kwargs": "Monitor arguments"}
+            "monitor_kwargs": "Monitor arguments"}
 SCHEDULE_KEYS = ("learning_rate", "clip_range")
 #: constructor arguments ``rotordrop train`` sets itself, and where they come from instead
 SET_BY_TRAIN = {"policy": "the config key policy", "env": "--env", "seed": "--seed",
@@ -430,6 +433,10 @@ def split(hp: dict) -> tuple[dict, dict]:
     if not isinstance(norm, (bool, dict)):
         raise ConfigError(f"normalize must be true/false or a dict, got {norm!r}")
     meta["normalize"] = norm
+    stack = meta.setdefault("frame_stack", 1)
+    if isinstance(stack, bool) or not isinstance(stack, int) or not 1 <= stack <= 64:
+        raise ConfigError(f"frame_stack must be an integer in [1, 64] (observations the policy "
+                          f"sees at once, newest last), got {stack!r}")
     meta.setdefault("reward", "env")
     if meta["reward"] not in REWARDS:
         raise ConfigError(f"reward must be one of {', '.join(REWARDS)}, got {meta['reward']!r}")

@@ -25,7 +25,7 @@ from .controllers import BASELINES, controller_class, make_baseline, make_contro
 from .plant import Plant
 from .hyperparams import ALGOS as ALGO_NAMES, algo_class, parse_literal
 from .residual import RESIDUAL_SCALE, residual_action
-from .sb3_policy import current_env_id, export_self_contained, is_self_contained
+from .sb3_policy import FrameStack, current_env_id, frame_stack_of, export_self_contained, is_self_contained
 from .score import write_json
 
 
@@ -59,6 +59,14 @@ class LearnedPolicy:
     base: object | None = None
     source: str | None = None            # the path it was loaded from
     given_env_id: str | None = None      # the env id given at load (a plain SB3 zip records none)
+    frame_stack: int | None = None       # observations the network sees at once (None: inferred)
+
+    def __post_init__(self):
+        if self.self_contained:
+            self.frame_stack = self.model.policy.stack.n
+        elif self.frame_stack is None:                  # a model still on its training env
+            self.frame_stack = frame_stack_of(self.model.get_env())
+        self.stack = FrameStack(self.frame_stack)
 
     def __reduce__(self):
         """Pickled as where it was loaded from (SB3 models and their statistics do not pickle):
@@ -86,7 +94,8 @@ class LearnedPolicy:
         if self.self_contained:                 # normalisation, network, residual: one path
             return self.model.policy.act(observation, state, episode_start, deterministic, self.base)
         raw = np.asarray(observation, dtype=np.float32)
-        obs = self.vecnormalize.normalize_obs(raw) if self.vecnormalize is not None else raw
+        obs = self.stack(raw, episode_start)
+        obs = self.vecnormalize.normalize_obs(obs) if self.vecnormalize is not None else obs
         action, state = self.model.predict(obs, state=state, episode_start=episode_start,
                                            deterministic=deterministic)
         if self.residual is not None:
@@ -99,6 +108,7 @@ class LearnedPolicy:
                                ("actions", self.model.action_space,
                                 2 if plant.discrete else len(plant.action_names))):
             size = space.shape[0] if space.shape else space.n
+            size //= self.frame_stack if what == "observations" else 1
             if size != n and self.given_env_id is not None and plant.env_id == self.env_id:
                 raise ValueError(f"policy {self.name} has {size} {what}, --env {self.env_id} has "
                                  f"{n}: pass the --env the model was trained on")
@@ -162,7 +172,8 @@ class LearnedPolicy:
         return cls(name or meta.get("name") or f"{algo}-{task}", algo, env_id, env_kwargs, model,
                    vn, meta, settings.get("residual"),
                    float(settings.get("residual_scale") or RESIDUAL_SCALE),
-                   source=str(path.resolve()), given_env_id=given)
+                   source=str(path.resolve()), given_env_id=given,
+                   frame_stack=settings.get("frame_stack"))
 
 
 def _reload(source: str, name: str, env_id: str | None = None) -> LearnedPolicy:

@@ -45,16 +45,54 @@ except ImportError:                     # pragma: no cover
 KEY = "rotordrop"
 
 
+class FrameStack:
+    """The last ``n`` observations side by side, newest last, as SB3's ``VecFrameStack`` builds
+    them in training: a row whose ``episode_start`` is set (or the first call) starts from zeros.
+    Observations ``(d,)`` or ``(batch, d)`` in, ``(n d,)`` or ``(batch, n d)`` out."""
+
+    def __init__(self, n: int):
+        self.n = int(n)
+        self.frames: np.ndarray | None = None
+
+    def __call__(self, obs: np.ndarray, episode_start=None) -> np.ndarray:
+        if self.n == 1:
+            return obs
+        single = obs.ndim == 1
+        rows = obs.reshape(1, -1) if single else obs
+        d = rows.shape[1]
+        if self.frames is None or self.frames.shape != (rows.shape[0], self.n * d):
+            self.frames = np.zeros((rows.shape[0], self.n * d), dtype=rows.dtype)
+        elif episode_start is not None:
+            self.frames[np.broadcast_to(np.asarray(episode_start, dtype=bool).reshape(-1),
+                                        (rows.shape[0],))] = 0.0
+        self.frames[:, :-d] = self.frames[:, d:]
+        self.frames[:, -d:] = rows
+        return self.frames[0].copy() if single else self.frames.copy()
+
+
+def frame_stack_of(venv) -> int:
+    """The ``VecFrameStack`` depth in a VecEnv's wrapper chain (1 without one)."""
+    from stable_baselines3.common.vec_env import VecFrameStack
+    while venv is not None:
+        if isinstance(venv, VecFrameStack):
+            return int(venv.stacked_obs.n_stack)
+        venv = getattr(venv, "venv", None)
+    return 1
+
+
 class SelfContained:
     """Mixin of the exported policy classes (see the module docstring).
 
     ``rotordrop`` (a ``policy_kwargs`` entry): ``env_id``, ``env_kwargs``, ``normalize``
     (``{"epsilon", "clip_obs"}`` or None), ``residual`` (baseline name or None),
-    ``residual_scale``, ``memoryless`` (the baseline keeps no per-episode state).
+    ``residual_scale``, ``memoryless`` (the baseline keeps no per-episode state),
+    ``frame_stack`` (observations the network sees at once, default 1: pass ``episode_start``
+    to ``predict`` so that a new episode starts from an empty stack).
     """
 
     def _setup_rotordrop(self, meta: dict[str, Any] | None) -> None:
         self.rotordrop = dict(meta or {})
+        self.stack = FrameStack(self.rotordrop.get("frame_stack", 1))
         n = int(np.prod(self.observation_space.shape))
         self.register_buffer("obs_mean", th.zeros(n, dtype=th.float64))
         self.register_buffer("obs_var", th.ones(n, dtype=th.float64))
@@ -78,8 +116,8 @@ class SelfContained:
         """Raw environment observations in, environment actions out: normalisation, network,
         then the residual on ``base`` (a baseline controller, or None without a residual)."""
         raw = np.asarray(observation, dtype=np.float32)
-        action, state = self.network_predict(self.normalize_obs(raw), state, episode_start,
-                                             deterministic)
+        action, state = self.network_predict(self.normalize_obs(self.stack(raw, episode_start)),
+                                             state, episode_start, deterministic)
         if base is not None:
             from .residual import residual_action
             action = residual_action(base, raw, action, float(self.rotordrop["residual_scale"]),
@@ -197,14 +235,15 @@ def _exported_class(policy) -> type:
 
 def export_self_contained(model, vecnormalize, out_path: str | Path, *, env_id: str | None = None,
                           env_kwargs: dict | None = None, residual: str | None = None,
-                          residual_scale: float | None = None) -> Path:
+                          residual_scale: float | None = None, frame_stack: int = 1) -> Path:
     """Write ``model`` (a PPO / SAC / TD3 / TQC with an ``MlpPolicy``) as a zip that plain SB3 loads
     and runs like the project's loader: ``vecnormalize`` (a ``VecNormalize`` or None) and the
     ``residual`` baseline (name, ``residual_scale``) go inside the policy. ``env_id`` and
     ``env_kwargs`` name the training environment (the residual's plant); without ``env_id``
     all four are read from the model's own training env (its spec and its
-    :class:`~agents.residual.ResidualAction` wrapper, if any). The model passed in is left as
-    it was."""
+    :class:`~agents.residual.ResidualAction` wrapper, if any). ``frame_stack``: the number of
+    observations the network sees at once (the run's ``frame_stack``). The model passed in is
+    left as it was."""
     from .controllers import BASELINES
     from .residual import RESIDUAL_SCALE, residual_of
     cls = _exported_class(model.policy)
@@ -224,7 +263,8 @@ def export_self_contained(model, vecnormalize, out_path: str | Path, *, env_id: 
     meta = dict(env_id=env_id, env_kwargs=copy.deepcopy(dict(env_kwargs or {})), normalize=norm,
                 residual=residual,
                 residual_scale=float(RESIDUAL_SCALE if residual_scale is None else residual_scale),
-                memoryless=bool(residual is None or BASELINES[residual].memoryless))
+                memoryless=bool(residual is None or BASELINES[residual].memoryless),
+                frame_stack=int(frame_stack))
     policy, kwargs = _rebuilt(model, cls, meta)
     if norm is not None:
         policy.obs_mean.copy_(th.as_tensor(vecnormalize.obs_rms.mean, dtype=th.float64))

@@ -184,7 +184,8 @@ def _callbacks():
             vn = self.model.get_vec_normalize_env()
             score = validation_score(self.validator, self.model, self.algo, self.env_id,
                                      self.env_kwargs, vn, self.meta.get("residual"),
-                                     self.meta.get("residual_scale"))
+                                     self.meta.get("residual_scale"),
+                                     self.meta.get("frame_stack", 1))
             self.eval_cb.kpi_history[-1]["validation_score"] = score
             self.logger.record("eval/validation_score", score)
             if score > self.best:
@@ -261,7 +262,8 @@ def save_policy(model, path: Path, env_id: str, meta: dict) -> None:
     from .sb3_policy import export_self_contained
     vn = model.get_vec_normalize_env()
     export_self_contained(model, vn, path, env_id=env_id, env_kwargs=meta["env_kwargs"],
-                          residual=meta.get("residual"), residual_scale=meta.get("residual_scale"))
+                          residual=meta.get("residual"), residual_scale=meta.get("residual_scale"),
+                          frame_stack=meta.get("frame_stack", 1))
     if vn is not None:
         vn.save(str(Path(path).parent / "vecnormalize.pkl"))
 
@@ -389,13 +391,16 @@ def _build(env_id: str, algo: str, meta: dict, algo_kwargs: dict, seed: int, ckp
     rw = dict(reward=meta["reward"], reward_kwargs=meta["reward_kwargs"],
               residual=meta.get("residual"), residual_scale=meta.get("residual_scale"))
     monitor = make_vec_env(env_id, meta.get("n_envs", 1), seed, meta["env_kwargs"], **rw)
-    eval_venv = _eval_env(make_vec_env(env_id, 1, seed + 10_000, meta["env_kwargs"], **rw),
-                          meta["normalize"])
+    stack = meta.get("frame_stack", 1)
+    eval_venv = _eval_env(_stacked(make_vec_env(env_id, 1, seed + 10_000, meta["env_kwargs"],
+                                                **rw), stack), meta["normalize"])
     if ckpt is not None:
-        model = _resumed_model(algo, env_id, ckpt, meta["normalize"], monitor, out, verbose)
+        model = _resumed_model(algo, env_id, ckpt, meta["normalize"], _stacked(monitor, stack),
+                               out, verbose)
     else:
-        model = _new_model(algo, meta, algo_kwargs, _train_env(monitor, meta["normalize"]), seed,
-                           out, verbose)
+        model = _new_model(algo, meta, algo_kwargs,
+                           _train_env(_stacked(monitor, stack), meta["normalize"]), seed, out,
+                           verbose)
     return monitor, eval_venv, model
 
 
@@ -442,6 +447,15 @@ def _train_env(venv, norm):
     """The training VecEnv: ``venv`` under a fresh ``VecNormalize`` unless ``normalize: false``."""
     from stable_baselines3.common.vec_env import VecNormalize
     return venv if norm is False else VecNormalize(venv, **(norm if isinstance(norm, dict) else {}))
+
+
+def _stacked(venv, n: int):
+    """``venv`` under SB3's ``VecFrameStack`` of ``n`` observations (config ``frame_stack``);
+    ``venv`` itself for n = 1. The normalisation goes over the stack (its statistics cover the
+    stacked observation), since SB3's off-policy algorithms store the observations that
+    ``VecNormalize`` saw, which must have the policy's shape."""
+    from stable_baselines3.common.vec_env import VecFrameStack
+    return venv if n == 1 else VecFrameStack(venv, n)
 
 
 def _eval_env(venv, norm):

@@ -22,11 +22,14 @@ EVAL_FREQ = 25_000
 
 
 def validation_score(validator, model, algo: str, env_id: str, env_kwargs: dict, vecnormalize,
-                     residual: str | None = None, residual_scale: float | None = None) -> float:
-    """The benchmark score of ``model`` (with its ``vecnormalize`` and ``residual``) on the
-    validation suite of ``validator``."""
+                     residual: str | None = None, residual_scale: float | None = None,
+                     frame_stack: int | None = None) -> float:
+    """The benchmark score of ``model`` (with its ``vecnormalize``, ``residual`` and
+    ``frame_stack``; None: read from the model's training env) on the validation suite of
+    ``validator``."""
     from .policies import LearnedPolicy
-    pol = LearnedPolicy("candidate", algo, env_id, env_kwargs, model, vecnormalize)
+    pol = LearnedPolicy("candidate", algo, env_id, env_kwargs, model, vecnormalize,
+                        frame_stack=frame_stack)
     if residual is not None:
         pol.residual, pol.residual_scale = residual, residual_scale
     score, _ = validator.score(pol.bound, env_kwargs)

@@ -88,7 +88,7 @@ def test_a_user_config_overrides_the_entries_in_either_form(tmp_path):
     ({"vec_env_wrapper": "my.Wrapper"}, "vec_env_wrapper my.Wrapper: rotordrop train knows"),
     ({"vec_env_wrapper": [{"agents.residual.ResidualAction": {"bas": "x"}}]}, "unknown key 'bas'"),
     ({"callback": "sb3.Other"}, "callback sb3.Other: rotordrop train knows"),
-    ({"frame_stack": 4}, "frame_stack .* is an rl-zoo3 option"),
+    ({"env_wrapper": "x.Y"}, "env_wrapper .* is an rl-zoo3 option"),
     ({"vec_env_wrapper": [{"a": 1, "b": 2}]}, "each entry is a class path"),
     ({"callback": [{"agents.validation.ValidationCallback": {"save_path": "x"}}]},
      "save_path is where rl-zoo3 keeps"),
