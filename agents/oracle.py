@@ -59,7 +59,7 @@ from .controllers import BASELINES, Passive
 from .plant import plant_of
 from .policies import load_shipped, shipped_names
 from .rollout import final_kpis, run_episodes
-from .score import DEFAULT_SCORE, overall_score, row_cost, write_json
+from .score import DEFAULT_SCORE, bootstrap_scores, overall_score, row_cost, write_json
 
 ENV_ID = TASKS["full"]
 COMMAND = "supervisor"
@@ -423,6 +423,21 @@ def score_rows(per_scenario: list[dict], names: list[str]) -> list[dict]:
     return table
 
 
+def add_bootstrap(summary: list[dict], per_scenario: list[dict], reference: str) -> None:
+    """Each summary row gains its paired-bootstrap SE over the drops and its difference to the
+    ``reference`` row with SE and 95 % interval (:func:`agents.score.bootstrap_scores`, the
+    leaderboards' resamples and seed)."""
+    names = [e["controller"] for e in summary]
+    costs = np.array([[s["rows"][n]["J"] for s in per_scenario] for n in names])
+    passive = np.array([s["rows"]["passive"]["J"] for s in per_scenario])
+    b = bootstrap_scores(costs, passive, names.index(reference))
+    for i, e in enumerate(summary):
+        e.update(score_se=float(b["score_se"][i]), diff_vs_reference=float(b["diff"][i]),
+                 diff_se=float(b["diff_se"][i]), diff_ci=[float(b["diff_ci_low"][i]),
+                                                          float(b["diff_ci_high"][i])],
+                 reference=reference)
+
+
 def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iterations: int = 10,
            seed: int = 0, policies: list[str] | None = None, progress: bool = True,
            plots: bool = True, search: bool = True, scenario_seed: int | None = None,
@@ -591,6 +606,8 @@ def _report(settings: dict, per_scenario: list[dict], names: list[str], t0: floa
     designed = [e for e in summary if e["controller"] in BASELINES and e["controller"] != "passive"]
     best = designed[0] if designed else None
     orc = next((e for e in summary if e["controller"] == "oracle"), None)
+    if best is not None and per_scenario:
+        add_bootstrap(summary, per_scenario, best["controller"])
     return dict(settings=settings, per_scenario=per_scenario, summary=summary,
                 learned=sorted(learned), constant_rows=list(constants),
                 best_designed=best["controller"] if best else None,

@@ -194,14 +194,69 @@ def oracle_section(reports: list[tuple[str, dict, str]], root: Path) -> list[str
                    else "") + f" (data: `{src}`)."
                 + (f" Searched plan over the best designed row (`{best['controller']}`): "
                    f"**{oracle['score'] - best['score']:+.2f}** points." if oracle and best else ""), "",
-                "| row | score | whirl rate | whirl where passive whirls | re-levitated | mean J |",
-                "|---|---:|---:|---:|---:|---:|"]
+                *_oracle_header(rows)]
         for e in rows:
-            out.append(f"| `{e['controller']}` | {_f(e['score'])} | {_f(e['whirl_rate'])} | "
-                       f"{_f(e.get('whirl_rate_where_passive_whirls'))} | "
+            out.append(f"| `{e['controller']}` | {_f(e['score'])} | " + _oracle_se(e, rows)
+                       + f"{_f(e['whirl_rate'])} | {_f(e.get('whirl_rate_where_passive_whirls'))} | "
                        f"{_f(e.get('relevitation_rate'))} | {_f(e.get('mean_J'), '.3f')} |")
         out.append("")
     return out
+
+
+def _oracle_header(rows: list[dict]) -> list[str]:
+    """The oracle table's header: with the SE and Δ columns when the report carries them."""
+    ref = next((e["reference"] for e in rows if e.get("reference")), None)
+    se = [f"SE | Δ vs `{ref}` ± SE [95 %] | "] if ref else [""]
+    return ["| row | score | " + se[0] + "whirl rate | whirl where passive whirls | re-levitated "
+            "| mean J |", "|---|---:|" + ("---:|---:|" if ref else "") + "---:|---:|---:|---:|"]
+
+
+def _oracle_se(e: dict, rows: list[dict]) -> str:
+    if not any(r.get("reference") for r in rows):
+        return ""
+    if e.get("score_se") is None:
+        return "– | – | "
+    lo, hi = e["diff_ci"]
+    return (f"{_f(e['score_se'])} | {e['diff_vs_reference']:+.2f} ± {e['diff_se']:.2f} "
+            f"[{lo:+.2f}, {hi:+.2f}] | ")
+
+
+def oracle_budget_section(report: dict, src: str) -> list[str]:
+    """The oracle's score against its search budget on the same drops (``--oracle-budget``)."""
+    runs = sorted(report["runs"], key=lambda r: r["rollouts_per_drop"])
+    first = runs[0]
+    out = ["### Search budget", "",
+           f"The same {first['scenarios']} drops ({first['suite']}, scenario seeds "
+           f"{first['scenario_seed']}–{first['scenario_seed'] + first['scenarios'] - 1}) searched "
+           f"with growing budgets (population × generations); Δ: the searched plan minus the best "
+           f"designed row on those drops, paired bootstrap over the drops (data: `{src}`).", "",
+           "| population × generations | rollouts per drop | oracle score | SE | best designed row "
+           "| Δ ± SE [95 %] | no gain over its start (drops) | wall time |",
+           "|---|---:|---:|---:|---|---:|---:|---:|"]
+    for r in runs:
+        lo, hi = r["diff_ci"]
+        out.append(f"| {r['population']} × {r['iterations']} | {r['rollouts_per_drop']} | "
+                   f"{_f(r['score'])} | {_f(r['score_se'])} | `{r['reference']}` "
+                   f"{_f(r['reference_score'])} | {r['diff']:+.2f} ± {r['diff_se']:.2f} "
+                   f"[{lo:+.2f}, {hi:+.2f}] | {r['unchanged']} / {r['scenarios']} | "
+                   f"{r['wall_time_s']:.0f} s |")
+    return out + [""]
+
+
+def budget_run(report: dict) -> dict:
+    """One row of the budget sweep from a ``rotordrop oracle`` oracle.json."""
+    s = report["settings"]
+    orc = next(e for e in report["summary"] if e["controller"] == "oracle")
+    ref = next(e for e in report["summary"] if e["controller"] == orc["reference"])
+    searched = [d["search"] for d in report["per_scenario"]]
+    return dict(population=s["population"], iterations=s["iterations"],
+                rollouts_per_drop=searched[0]["rollouts"],
+                scenarios=s["scenarios"], scenario_seed=s["scenario_seed"],
+                suite=s.get("suite", "nominal"), score=orc["score"], score_se=orc["score_se"],
+                reference=orc["reference"], reference_score=ref["score"],
+                diff=orc["diff_vs_reference"], diff_se=orc["diff_se"], diff_ci=orc["diff_ci"],
+                unchanged=sum(d["J"] >= d["start_J"] for d in searched),
+                wall_time_s=report["wall_time_s"])
 
 
 def _quantile(values: list[float], q: float) -> float:
@@ -311,6 +366,9 @@ def results_page(root: Path = ROOT) -> str:
                if (data / name).exists()]
     if oracles:
         lines += oracle_section(oracles, root)
+    budget = _load(data / "oracle-budget.json")
+    if budget:
+        lines += oracle_budget_section(budget, (DATA / "oracle-budget.json").as_posix())
     hard = [(json.loads(p.read_text()), (DATA / p.name).as_posix())
             for p in sorted(data.glob("hard-*.json"))]
     if hard:
@@ -369,6 +427,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                                             "store as docs/data/oracle-nominal.json")
     p.add_argument("--oracle-robust", help="a `rotordrop oracle --suite robust` oracle.json to "
                                            "store as docs/data/oracle-robust.json")
+    p.add_argument("--oracle-budget", nargs="+", default=[],
+                   help="`rotordrop oracle` oracle.json files of one suite's drops at several "
+                        "search budgets, stored together as docs/data/oracle-budget.json")
     p.add_argument("--root", default=str(ROOT), help="the project folder (default: this checkout)")
     p.add_argument("--check", action="store_true",
                    help="write nothing; exit 1 if the committed pages differ from the data")
@@ -377,7 +438,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def run(args) -> int:
     """Store the given benchmark output in docs/data and regenerate the pages (or ``--check``)."""
     root = Path(args.root)
-    given = (args.nominal, args.robust, args.hard, args.oracle_nominal, args.oracle_robust)
+    given = (args.nominal, args.robust, args.hard, args.oracle_nominal, args.oracle_robust,
+             args.oracle_budget)
     if args.check and any(given):
         print("results: error: --check takes no data files", file=sys.stderr)
         return 2
@@ -390,6 +452,11 @@ def run(args) -> int:
                       (args.oracle_robust, "oracle-robust.json")):
         if src:
             stored.append(store(src, root / DATA / name, keep=ORACLE_KEYS))
+    if args.oracle_budget:
+        runs = [budget_run(json.loads(Path(p).read_text())) for p in args.oracle_budget]
+        dest = root / DATA / "oracle-budget.json"
+        dest.write_text(json.dumps({"runs": runs}, indent=1, sort_keys=True) + "\n")
+        stored.append(dest)
     for h in args.hard:
         name = re.sub(r"[^A-Za-z0-9_.-]+", "-", json.loads(Path(h).read_text())["policy"]).strip("-")
         stored.append(store(h, root / DATA / f"hard-{name}.json", keep=HARD_KEYS))

@@ -69,6 +69,33 @@ def test_oracle_never_worse_than_its_start_and_resumes(tmp_path):
     assert again["per_scenario"][0]["search"] == saved["per_scenario"][0]["search"]     # reused
 
 
+def test_every_oracle_row_has_its_bootstrap_se_against_the_best_designed_row(tmp_path):
+    """Paired bootstrap over the drops (the leaderboards' resamples and seed); the budget sweep's
+    row of the results page reads the same fields."""
+    from agents.results import budget_run, oracle_budget_section
+    from agents.score import bootstrap_scores
+    rep = oracle(tmp_path, scenarios=3, population=4, iterations=1, progress=False, plots=False)
+    ref = rep["best_designed"]
+    rows = {e["controller"]: e for e in rep["summary"]}
+    assert all(e["reference"] == ref for e in rep["summary"])
+    assert rows[ref]["diff_vs_reference"] == 0.0 and rows[ref]["diff_se"] == 0.0
+    names = list(rows)
+    costs = [[d["rows"][n]["J"] for d in rep["per_scenario"]] for n in names]
+    passive = [d["rows"]["passive"]["J"] for d in rep["per_scenario"]]
+    b = bootstrap_scores(costs, passive, names.index(ref))
+    i = names.index("oracle")
+    assert rows["oracle"]["score_se"] == pytest.approx(b["score_se"][i]) and b["score_se"][i] > 0
+    assert rows["oracle"]["diff_vs_reference"] == pytest.approx(rows["oracle"]["score"]
+                                                                - rows[ref]["score"])
+    lo, hi = rows["oracle"]["diff_ci"]
+    assert lo <= rows["oracle"]["diff_vs_reference"] <= hi
+    run = budget_run(rep)
+    assert run["rollouts_per_drop"] == 5 and run["scenarios"] == 3
+    assert run["unchanged"] == sum(d["search"]["J"] >= d["search"]["start_J"]
+                                   for d in rep["per_scenario"])
+    assert "| 4 × 1 | 5 |" in "\n".join(oracle_budget_section({"runs": [run]}, "x"))
+
+
 def test_rows_only_on_other_scenarios(tmp_path):
     rep = oracle(tmp_path, scenarios=2, search=False, scenario_seed=20_000, progress=False,
                  plots=True)
