@@ -113,25 +113,43 @@ def whirl_reference(passive: dict) -> float:
     return max(float(passive["peak_whirl_revolutions"]), float(WHIRL_MIN_REVOLUTIONS))
 
 
+def cost_terms(row: dict, passive: dict, episode_time: float, relevitation: bool,
+               score: str = DEFAULT_SCORE) -> dict[str, float]:
+    """The terms of J(c, s) (module docstring) for one benchmark row against its passive row:
+    ``whirl`` (the verdict: W, or ½ W with the severity score), ``whirl_severity`` (½ N / N_ref,
+    0 in the legacy score), ``force``, ``displacement``, and in tasks that can re-levitate
+    ``relevitation_failure`` (1 − R) and ``relevitation_time`` (T_R / T_episode, T_episode for
+    the failed share). :func:`row_cost` sums them."""
+    legacy = check_score(score) == "legacy"
+    terms = dict(whirl=(1.0 if legacy else 0.5) * float(row["backward_whirl"]),
+                 whirl_severity=0.0 if legacy else
+                 0.5 * float(row["peak_whirl_revolutions"]) / whirl_reference(passive),
+                 force=0.5 * row["peak_contact_force_N"] / max(passive["peak_contact_force_N"], 1e-9),
+                 displacement=0.5 * row["max_displacement_um"] / max(passive["max_displacement_um"],
+                                                                     1e-9))
+    if relevitation:
+        rate = row.get("relevitated") or 0.0
+        t = row.get("relevitation_time_s")
+        terms.update(relevitation_failure=1.0 - rate,
+                     relevitation_time=(rate * (t if t is not None else episode_time)
+                                        + (1.0 - rate) * episode_time) / episode_time)
+    return terms
+
+
 def row_cost(row: dict, passive: dict, episode_time: float, relevitation: bool,
              score: str = DEFAULT_SCORE) -> float:
-    """J(c, s) of the module docstring for one benchmark row against its passive row.
+    """J(c, s) of the module docstring for one benchmark row against its passive row (the sum
+    of :func:`cost_terms`).
 
     Rows hold the scenario means ``backward_whirl`` (rate), ``peak_whirl_revolutions``
     (``severity`` score), ``peak_contact_force_N``, ``max_displacement_um``, ``relevitated``
     (rate) and ``relevitation_time_s`` (mean over the successful episodes)."""
-    if check_score(score) == "legacy":
-        cost = float(row["backward_whirl"])
-    else:
-        cost = 0.5 * float(row["backward_whirl"])
-        cost += 0.5 * float(row["peak_whirl_revolutions"]) / whirl_reference(passive)
-    cost += 0.5 * row["peak_contact_force_N"] / max(passive["peak_contact_force_N"], 1e-9)
-    cost += 0.5 * row["max_displacement_um"] / max(passive["max_displacement_um"], 1e-9)
+    t = cost_terms(row, passive, episode_time, relevitation, score)
+    cost = t["whirl"] if check_score(score) == "legacy" else t["whirl"] + t["whirl_severity"]
+    cost += t["force"]
+    cost += t["displacement"]
     if relevitation:
-        rate = row.get("relevitated") or 0.0
-        t = row.get("relevitation_time_s")
-        cost += (1.0 - rate) + (rate * (t if t is not None else episode_time)
-                                + (1.0 - rate) * episode_time) / episode_time
+        cost += t["relevitation_failure"] + t["relevitation_time"]
     return cost
 
 
