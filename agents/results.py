@@ -243,6 +243,20 @@ def oracle_budget_section(report: dict, src: str) -> list[str]:
     return out + [""]
 
 
+def headroom_section(result: dict, src: str) -> list[str]:
+    """Where the robust suite's points go (``python -m agents.research.headroom``)."""
+    from .research.headroom import table
+    return ["## Headroom on the robust suite", "",
+            f"Each column's score split into the points each term of J costs (score = 100 − the "
+            f"sum), on the {result['drops']} test drops of the robust leaderboard: the best "
+            f"designed row `{result['reference']}`, the best learned row, each drop scored by the "
+            f"best designed row on it and by the best row of all (knowing the drop), and every "
+            f"term at its best over all rows at once with the re-levitation time at the power "
+            f"return (optimistic: the terms trade against each other; not a bound). ± SE: paired "
+            f"bootstrap over the drops ([how](agents.md#robust-suite); data: `{src}`).", "",
+            table(result), ""]
+
+
 def budget_run(report: dict) -> dict:
     """One row of the budget sweep from a ``rotordrop oracle`` oracle.json."""
     s = report["settings"]
@@ -366,6 +380,9 @@ def results_page(root: Path = ROOT) -> str:
                if (data / name).exists()]
     if oracles:
         lines += oracle_section(oracles, root)
+    room = _load(data / "headroom-robust.json")
+    if room:
+        lines += headroom_section(room, (DATA / "headroom-robust.json").as_posix())
     budget = _load(data / "oracle-budget.json")
     if budget:
         lines += oracle_budget_section(budget, (DATA / "oracle-budget.json").as_posix())
@@ -427,6 +444,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                                             "store as docs/data/oracle-nominal.json")
     p.add_argument("--oracle-robust", help="a `rotordrop oracle --suite robust` oracle.json to "
                                            "store as docs/data/oracle-robust.json")
+    p.add_argument("--headroom", help="a `python -m agents.research.headroom` headroom.json of "
+                                      "the robust leaderboard, stored as "
+                                      "docs/data/headroom-robust.json")
     p.add_argument("--oracle-budget", nargs="+", default=[],
                    help="`rotordrop oracle` oracle.json files of one suite's drops at several "
                         "search budgets, stored together as docs/data/oracle-budget.json")
@@ -439,7 +459,7 @@ def run(args) -> int:
     """Store the given benchmark output in docs/data and regenerate the pages (or ``--check``)."""
     root = Path(args.root)
     given = (args.nominal, args.robust, args.hard, args.oracle_nominal, args.oracle_robust,
-             args.oracle_budget)
+             args.oracle_budget, args.headroom)
     if args.check and any(given):
         print("results: error: --check takes no data files", file=sys.stderr)
         return 2
@@ -452,6 +472,8 @@ def run(args) -> int:
                       (args.oracle_robust, "oracle-robust.json")):
         if src:
             stored.append(store(src, root / DATA / name, keep=ORACLE_KEYS))
+    if args.headroom:
+        stored.append(store(args.headroom, root / DATA / "headroom-robust.json"))
     if args.oracle_budget:
         runs = [budget_run(json.loads(Path(p).read_text())) for p in args.oracle_budget]
         dest = root / DATA / "oracle-budget.json"

@@ -204,7 +204,7 @@ def scenario_record(s: Scenario) -> dict:
                 latency_ms=round(1e3 * s.latency_s, 9))
 
 
-def target(board: list[dict], groups: list[dict], margin: float = 3.0) -> dict:
+def target(board: list[dict], groups: list[dict], margin: float = 2.0) -> dict:
     """The issue's target: the best learned configuration (mean − std over its seeds; a single
     policy's own score when it has no seeds beside it) ≥ the best designed row + ``margin``."""
     designed = [e for e in board if e["kind"] == "designed"]
