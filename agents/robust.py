@@ -208,7 +208,7 @@ def target(board: list[dict], groups: list[dict], margin: float = 2.0) -> dict:
     """The issue's target: the best learned configuration (mean − std over its seeds; a single
     policy's own score when it has no seeds beside it) ≥ the best designed row + ``margin``."""
     designed = [e for e in board if e["kind"] == "designed"]
-    grouped = {n for g in groups for n in g["members"]}
+    grouped = {n for g in groups for n in g["members"] + g.get("repeats", [])}
     learned = [(g["mean_minus_std"], " + ".join(g["members"])) for g in groups]
     learned += [(e["score"], e["controller"]) for e in board
                 if e["kind"] == "learned" and e["controller"] not in grouped]

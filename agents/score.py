@@ -217,20 +217,29 @@ def bootstrap_scores(costs: np.ndarray, passive: np.ndarray, reference: int,
 def seed_groups(board: list[dict], learned: dict) -> list[dict]:
     """Learned rows trained with the same algorithm and hyperparameters (the seeds of one
     configuration): mean, standard deviation (over seeds, ddof = 1) and mean − std of their
-    scores; groups of one row are left out."""
+    scores; groups of one row are left out. A seed counts once: a shipped policy benchmarked
+    beside the run it was shipped from (same seed) is one member, the first listed."""
     import json
     keys: dict[str, list[str]] = {}
+    seeds: dict[str, set] = {}
+    repeats: dict[str, list[str]] = {}
     for name, pol in learned.items():
         key = json.dumps([pol.algo, pol.env_id, pol.meta.get("hyperparams") or pol.env_kwargs],
                          sort_keys=True, default=str)
+        seed = pol.meta.get("seed")
+        if seed is not None and seed in seeds.setdefault(key, set()):
+            repeats.setdefault(key, []).append(name)
+            continue
+        seeds.setdefault(key, set()).add(seed)
         keys.setdefault(key, []).append(name)
     score = {e["controller"]: e["score"] for e in board}
     out = []
-    for names in keys.values():
+    for key, names in keys.items():
         if len(names) < 2:
             continue
         s = np.array([score[n] for n in names])
-        out.append(dict(members=names, scores=s.tolist(), mean=float(s.mean()),
+        out.append(dict(members=names, repeats=repeats.get(key, []), scores=s.tolist(),
+                        mean=float(s.mean()),
                         std=float(s.std(ddof=1)), mean_minus_std=float(s.mean() - s.std(ddof=1))))
     out.sort(key=lambda g: -g["mean_minus_std"])
     return out

@@ -78,9 +78,20 @@ def test_seed_groups_and_the_target():
     assert groups[0]["std"] == pytest.approx(1.0) and groups[0]["mean_minus_std"] == pytest.approx(64.0)
     t = target(board, groups)
     assert t["best_designed"] == "inner-loop" and t["best_learned_score"] == pytest.approx(64.0)
-    assert t["met"]                                     # 64.0 >= 60 + 3
-    board[0]["score"] = 61.5
+    assert t["met"] and t["margin"] == 2.0              # 64.0 >= 60 + 2
+    board[0]["score"] = 62.5
     assert not target(board, groups)["met"]             # 64.0 < 64.5: mean - std counts, not the best seed
+    # a shipped policy benchmarked beside the run it came from (same seed) counts once, and
+    # does not stand alone as a best learned row either
+    for name, seed in (("sac@s0", 0), ("sac@s1", 1), ("sac@s2", 2)):
+        pols[name].meta = {"hyperparams": hp, "seed": seed}
+    pols["sac-shipped"] = SimpleNamespace(algo="sac", env_id="F", env_kwargs={},
+                                          meta={"hyperparams": hp, "seed": 0})
+    board.append(dict(controller="sac-shipped", score=66.0, kind="learned"))
+    groups = seed_groups(board, pols)
+    assert groups[0]["members"] == ["sac@s0", "sac@s1", "sac@s2"]
+    assert groups[0]["repeats"] == ["sac-shipped"] and groups[0]["mean"] == pytest.approx(65.0)
+    assert target(board, groups)["best_learned_score"] == pytest.approx(64.0)
 
 
 def test_bad_suite_and_nominal_only_options_raise():
