@@ -21,8 +21,41 @@ from __future__ import annotations
 from ._jit import njit
 
 STATE_NAMES = ("RB1.temperature", "RB2.temperature", "heat_lost", "friction_work")
+SCENE_KEYS = ("thermal.*", "effects.thermal", "sleeve.mass", "contact.friction")
+#: the parameters, in the order of :func:`parameters`: heat capacity, loss conductance, contact
+#: heat partition, relative mu slope, mu ratio floor and ceiling, bearing heat partition
+PARAM_NAMES = ("thermal.heat_capacity", "thermal.conductance", "thermal.heat_partition",
+               "thermal.mu_slope", "thermal.mu_ratio_min", "thermal.mu_ratio_max",
+               "thermal.drag_heat_partition")
 TEMPERATURE_SIZE = 10.0          # K: tolerance size of a temperature state (atol = rtol x size)
 TEMPERATURE_OBS = 100.0          # K: its observation size
+
+
+def declare(layout) -> None:
+    """The thermal parameters (one block, in PARAM_NAMES order) and the first state's slot."""
+    layout.params.block(*PARAM_NAMES)
+    layout.index.add("state.thermal")
+
+
+def pack(scene, P, I, layout) -> None:
+    """The thermal parameters (only with effects.thermal; zero otherwise)."""
+    if scene.effects.thermal:
+        first = layout.params[PARAM_NAMES[0]]
+        P[first:first + len(PARAM_NAMES)] = parameters(scene)
+
+
+def states(scene, I, layout, sizes, add) -> None:
+    """Sleeve temperatures of RB1 and RB2, then the heat audit's heat_lost and friction_work."""
+    if not scene.effects.thermal:
+        return
+    first = -1
+    for name in STATE_NAMES:
+        if name.endswith("temperature"):
+            i = add(name, TEMPERATURE_SIZE, TEMPERATURE_OBS)
+        else:
+            i = add(name, sizes.energy, sizes.spin_energy)
+        first = i if first < 0 else first
+    I[layout.index["state.thermal"]] = first
 
 
 def heat_capacity(scene) -> float:
