@@ -50,6 +50,10 @@ class Slots:
             self.add(name)
         return first
 
+    def add_each(self, *names: str) -> tuple[int, ...]:
+        """Declare ``names`` as consecutive single entries; returns each one's index."""
+        return tuple(self.add(name) for name in names)
+
     def freeze(self) -> "Slots":
         """No more declarations (the size is final)."""
         self._frozen = True
