@@ -21,7 +21,7 @@ import math
 import numba
 import numpy as np
 
-from physics._jit import njit, njit_parallel
+from physics.jit import njit, njit_parallel
 from physics.integrate import integrate_segment
 from physics.layout import Slots
 from physics.model import (A_DELTA, A_FR, A_QMAX, A_WS, F_SENSOR, I_AMB_FILT, I_AMB_INT, I_CS,
