@@ -35,11 +35,11 @@ from .contact import (FRIC_KINEMATIC, FRIC_NONE, FRIC_PAPER, LAW_HERTZ_LINE,  # 
                       smooth_sign)
 from ._jit import njit, njit_borrow
 from .layout import Layout, StateSizes
-from .rotor import axis_at, tilt_accelerations, unbalance_force
+from .rotor import axis_at, tilt_accelerations, unbalance_load
 from .scene import Scene
 from . import sensor as sensor_mod
-from .stator import stator_force, stator_potential
-from .support import housing_force
+from .stator import mount_power, mount_rates, stator_force, stator_potential
+from .support import damper_rate, housing_rates, support_power
 
 VELOCITY = 0.1      # m/s: size of translational velocities (a free fall through the gap: 0.077 m/s)
 
@@ -399,16 +399,16 @@ def rhs(t, y, P, I, U, dy, aux):
     p_diss = 0.0        # power dissipated by dampers, friction and drag
     p_ext = 0.0         # power of external and non-potential forces (unbalance, AMB, film, cage)
 
-    # unbalance
+    # unbalance (physics/rotor.py)
     if dy is not None and I[F_UNB]:
         iphi = I[S_PHI]
-        ux, uy = unbalance_force(P[P_MUE], W, y[iphi] + P[P_UB_PHASE])
-        z = P[P_Z_UB]
+        ux, uy, mx, my, p = unbalance_load(P[P_MUE], W, y[iphi], P[P_UB_PHASE], P[P_Z_UB],
+                                           vx, vy, va, vb)
         Fx += ux
         Fy += uy
-        Ma += z * ux
-        Mb += z * uy
-        p_ext += ux * (vx + z * va) + uy * (vy + z * vb)
+        Ma += mx
+        Mb += my
+        p_ext += p
         dy[iphi] = W
 
     # AMBs (hold the rotor until the fault)
@@ -469,9 +469,7 @@ def rhs(t, y, P, I, U, dy, aux):
         tau = P[P_SENS_TAU]
         for k in range(2):
             dx, dyy, _, _ = axis_motion(y, I, P[P_Z_AMB1 + k])
-            i = i_sens + sensor_mod.STATES_PER_PLANE * k
-            dy[i], dy[i + 1] = sensor_mod.pade_rates(dx, y[i], y[i + 1], tau)
-            dy[i + 2], dy[i + 3] = sensor_mod.pade_rates(dyy, y[i + 2], y[i + 3], tau)
+            sensor_mod.delay_rates(dx, dyy, y, i_sens + sensor_mod.STATES_PER_PLANE * k, tau, dy)
 
     # retainer planes: rotor-sleeve contact, sleeve on ball bearing, housing
     twin = False
@@ -622,30 +620,25 @@ def rhs(t, y, P, I, U, dy, aux):
             dy[I[base + J_SVX]] = (cfx + bfx) / ms
             dy[I[base + J_SVY]] = (cfy + bfy) / ms - g
         # --- housing ---
+        # --- housing (physics/support.py) ---
         p_support = 0.0                          # power of the support dashpot C_s
         if i_hx >= 0:
             cs = U[U_CS1 + k]
             if I[I_CS] >= 0:                     # semi-active damper lags its command (spec §6)
                 cs = y[I[I_CS] + k]
-            p_support = cs * (hvx * hvx + hvy * hvy)
+            p_support = support_power(hvx, hvy, cs)
             p_diss += p_support
         if dy is not None and i_hx >= 0:
             if I[I_CS] >= 0:
-                # the clamp is needed: U is a public input, and even the env's command
-                # C_min + frac (C_max - C_min) can exceed C_max by one ulp at frac = 1
-                i_cs = I[I_CS] + k
-                dy[i_cs] = (amb_mod.clamp(U[U_CS1 + k], P[P_CS_MIN], P[P_CS_MAX]) - cs) / P[P_CS_TAU]
-            gx, gy = housing_force(hx, hy, hvx, hvy, P[P_KS], cs)
+                dy[I[I_CS] + k] = damper_rate(U[U_CS1 + k], cs, P[P_CS_MIN], P[P_CS_MAX],
+                                              P[P_CS_TAU])
             if i_sx >= 0:                        # reaction of the bearing
-                gx -= bfx
-                gy -= bfy
+                rx, ry = -bfx, -bfy
             else:                                # sleeve in the housing: contact acts directly
-                gx += cfx
-                gy += cfy
-            dy[i_hx] = hvx
-            dy[i_hx + 1] = hvy
-            dy[I[base + J_HVX]] = gx / P[P_MH]
-            dy[I[base + J_HVY]] = gy / P[P_MH] - g
+                rx, ry = cfx, cfy
+            i_hvx = I[base + J_HVX]
+            dy[i_hx], dy[i_hx + 1], dy[i_hvx], dy[i_hvx + 1] = housing_rates(
+                hx, hy, hvx, hvy, P[P_KS], cs, rx, ry, P[P_MH], g)
 
         o = k * N_AUX_PLANE
         aux[o + A_FR] = f_r
@@ -663,18 +656,8 @@ def rhs(t, y, P, I, U, dy, aux):
 
     i_heat = I[I_THERM]
     if dy is not None and i_heat >= 0:           # effects.thermal: sleeve heating, heat audit
-        q_lost = 0.0
-        w_fric = 0.0
-        for k in range(2):
-            o = k * N_AUX_PLANE
-            p = aux[o + A_PFRIC]
-            d = aux[o + A_PDRAG]                 # bearing friction power M omega_s
-            dy[i_heat + k], q = thermal.heat_rates(p, d, y[i_heat + k], P[P_TH_C], P[P_TH_G],
-                                                   P[P_TH_A], P[P_TH_B])
-            q_lost += q
-            w_fric += p + d
-        dy[i_heat + 2] = q_lost
-        dy[i_heat + 3] = w_fric
+        thermal.rates(y, dy, i_heat, aux[A_PFRIC], aux[A_PDRAG], aux[N_AUX_PLANE + A_PFRIC],
+                      aux[N_AUX_PLANE + A_PDRAG], P[P_TH_C], P[P_TH_G], P[P_TH_A], P[P_TH_B])
     if I[F_STATOR]:                              # rotor-stator contact at the AMB planes
         for k in range(2):
             z = P[P_Z_AMB1 + k]
@@ -687,13 +670,11 @@ def rhs(t, y, P, I, U, dy, aux):
             i_q = I[I_STM]
             if i_q >= 0:                         # the stator on its mount takes the reaction
                 i_q += 4 * k
-                p_mount = P[P_STM_C] * (qvx * qvx + qvy * qvy)
+                p_mount = mount_power(qvx, qvy, P[P_STM_C])
                 p_diss += p_mount
                 if dy is not None:
-                    dy[i_q] = qvx
-                    dy[i_q + 1] = qvy
-                    dy[i_q + 2] = (-sfx - P[P_STM_K] * qx - P[P_STM_C] * qvx) / P[P_STM_M]
-                    dy[i_q + 3] = (-sfy - P[P_STM_K] * qy - P[P_STM_C] * qvy) / P[P_STM_M]
+                    dy[i_q], dy[i_q + 1], dy[i_q + 2], dy[i_q + 3] = mount_rates(
+                        sfx, sfy, qx, qy, qvx, qvy, P[P_STM_K], P[P_STM_C], P[P_STM_M])
             Fx += sfx
             Fy += sfy
             Ma += z * sfx

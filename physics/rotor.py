@@ -91,6 +91,15 @@ def unbalance_force(m_e, Omega, angle):
     return f * math.cos(angle), f * math.sin(angle)
 
 
+@njit
+def unbalance_load(m_e, Omega, phi, phase, z, vx, vy, va, vb):
+    """The unbalance's force (fx, fy), moments (z fx, z fy) about the centre of mass and power
+    at spin angle ``phi`` (station z; the rotor's velocities vx, vy, va, vb): what the drop
+    model's right-hand side adds (its spin-angle rate is Omega)."""
+    fx, fy = unbalance_force(m_e, Omega, phi + phase)
+    return fx, fy, z * fx, z * fy, fx * (vx + z * va) + fy * (vy + z * vb)
+
+
 def steady_unbalance_orbit(m_u_e: float, Omega: float, mass: float, k: float, c: float) -> complex:
     """Complex amplitude Z of the settled translational orbit x + iy = Z e^{i Omega t}.
 

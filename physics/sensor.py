@@ -74,6 +74,14 @@ def pade_rates(d, q1, q2, tau):
 
 
 @njit
+def delay_rates(dx, dy_, y, i, tau, dy):
+    """Write the rates of one AMB plane's delay states y[i:i + 4] (x axis q1, q2, then y axis)
+    at the true displacements (dx, dy_) into ``dy``."""
+    dy[i], dy[i + 1] = pade_rates(dx, y[i], y[i + 1], tau)
+    dy[i + 2], dy[i + 3] = pade_rates(dy_, y[i + 2], y[i + 3], tau)
+
+
+@njit
 def delayed(d, v, q1, q2, tau):
     """(d(t - tau), d'(t - tau)) of the (2,2) Padé approximant (S1), from the true displacement
     ``d`` and velocity ``v`` and the axis's delay states."""

@@ -138,6 +138,19 @@ def stator_force(px, py, pvx, pvy, W, gap, k, c, mu, radius, v_l):
 
 
 @njit
+def mount_rates(sfx, sfy, qx, qy, qvx, qvy, k, c, m):
+    """(x', y', vx', vy') of a stator (mass m) on its mount (stiffness k, damping c) at (qx, qy)
+    moving at (qvx, qvy), under the reaction of the rotor's contact force (sfx, sfy)."""
+    return qvx, qvy, (-sfx - k * qx - c * qvx) / m, (-sfy - k * qy - c * qvy) / m
+
+
+@njit
+def mount_power(qvx, qvy, c):
+    """Power [W] the mount's dashpot c dissipates."""
+    return c * (qvx * qvx + qvy * qvy)
+
+
+@njit
 def stator_potential(px, py, gap, k):
     """Elastic energy ½ k δ² stored in the stator contact (energy audit)."""
     delta = math.sqrt(px * px + py * py) - gap

@@ -5,6 +5,7 @@ An effect of the drop model (docs/architecture.md "Adding an effect"): its scene
 slots, states and parameter packing are declared here; :mod:`physics.model` composes them.
 """
 from ._jit import njit
+from .amb import clamp
 
 SCENE_KEYS = ("support.stiffness", "support.housing_mass", "support.damping",
               "support.damping_min", "support.damping_max", "support.damper_time_constant",
@@ -64,3 +65,28 @@ def states(scene, I, layout, sizes, add) -> None:
 def housing_force(hx, hy, vx, vy, K_s, C_s):
     """Spring-damper force on the housing from the ground."""
     return -K_s * hx - C_s * vx, -K_s * hy - C_s * vy
+
+
+@njit
+def housing_rates(hx, hy, vx, vy, K_s, C_s, rx, ry, m_h, g):
+    """(hx', hy', vx', vy') of a housing (mass m_h, gravity g) on its support under the force
+    (rx, ry) of what it carries (the bearing's reaction, or the contact through a rigidly
+    mounted sleeve)."""
+    gx, gy = housing_force(hx, hy, vx, vy, K_s, C_s)
+    gx += rx
+    gy += ry
+    return vx, vy, gx / m_h, gy / m_h - g
+
+
+@njit
+def damper_rate(command, C_s, c_min, c_max, tau):
+    """dC_s/dt of the semi-active damper: C_s lags its command, clamped to [c_min, c_max] (the
+    command is a public input, and even C_min + frac (C_max - C_min) can exceed C_max by one ulp
+    at frac = 1)."""
+    return (clamp(command, c_min, c_max) - C_s) / tau
+
+
+@njit
+def support_power(vx, vy, C_s):
+    """Power [W] the support dashpot C_s dissipates."""
+    return C_s * (vx * vx + vy * vy)

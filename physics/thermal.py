@@ -94,6 +94,23 @@ def friction_coefficient(mu0, theta, kappa, r_min, r_max):
 
 
 @njit
+def rates(y, dy, i, p_fric1, p_drag1, p_fric2, p_drag2, C, G, a, b):
+    """Write the rates of the thermal states y[i:i + 4] (STATE_NAMES: the two sleeve
+    temperatures, heat_lost, friction_work) into ``dy`` for each plane's contact friction power
+    ``p_fric`` and bearing friction power ``p_drag``."""
+    dy[i], q1 = heat_rates(p_fric1, p_drag1, y[i], C, G, a, b)
+    dy[i + 1], q2 = heat_rates(p_fric2, p_drag2, y[i + 1], C, G, a, b)
+    q_lost = 0.0
+    q_lost += q1
+    q_lost += q2
+    w_fric = 0.0
+    w_fric += p_fric1 + p_drag1
+    w_fric += p_fric2 + p_drag2
+    dy[i + 2] = q_lost
+    dy[i + 3] = w_fric
+
+
+@njit
 def heat_rates(p_fric, p_drag, theta, C, G, a, b):
     """(dtheta/dt, heat lost per second) of one sleeve + inner ring with the contact friction
     power ``p_fric`` and its ball bearing's friction power ``p_drag``."""
