@@ -172,6 +172,33 @@ def clamp(v, lo, hi):
     return lo if v < lo else (hi if v > hi else v)
 
 
+@njit
+def actuator_command(t, d, z_int, q, u_direct, u_power, u_icmd, t_on, ref0, offset, lim, ramp,
+                     i_ff, kp, ki, kd, td):
+    """Commanded control current of one actuator axis, its error e and integral rate (spec §5).
+
+    ``d``: displacement at the axis; ``z_int``, ``q``: its PID integral and derivative-filter
+    states; ``u_*``, ``t_on``, ``ref0``: its controls (``U_AMB_DIRECT``, ``U_AMB_POWER``,
+    ``U_ICMD + j``, ``U_T_ON``, ``U_REF0 + j``, ``U_REF_OFF + j``); the rest its parameters
+    (``P_AMB_*``, the gains already scaled by ``U_AMB_GAIN``; ``i_ff`` the gravity feed-forward
+    current, zero on x axes). Scalars only, so that the model's ``rhs`` inlines it.
+
+    Direct mode: ``u_icmd`` clipped to the current limit (U is a public input). PID mode:
+    feed-forward minus PID of e = d - ramped reference, with conditional-integration anti-windup
+    (the integral stops while the current is saturated and the error would saturate it further).
+    Off: zero.
+    """
+    if u_direct > 0.0:
+        return clamp(u_icmd, -lim, lim), 0.0, 0.0
+    if u_power <= 0.0:
+        return 0.0, 0.0, 0.0
+    e = d - ramp_reference(t, t_on, ref0, ramp) - offset
+    raw = pid_current(e, z_int, q, kp, ki, kd, td, i_ff)
+    if (raw > lim and e < 0.0) or (raw < -lim and e > 0.0):
+        return (lim if raw > lim else -lim), e, 0.0
+    return clamp(raw, -lim, lim), e, e
+
+
 @dataclass(frozen=True)
 class ActuatorConstants:
     """Derived constants of the actuator level (spec §5), per AMB axis."""

@@ -437,7 +437,7 @@ def rhs(t, y, P, I, U, dy, aux):
                     j = 2 * k + a
                     d = dyy if a == 1 else dx
                     i_int, i_q = I[I_AMB_INT] + j, I[I_AMB_FILT] + j
-                    i_cmd, e, de_int = _actuator_command(
+                    i_cmd, e, de_int = amb_mod.actuator_command(
                         t, sy if a == 1 else sx, y[i_int], y[i_q], U[U_AMB_DIRECT],
                         U[U_AMB_POWER], U[U_ICMD + j],
                         U[U_T_ON], U[U_REF0 + j], oy if a == 1 else ox, P[P_AMB_ILIM],
@@ -730,33 +730,6 @@ def twin_planes(y, P, I):
     return i < 0 or _same(y[i], y[i + 1])
 
 
-@njit
-def _actuator_command(t, d, z_int, q, u_direct, u_power, u_icmd, t_on, ref0, offset, lim, ramp,
-                      i_ff, kp, ki, kd, td):
-    """Commanded control current of one actuator axis, its error e and integral rate (spec §5).
-
-    ``d``: displacement at the axis; ``z_int``, ``q``: its PID integral and derivative-filter
-    states; ``u_*``, ``t_on``, ``ref0``: its controls (``U_AMB_DIRECT``, ``U_AMB_POWER``,
-    ``U_ICMD + j``, ``U_T_ON``, ``U_REF0 + j``, ``U_REF_OFF + j``); the rest its parameters
-    (``P_AMB_*``, the gains already scaled by ``U_AMB_GAIN``; ``i_ff`` the gravity feed-forward
-    current, zero on x axes). Scalars only, so that ``rhs`` inlines it.
-
-    Direct mode: ``u_icmd`` clipped to the current limit (U is a public input). PID mode:
-    feed-forward minus PID of e = d - ramped reference, with conditional-integration anti-windup
-    (the integral stops while the current is saturated and the error would saturate it further).
-    Off: zero.
-    """
-    if u_direct > 0.0:
-        return amb_mod.clamp(u_icmd, -lim, lim), 0.0, 0.0
-    if u_power <= 0.0:
-        return 0.0, 0.0, 0.0
-    e = d - amb_mod.ramp_reference(t, t_on, ref0, ramp) - offset
-    raw = amb_mod.pid_current(e, z_int, q, kp, ki, kd, td, i_ff)
-    if (raw > lim and e < 0.0) or (raw < -lim and e > 0.0):
-        return (lim if raw > lim else -lim), e, 0.0
-    return amb_mod.clamp(raw, -lim, lim), e, e
-
-
 #: the orbit frame's unit vectors are regularised within this fraction of the clearance of the
 #: centre (an offset fades out there instead of jumping with the direction of a tiny orbit)
 ORBIT_FRAME_CORE = 0.05
@@ -789,7 +762,7 @@ def amb_currents(t, y, P, I, U, out):
             dx, dyy, _, _ = sensed_motion(y, P, I, U, k, dx, dyy, ddx, ddy)
         ox, oy = orbit_offset(dx, dyy, U[U_REF_OFF + 2 * k], U[U_REF_OFF + 2 * k + 1], y[I[S_W]],
                               P[P_CLR])
-        out[j] = _actuator_command(
+        out[j] = amb_mod.actuator_command(
             t, dyy if j % 2 == 1 else dx, y[I[I_AMB_INT] + j], y[I[I_AMB_FILT] + j],
             U[U_AMB_DIRECT], U[U_AMB_POWER], U[U_ICMD + j], U[U_T_ON], U[U_REF0 + j],
             oy if j % 2 == 1 else ox, P[P_AMB_ILIM], P[P_AMB_RAMP],
