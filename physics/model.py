@@ -137,6 +137,7 @@ I_AMB_INT, I_AMB_FILT, I_AMB_COIL, I_CS, I_THERM, I_STM, I_SENS = _I.indices(
     "state.amb_integral", "state.amb_filter", "state.amb_current", "state.damper",
     "state.thermal", "state.stator_mount", "state.sensor")
 N_I = _I.size
+MOUNT_STRIDE = len(stator.MOUNT_STATES)      # the stator-mount states of one AMB plane
 
 # ------------------------------------------------------------------------- controls U --
 # U_AMB_POWER > 0: the AMBs run under their built-in controller (linear law or PID);
@@ -325,7 +326,7 @@ def stator_motion(y, I, k):
     i = I[I_STM]
     if i < 0:
         return 0.0, 0.0, 0.0, 0.0
-    i += 4 * k
+    i += MOUNT_STRIDE * k
     return y[i], y[i + 1], y[i + 2], y[i + 3]
 
 
@@ -669,7 +670,7 @@ def rhs(t, y, P, I, U, dy, aux):
             p_mount = 0.0
             i_q = I[I_STM]
             if i_q >= 0:                         # the stator on its mount takes the reaction
-                i_q += 4 * k
+                i_q += MOUNT_STRIDE * k
                 p_mount = mount_power(qvx, qvy, P[P_STM_C])
                 p_diss += p_mount
                 if dy is not None:
