@@ -5,7 +5,9 @@ diagnostics). Their slots are declared here one after the other, never numbered 
 :class:`Slots` table hands out the next free index for each name (``width`` entries for a
 block), and the module-level constants the kernels read (``P_M = params["rotor.mass"]``) are
 assigned from it at import time. numba treats module-level ints as compile-time constants, so a
-name costs nothing at run time.
+name costs nothing at run time. Because ``@njit`` kernels compile these ints in, this file counts
+as kernel source for the on-disk cache (:mod:`physics._jit` hashes every file that mentions
+njit): a change to how slots are laid out recompiles the kernels.
 
 A :class:`Layout` holds the tables of the drop model (:mod:`physics.model` builds it by asking
 each registered effect to :func:`declare` its slots); the environments' kernels use a
