@@ -35,11 +35,12 @@ from .contact import (FRIC_KINEMATIC, FRIC_NONE, FRIC_PAPER, LAW_HERTZ_LINE,  # 
                       smooth_sign)
 from ._jit import njit, njit_borrow
 from .layout import Layout, StateSizes
-from .rotor import axis_at, tilt_accelerations, unbalance_load
+from .rotor import axis_at, rotor_energy, tilt_accelerations, unbalance_load
 from .scene import Scene
 from . import sensor as sensor_mod
-from .stator import mount_power, mount_rates, stator_force, stator_potential
-from .support import damper_rate, housing_rates, support_power
+from .stator import mount_energy, mount_power, mount_rates, stator_force, stator_potential
+from .support import (body_energy, damper_rate, housing_rates, spin_energy, spring_energy,
+                      support_power)
 
 VELOCITY = 0.1      # m/s: size of translational velocities (a free fall through the gap: 0.077 m/s)
 
@@ -780,7 +781,7 @@ def mechanical_energy(y, P, I):
     yy = y[I[S_Y]]
     vx, vy, va, vb = y[I[S_VX]], y[I[S_VY]], y[I[S_VA]], y[I[S_VB]]
     W = y[I[S_W]]
-    E = 0.5 * m * (vx * vx + vy * vy) + 0.5 * P[P_ID] * (va * va + vb * vb) + 0.5 * P[P_IP] * W * W
+    E = rotor_energy(m, P[P_ID], P[P_IP], vx, vy, va, vb, W)
     E += m * g * yy
     for k in range(2):
         base = I_PLANES + k * N_PLANE_IDX
@@ -788,14 +789,14 @@ def mechanical_energy(y, P, I):
         hx, hy, hvx, hvy = housing_motion(y, I, k)
         sx, sy, svx, svy = sleeve_motion(y, I, k)
         if I[base + J_HX] >= 0:
-            E += 0.5 * P[P_MH] * (hvx * hvx + hvy * hvy) + P[P_MH] * g * hy
-            E += 0.5 * P[P_KS] * (hx * hx + hy * hy)
+            E += body_energy(P[P_MH], hvx, hvy, g, hy)
+            E += spring_energy(P[P_KS], hx, hy)
         if I[base + J_SX] >= 0:
-            E += 0.5 * P[P_MS] * (svx * svx + svy * svy) + P[P_MS] * g * sy
+            E += body_energy(P[P_MS], svx, svy, g, sy)
         i_ws = I[base + J_WS]
         ws = y[i_ws] if i_ws >= 0 else 0.0
         if i_ws >= 0:
-            E += 0.5 * P[P_JS] * ws * ws
+            E += spin_energy(P[P_JS], ws)
         er, _, _ = geometry(px - sx, py - sy)
         if I[F_LAW] == LAW_PAPER:
             E += contact_potential(er - P[P_CLR], P[P_KC], P[P_EC])
@@ -805,7 +806,7 @@ def mechanical_energy(y, P, I):
             ax, ay, _, _ = axis_motion(y, I, P[P_Z_AMB1 + k])
             qx, qy, qvx, qvy = stator_motion(y, I, k)
             E += stator_potential(ax - qx, ay - qy, P[P_ST_GAP], P[P_ST_K])
-            E += 0.5 * P[P_STM_M] * (qvx * qvx + qvy * qvy) + 0.5 * P[P_STM_K] * (qx * qx + qy * qy)
+            E += mount_energy(qx, qy, qvx, qvy, P[P_STM_K], P[P_STM_M])
         ux, uy = sx - hx, sy - hy
         if I[F_RB] == RB_SM:        # zero film without sleeve inertia (see rhs)
             h = film_thickness(ws, P[P_FILM])[0] if I[F_FILM] and i_ws >= 0 else 0.0
@@ -813,7 +814,7 @@ def mechanical_energy(y, P, I):
                                            P[P_HALF_PLAY], h, P[P_KTOT])
             E += V
         elif I[F_RB] == RB_LINEAR:
-            E += 0.5 * P[P_KLIN] * (ux * ux + uy * uy)
+            E += spring_energy(P[P_KLIN], ux, uy)
     return E
 
 

@@ -92,6 +92,12 @@ def unbalance_force(m_e, Omega, angle):
 
 
 @njit
+def rotor_energy(m, I_d, I_p, vx, vy, va, vb, Omega):
+    """Kinetic energy of the rigid rotor: translation, tilt and spin [J]."""
+    return 0.5 * m * (vx * vx + vy * vy) + 0.5 * I_d * (va * va + vb * vb) + 0.5 * I_p * Omega * Omega
+
+
+@njit
 def unbalance_load(m_e, Omega, phi, phase, z, vx, vy, va, vb):
     """The unbalance's force (fx, fy), moments (z fx, z fy) about the centre of mass and power
     at spin angle ``phi`` (station z; the rotor's velocities vx, vy, va, vb): what the drop

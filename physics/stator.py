@@ -145,6 +145,12 @@ def mount_rates(sfx, sfy, qx, qy, qvx, qvy, k, c, m):
 
 
 @njit
+def mount_energy(qx, qy, qvx, qvy, k, m):
+    """Kinetic energy of a stator (mass m) on its mount plus the mount spring's (stiffness k)."""
+    return 0.5 * m * (qvx * qvx + qvy * qvy) + 0.5 * k * (qx * qx + qy * qy)
+
+
+@njit
 def mount_power(qvx, qvy, c):
     """Power [W] the mount's dashpot c dissipates."""
     return c * (qvx * qvx + qvy * qvy)

@@ -90,3 +90,23 @@ def damper_rate(command, C_s, c_min, c_max, tau):
 def support_power(vx, vy, C_s):
     """Power [W] the support dashpot C_s dissipates."""
     return C_s * (vx * vx + vy * vy)
+
+
+@njit
+def body_energy(m, vx, vy, g, y):
+    """Kinetic plus gravitational energy of a body of mass m moving in the x-y plane [J] (a
+    housing here, the sleeve in the model's energy audit)."""
+    return 0.5 * m * (vx * vx + vy * vy) + m * g * y
+
+
+@njit
+def spring_energy(k, x, y):
+    """Energy of an isotropic linear spring k at deflection (x, y) [J] (the support spring, the
+    linear retainer bearing)."""
+    return 0.5 * k * (x * x + y * y)
+
+
+@njit
+def spin_energy(J, w):
+    """Kinetic energy of a body of spin inertia J at speed w [J] (a sleeve)."""
+    return 0.5 * J * w * w
