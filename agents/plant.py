@@ -100,16 +100,15 @@ class Plant:
         elif hasattr(u, "get_attr") and not hasattr(u, "obs_names"):   # SubprocVecEnv
             spec = u.get_attr("spec", [0])[0]
             return plant_of(spec.id, **spec.kwargs)
-        from physics.model import P_AMB_IFF1, P_AMB_IFF2
         s = u.base_scene
-        P = u.model.P              # gravity feed-forward currents: 0 without actuator AMBs
+        m = u.model                # gravity feed-forward currents: 0 without actuator AMBs
         return cls(env_id=u.spec.id if u.spec is not None else type(u).__name__,
                    obs_names=tuple(u.obs_names), obs_scale=np.asarray(u.obs_scale, dtype=np.float64),
                    action_names=tuple(u.action_names), discrete=bool(u._discrete),
                    control_dt=float(u.dt), clearance=s.contact.clearance,
                    damping_range=(s.support.damping_min, s.support.damping_max),
                    current_limit=s.amb.current_limit, pid=(s.amb.kp, s.amb.ki, s.amb.kd),
-                   feedforward=(float(P[P_AMB_IFF1]), float(P[P_AMB_IFF2])),
+                   feedforward=(m.param("amb1.feedforward_current"), m.param("amb2.feedforward_current")),
                    liftoff_ramp=s.amb.liftoff_ramp_time,
                    damping_action=getattr(u, "damping_action", "linear"))
 

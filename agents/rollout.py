@@ -13,7 +13,6 @@ from typing import Callable
 
 import numpy as np
 
-from physics.model import P_Z_AMB1, axis_motion
 
 from .controllers import Controller, check_controller
 from .plant import POSITIONS, Plant, make_env
@@ -123,5 +122,4 @@ def sensor_positions(env) -> np.ndarray:
     """(4,) x1, y1, x2, y2 [m]: the rotor axis at the AMB (sensor) planes from the env's state,
     for the orbit plots of a ``full_state=True`` environment, which does not observe them."""
     u = env.unwrapped
-    return np.array([v for k in range(2) for v in axis_motion(u.state, u.model.I,
-                                                               u.model.P[P_Z_AMB1 + k])[:2]])
+    return u.model.sensor_positions(u.state)

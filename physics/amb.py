@@ -15,6 +15,10 @@ Force of one axis (spec §5), positive towards +x::
 Each magnet's term is capped at B_sat^2 A_g cos(alpha) / mu_0 (flux density at most B_sat), which
 bounds the force near the stator. At the centre: k_i = 4 k cos(alpha) i_0 / g_0^2 (current gain),
 k_s = 4 k cos(alpha) i_0^2 / g_0^3 (negative stiffness).
+
+An effect of the drop model (docs/architecture.md "Adding an effect"): its scene keys, packed
+slots (parameters, controls), states and parameter packing are declared here;
+:mod:`physics.model` composes them.
 """
 from __future__ import annotations
 
@@ -24,6 +28,84 @@ from dataclasses import dataclass
 from ._jit import njit
 
 MU_0 = 4e-7 * math.pi
+
+SCENE_KEYS = ("amb.*", "effects.amb", "rotor.mass", "world.gravity", "positions.amb1",
+              "positions.amb2", "effects.gravity")
+AMB_NONE, AMB_LINEAR, AMB_ACTUATOR = 0, 1, 2
+#: the actuator's axes, in the order of its per-axis states and controls
+AMB_AXES = ("AMB1.x", "AMB1.y", "AMB2.x", "AMB2.y")
+#: the actuator's parameters (spec §5): k cos(alpha), g_0, i_0, current limit, current/gap cap,
+#: PID gains, derivative filter, coil lag, lift-off ramp
+ACTUATOR_PARAMS = ("amb.force_constant", "amb.air_gap", "amb.bias_current", "amb.current_limit",
+                   "amb.ratio_max", "amb.kp", "amb.ki", "amb.kd", "amb.derivative_filter",
+                   "amb.coil_time_constant", "amb.liftoff_ramp_time")
+
+
+def declare(layout) -> None:
+    """The AMBs' slots. Controls: ``amb.power`` > 0 runs the AMBs under their built-in controller
+    (linear law or PID). Actuator level only: ``amb.direct`` > 0 applies the control currents
+    ``amb.current_command`` + j (j = axis, see AMB_AXES) instead of the PID; ``amb.t_on`` is
+    the time the PID was switched on and ``amb.reference0`` + j the reference it ramps from
+    (spec §5 reactivation). A supervisor over the PID shifts the reference of AMB plane k by
+    ``amb.reference_offset`` + 2k (radial) and + 2k + 1 (tangential, along a forward orbit) [m]
+    in the frame of the sensed orbit and scales the three PID gains by ``amb.gain``."""
+    p = layout.params
+    p.add("amb.stiffness")
+    p.add("amb.damping")
+    p.block("amb1.bias", "amb2.bias")
+    for name in ACTUATOR_PARAMS:
+        p.add(name)
+    p.block("amb1.feedforward_current", "amb2.feedforward_current")    # gravity feed-forward
+    layout.index.add("flag.amb")
+    for name in ("integral", "filter", "current"):   # first state of each per-axis block
+        layout.index.add("state.amb_" + name)
+    u = layout.controls
+    u.add("amb.power")
+    u.add("amb.direct")
+    u.add("amb.current_command", len(AMB_AXES))
+    u.add("amb.t_on")
+    u.add("amb.reference0", len(AMB_AXES))
+    u.add("amb.reference_offset", len(AMB_AXES))
+    u.add("amb.gain")
+
+
+def pack(scene, P, I, layout) -> None:
+    """The AMBs' parameters and flag (level)."""
+    s, fx, p = scene, scene.effects, layout.params
+    I[layout.index["flag.amb"]] = {"none": AMB_NONE, "linear": AMB_LINEAR,
+                                   "actuator": AMB_ACTUATOR}[fx.amb]
+    g = s.world.gravity if fx.gravity else 0.0
+    P[p["amb.stiffness"]], P[p["amb.damping"]] = s.amb.stiffness, s.amb.damping
+    P[p["amb1.bias"]], P[p["amb2.bias"]] = weight_shares(s.rotor.mass * g, s.positions.amb1,
+                                                         s.positions.amb2)
+    if fx.amb == "actuator":
+        a = s.amb
+        ac = actuator_constants(a, P[p["amb1.bias"]], P[p["amb2.bias"]])
+        for name, value in zip(ACTUATOR_PARAMS, (
+                ac.force_constant, a.air_gap, a.bias_current, a.current_limit, ac.ratio_max,
+                a.kp, a.ki, a.kd, a.derivative_filter, a.coil_time_constant,
+                a.liftoff_ramp_time)):
+            P[p[name]] = value
+        P[p["amb1.feedforward_current"]], P[p["amb2.feedforward_current"]] = ac.feedforward
+
+
+def states(scene, I, layout, sizes, add) -> None:
+    """The actuator's PID integral, derivative-filter and (with a coil lag) coil-current states,
+    one block of 4 (AMB_AXES) each."""
+    if scene.effects.amb != "actuator":
+        return
+    i, c = layout.index, sizes.clearance
+    I[i["state.amb_integral"]] = add(f"{AMB_AXES[0]}.integral", 0.01 * c)
+    for ax in AMB_AXES[1:]:
+        add(f"{ax}.integral", 0.01 * c)
+    I[i["state.amb_filter"]] = add(f"{AMB_AXES[0]}.filter", c)
+    for ax in AMB_AXES[1:]:
+        add(f"{ax}.filter", c)
+    if scene.amb.coil_time_constant > 0.0:
+        size = max(scene.amb.current_limit, 1e-3)
+        I[i["state.amb_current"]] = add(f"{AMB_AXES[0]}.current", size)
+        for ax in AMB_AXES[1:]:
+            add(f"{ax}.current", size)
 
 
 @njit
@@ -88,6 +170,33 @@ def pid_current(e, z_int, q, kp, ki, kd, tau_d, i_ff):
 @njit
 def clamp(v, lo, hi):
     return lo if v < lo else (hi if v > hi else v)
+
+
+@njit
+def actuator_command(t, d, z_int, q, u_direct, u_power, u_icmd, t_on, ref0, offset, lim, ramp,
+                     i_ff, kp, ki, kd, td):
+    """Commanded control current of one actuator axis, its error e and integral rate (spec §5).
+
+    ``d``: displacement at the axis; ``z_int``, ``q``: its PID integral and derivative-filter
+    states; ``u_*``, ``t_on``, ``ref0``: its controls (``U_AMB_DIRECT``, ``U_AMB_POWER``,
+    ``U_ICMD + j``, ``U_T_ON``, ``U_REF0 + j``, ``U_REF_OFF + j``); the rest its parameters
+    (``P_AMB_*``, the gains already scaled by ``U_AMB_GAIN``; ``i_ff`` the gravity feed-forward
+    current, zero on x axes). Scalars only, so that the model's ``rhs`` inlines it.
+
+    Direct mode: ``u_icmd`` clipped to the current limit (U is a public input). PID mode:
+    feed-forward minus PID of e = d - ramped reference, with conditional-integration anti-windup
+    (the integral stops while the current is saturated and the error would saturate it further).
+    Off: zero.
+    """
+    if u_direct > 0.0:
+        return clamp(u_icmd, -lim, lim), 0.0, 0.0
+    if u_power <= 0.0:
+        return 0.0, 0.0, 0.0
+    e = d - ramp_reference(t, t_on, ref0, ramp) - offset
+    raw = pid_current(e, z_int, q, kp, ki, kd, td, i_ff)
+    if (raw > lim and e < 0.0) or (raw < -lim and e > 0.0):
+        return (lim if raw > lim else -lim), e, 0.0
+    return clamp(raw, -lim, lim), e, e
 
 
 @dataclass(frozen=True)

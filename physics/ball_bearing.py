@@ -1,7 +1,12 @@
-"""Planar Sopanen-Mikkola deep-groove ball bearing (spec §4).
+"""Planar Sopanen-Mikkola deep-groove ball bearing (spec §4), or a linear spring bearing, and the
+sleeve (the bearing's inner ring) it carries.
 
 Python side: Hertz and film constants from the bearing geometry (computed once per scene).
 Kernel side: per-ball Hertz loads with clearance and film, bearing friction torque.
+
+An effect of the drop model (docs/architecture.md "Adding an effect"): its scene keys, packed
+slots, per-plane states and parameter packing are declared here; :mod:`physics.model` composes
+them.
 """
 import math
 from dataclasses import dataclass
@@ -9,6 +14,59 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._jit import njit
+from .amb import static_weight_share
+
+SCENE_KEYS = ("sleeve.mass", "sleeve.spin_inertia", "bearing.*", "effects.retainer_bearing",
+              "effects.ehl_film", "effects.bearing_friction", "effects.sleeve_inertia")
+RB_RIGID, RB_LINEAR, RB_SM = 0, 1, 2
+#: per retainer plane: sleeve position and velocity, cage angle, sleeve spin (index slots)
+PLANE_STATES = ("sx", "sy", "svx", "svy", "theta", "omega_s")
+
+
+def declare(layout) -> None:
+    """The sleeve's and the bearing's parameters, flags and per-plane state slots."""
+    for name in ("sleeve.mass", "sleeve.spin_inertia", "bearing.balls", "bearing.half_play",
+                 "bearing.stiffness", "bearing.film_coef", "bearing.damping",
+                 "bearing.linear_stiffness", "bearing.cage_ratio", "bearing.m0_low",
+                 "bearing.m0_coef", "bearing.m1_coef", "bearing.seal_torque"):
+        layout.params.add(name)
+    for name in ("retainer_bearing", "ehl_film", "bearing_friction", "sleeve_inertia"):
+        layout.index.add("flag." + name)
+    for name in PLANE_STATES:
+        layout.plane.add(name)
+
+
+def pack(scene, P, I, layout) -> None:
+    """The bearing's parameters (film reference load, spec §4: Q_n = 5 x static bearing load /
+    z) and flags."""
+    s, fx, p, i = scene, scene.effects, layout.params, layout.index
+    I[i["flag.retainer_bearing"]] = {"rigid": RB_RIGID, "linear": RB_LINEAR,
+                                     "sopanen_mikkola": RB_SM}[fx.retainer_bearing]
+    I[i["flag.ehl_film"]] = fx.ehl_film and fx.retainer_bearing == "sopanen_mikkola"
+    I[i["flag.bearing_friction"]] = fx.bearing_friction
+    I[i["flag.sleeve_inertia"]] = fx.sleeve_inertia
+    P[p["sleeve.mass"]], P[p["sleeve.spin_inertia"]] = s.sleeve.mass, s.sleeve.spin_inertia
+    b = s.bearing
+    bc = bearing_constants(b, static_weight_share(s))
+    P[p["bearing.balls"]], P[p["bearing.half_play"]] = b.balls, b.clearance / 2.0
+    P[p["bearing.stiffness"]], P[p["bearing.film_coef"]] = bc.K_tot, bc.film_coef
+    P[p["bearing.damping"]], P[p["bearing.linear_stiffness"]] = b.damping, b.linear_stiffness
+    P[p["bearing.cage_ratio"]] = cage_ratio(b)
+    P[p["bearing.m0_low"]], P[p["bearing.m0_coef"]] = bc.m0_low, bc.m0_coef
+    P[p["bearing.m1_coef"]], P[p["bearing.seal_torque"]] = bc.m1_coef, b.seal_torque
+
+
+def plane_states(scene, I, base, layout, sizes, plane, add) -> None:
+    """Retainer plane ``plane``'s sleeve states: its position and velocity (unless rigidly mounted
+    in the housing), the cage angle (Sopanen-Mikkola balls), its spin (with sleeve inertia)."""
+    fx, j, c = scene.effects, layout.plane, sizes.clearance
+    if fx.retainer_bearing != "rigid":
+        for n, sz in (("sx", c), ("sy", c), ("svx", sizes.velocity), ("svy", sizes.velocity)):
+            I[base + j[n]] = add(f"{plane}.{n}", sz)
+    if fx.retainer_bearing == "sopanen_mikkola":
+        I[base + j["theta"]] = add(f"{plane}.theta", math.pi)
+    if fx.sleeve_inertia:
+        I[base + j["omega_s"]] = add(f"{plane}.omega_s", sizes.spin)
 
 
 # ------------------------------------------------------------------------------- constants --

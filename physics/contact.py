@@ -1,7 +1,65 @@
-"""Rotor-sleeve circle-in-circle contact (paper eqs. 14-19, spec §3)."""
+"""Rotor-sleeve circle-in-circle contact (paper eqs. 14-19, spec §3).
+
+An effect of the drop model (docs/architecture.md "Adding an effect"): its scene keys, packed
+slots and parameter packing are declared here (no state of its own), and the retainer plane's
+diagnostics table (its own entries and the retainer bearing's, in the order of ``Result.aux``).
+"""
 import math
 
 from ._jit import njit
+
+SCENE_KEYS = ("contact.clearance", "contact.stiffness", "contact.exponent", "contact.damping",
+              "contact.damping_depth", "contact.friction", "contact.threshold_rpm",
+              "contact.law", "contact.length", "contact.restitution", "rotor.journal_radius",
+              "bearing.youngs_modulus", "bearing.poisson", "effects.friction")
+FRIC_NONE, FRIC_PAPER, FRIC_KINEMATIC = 0, 1, 2
+LAW_PAPER, LAW_HERTZ_LINE = 0, 1
+STANDARD_GRAVITY = 9.80665  # m/s^2: sets the hertz_line reference impact speed sqrt(2 g c)
+#: the per-plane diagnostics (Result.aux columns): contact normal force, friction force,
+#: penetration, bearing load, sleeve speed, bearing drag torque, then the powers [W] each
+#: dissipative element takes out of the mechanical energy (physics/dissipation.py checks each is
+#: >= 0): contact friction, (largest ball load), contact normal damping, ball-bearing dashpot,
+#: bearing drag, support dashpot
+PLANE_DIAGNOSTICS = ("contact_force", "friction_force", "penetration", "bearing_load",
+                     "sleeve_speed", "drag_torque", "friction_power", "ball_load_max",
+                     "contact_damping_power", "bearing_damping_power", "drag_power",
+                     "support_power")
+
+
+def declare(layout) -> None:
+    """The contact's parameters and flags, and the retainer plane's diagnostics."""
+    for name in ("contact.clearance", "sleeve.radius", "contact.stiffness", "contact.exponent",
+                 "contact.damping", "contact.damping_depth", "contact.friction",
+                 "contact.threshold_speed", "contact.threshold_velocity",
+                 "contact.line_coefficient", "contact.hysteresis"):
+        layout.params.add(name)
+    layout.index.add("flag.friction")
+    layout.index.add("flag.law")
+    for name in PLANE_DIAGNOSTICS:
+        layout.plane_aux.add(name)
+
+
+def pack(scene, P, I, layout) -> None:
+    """The contact's parameters (the hertz_line law's pi L E* and Hunt-Crossley factor chi) and
+    flags (friction slip law, normal-force law)."""
+    s, p, i = scene, layout.params, layout.index
+    c = s.contact.clearance
+    I[i["flag.friction"]] = {"none": FRIC_NONE, "paper": FRIC_PAPER,
+                             "kinematic": FRIC_KINEMATIC}[s.effects.friction]
+    I[i["flag.law"]] = {"paper": LAW_PAPER, "hertz_line": LAW_HERTZ_LINE}[s.contact.law]
+    P[p["contact.clearance"]] = c
+    P[p["sleeve.radius"]] = s.rotor.journal_radius + c
+    P[p["contact.stiffness"]], P[p["contact.exponent"]] = s.contact.stiffness, s.contact.exponent
+    P[p["contact.damping"]], P[p["contact.damping_depth"]] = (s.contact.damping,
+                                                              s.contact.damping_depth)
+    P[p["contact.friction"]] = s.contact.friction
+    P[p["contact.threshold_speed"]] = s.contact.threshold_rpm * math.pi / 30.0
+    P[p["contact.threshold_velocity"]] = P[p["contact.threshold_speed"]] * s.rotor.journal_radius
+    b, ct = s.bearing, s.contact
+    e_star = b.youngs_modulus / (2.0 * (1.0 - b.poisson ** 2))     # steel journal in a steel sleeve
+    P[p["contact.line_coefficient"]] = math.pi * ct.length * e_star
+    P[p["contact.hysteresis"]] = hysteresis_factor(ct.restitution,
+                                                   math.sqrt(2.0 * STANDARD_GRAVITY * ct.clearance))
 
 
 @njit

@@ -10,10 +10,14 @@ import math
 import numpy as np
 
 from ._jit import njit, njit_borrow
+from .layout import Slots
 from .model import A_FR, A_LOAD, A_QMAX, N_AUX, N_AUX_PLANE, rhs
 
-# step-resolved peaks per retainer plane k at peaks[k * N_PEAK + j]
-(P_FR, P_LOAD, P_QMAX, N_PEAK) = range(4)
+# step-resolved peaks per retainer plane k at peaks[k * N_PEAK + j]: contact force, bearing
+# load, largest ball load
+PEAKS = Slots("peak")
+P_FR, P_LOAD, P_QMAX = PEAKS.add_each("contact_force", "bearing_load", "ball_load_max")
+N_PEAK = PEAKS.freeze().size
 
 OK, STEP_COLLAPSE, TOO_MANY_STEPS, NOT_FINITE = 0, 1, 2, 3
 SAMPLE_BLOCK = 64       # output samples per block of sample_diagnostics' column-major copies

@@ -1,14 +1,21 @@
 """The drop-down model compiled from a scene: state layout, packed parameters, right-hand side.
 
-Effects are runtime flags in an int array (one compiled, disk-cached kernel serves every scene);
-the state vector holds only the bodies and coordinates the scene enables. Index -1 marks an
-absent coordinate, and the kernel never touches it.
+The model is composed of effects, one module each (:data:`EFFECTS`): each declares the scene keys
+it reads, its named slots in the packed arrays (:mod:`physics.layout`), its states and how its
+parameters pack. :data:`LAYOUT` is built from those declarations at import time, and the
+module-level constants the kernels read (``P_M``, ``U_ICMD`` ...) are assigned from it by name
+(numba compiles them in as constants). Effects are runtime flags in an int array (one compiled,
+disk-cached kernel serves every scene); the state vector holds only the bodies and coordinates
+the scene enables. Index -1 marks an absent coordinate, and the kernel never touches it.
 
 Packed arrays passed to every kernel:
 
 * ``P`` float64 parameters (indices ``P_*``),
 * ``I`` int64 flags and state indices (``F_*`` flags, ``S_*`` rotor indices, per-plane blocks),
 * ``U`` float64 controls that may change between integration segments (``U_*``).
+
+Code above physics reads them by name: :meth:`Model.param`, :meth:`Model.state_index`,
+:meth:`Model.control_index` and the helpers of :class:`Model`.
 """
 from __future__ import annotations
 
@@ -18,72 +25,120 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import amb as amb_mod
-from . import thermal
-from .ball_bearing import (ball_forces, ball_forces_with_dry, bearing_constants, cage_ratio,
+from . import ball_bearing, contact, rotor, sensor, stator, support, thermal
+from .amb import AMB_ACTUATOR, AMB_AXES, AMB_LINEAR, AMB_NONE  # noqa: F401  (re-exported)
+from .ball_bearing import (RB_LINEAR, RB_RIGID, RB_SM, ball_forces, ball_forces_with_dry,  # noqa: F401
                            drag_torque_magnitude, film_thickness)
-from .contact import (contact_potential, friction_force, geometry, hunt_crossley, hysteresis_factor,
-                      line_elastic_force, line_potential, normal_force, smooth_sign)
+from .contact import (FRIC_KINEMATIC, FRIC_NONE, FRIC_PAPER, LAW_HERTZ_LINE,  # noqa: F401
+                      LAW_PAPER, STANDARD_GRAVITY, contact_potential, friction_force, geometry,
+                      hunt_crossley, line_elastic_force, line_potential, normal_force,
+                      smooth_sign)
 from ._jit import njit, njit_borrow
-from .rotor import axis_at, tilt_accelerations, unbalance_force
+from .layout import Layout, StateSizes
+from .rotor import axis_at, rotor_energy, tilt_accelerations, unbalance_load
 from .scene import Scene
 from . import sensor as sensor_mod
-from .stator import damping_coefficient as stator_damping
-from .stator import stator_force, stator_potential
-from .support import housing_force
+from .stator import mount_energy, mount_power, mount_rates, stator_force, stator_potential
+from .support import (body_energy, damper_rate, housing_rates, spin_energy, spring_energy,
+                      support_power)
+
+VELOCITY = 0.1      # m/s: size of translational velocities (a free fall through the gap: 0.077 m/s)
+
+
+class EnergyAudit:
+    """The energy audit (part of every model): the flag and the two quadratures, dissipated
+    energy and work of external / non-potential forces; tolerance size the rotor's kinetic energy
+    at VELOCITY, observation size its spin energy (about all a drop can dissipate: the
+    observations stay within about [-1, 1])."""
+    SCENE_KEYS: tuple[str, ...] = ()
+
+    @staticmethod
+    def declare(layout) -> None:
+        layout.index.add("flag.audit")
+        layout.index.add("state.E_dissipated")
+        layout.index.add("state.W_external")
+
+    @staticmethod
+    def pack(scene, P, I, layout) -> None:
+        I[layout.index["flag.audit"]] = 1
+
+    @staticmethod
+    def states(scene, I, layout, sizes, add) -> None:
+        for name in ("E_dissipated", "W_external"):
+            I[layout.index["state." + name]] = add(name, sizes.energy, sizes.spin_energy)
+
+
+#: the registered effects, in the order their states are laid out (adding an effect: one line)
+EFFECTS = (rotor, contact, ball_bearing, amb_mod, support, EnergyAudit, thermal, stator, sensor)
+#: the packed arrays' named slots, from the effects' declarations
+LAYOUT = Layout.build(EFFECTS)
+_P, _I, _J, _U, _A, _AP = (LAYOUT.params, LAYOUT.index, LAYOUT.plane, LAYOUT.controls,
+                           LAYOUT.aux, LAYOUT.plane_aux)
 
 # ---------------------------------------------------------------------------- parameters P --
-(P_M, P_IP, P_ID, P_G, P_RJ, P_RS, P_CLR,
- P_Z_RB1, P_Z_RB2, P_Z_AMB1, P_Z_AMB2,
- P_MUE, P_UB_PHASE, P_Z_UB,
- P_K_AMB, P_C_AMB, P_AMB_BIAS1, P_AMB_BIAS2,
- P_KC, P_EC, P_CMAX, P_DC, P_MU, P_WL, P_VL,
- P_MS, P_JS,
- P_NB, P_HALF_PLAY, P_KTOT, P_FILM, P_CB, P_KLIN, P_CAGE, P_M0_LOW, P_M0_COEF, P_M1_COEF, P_MSEAL,
- P_KS, P_MH,
- # actuator AMBs (spec §5): k cos(alpha), g_0, i_0, current limit, current/gap cap, PID gains,
- # derivative filter, coil lag, lift-off ramp, gravity feed-forward currents of AMB1/AMB2
- P_AMB_KMAG, P_AMB_G0, P_AMB_I0, P_AMB_ILIM, P_AMB_RMAX, P_AMB_KP, P_AMB_KI, P_AMB_KD, P_AMB_TD,
- P_AMB_TL, P_AMB_RAMP, P_AMB_IFF1, P_AMB_IFF2,
- # semi-active support damper (spec §6): C_min, C_max, lag time constant
- P_CS_MIN, P_CS_MAX, P_CS_TAU, N_P_BASE) = range(57)
-# rotor-stator contact (physics/stator.py): gap, stiffness, damping, friction, rotor radius,
-# threshold speed; hertz_line law (physics/contact.py): pi L E*, Hunt-Crossley factor chi
-(P_ST_GAP, P_ST_K, P_ST_C, P_ST_MU, P_ST_R, P_ST_VL, P_HL_A, P_HL_CHI,
- N_P) = range(N_P_BASE, N_P_BASE + 9)
-
-# sleeve heating (effects.thermal, physics/thermal.py): heat capacity, loss conductance, contact
-# heat partition, relative mu slope, mu ratio floor and ceiling, bearing heat partition
-P_TH_C, P_TH_G, P_TH_A, P_TH_SLOPE, P_TH_RMIN, P_TH_RMAX, P_TH_B, N_P = range(N_P, N_P + 8)
-# stator mount (effects.stator_mount, physics/stator.py): stiffness, damping, mass per AMB plane
-P_STM_K, P_STM_C, P_STM_M, N_P = range(N_P, N_P + 4)
+P_M, P_IP, P_ID, P_G, P_RJ = _P.indices("rotor.mass", "rotor.polar_inertia",
+                                        "rotor.diametral_inertia", "world.gravity",
+                                        "rotor.journal_radius")
+P_Z_RB1, P_Z_RB2, P_Z_AMB1, P_Z_AMB2 = _P.indices("rb1.z", "rb2.z", "amb1.z", "amb2.z")
+P_MUE, P_UB_PHASE, P_Z_UB = _P.indices("unbalance.me", "unbalance.phase", "unbalance.z")
+P_CLR, P_RS, P_KC, P_EC, P_CMAX, P_DC, P_MU, P_WL, P_VL, P_HL_A, P_HL_CHI = _P.indices(
+    "contact.clearance", "sleeve.radius", "contact.stiffness", "contact.exponent",
+    "contact.damping", "contact.damping_depth", "contact.friction", "contact.threshold_speed",
+    "contact.threshold_velocity", "contact.line_coefficient", "contact.hysteresis")
+(P_MS, P_JS, P_NB, P_HALF_PLAY, P_KTOT, P_FILM, P_CB, P_KLIN, P_CAGE, P_M0_LOW, P_M0_COEF,
+ P_M1_COEF, P_MSEAL) = _P.indices(
+    "sleeve.mass", "sleeve.spin_inertia", "bearing.balls", "bearing.half_play",
+    "bearing.stiffness", "bearing.film_coef", "bearing.damping", "bearing.linear_stiffness",
+    "bearing.cage_ratio", "bearing.m0_low", "bearing.m0_coef", "bearing.m1_coef",
+    "bearing.seal_torque")
+P_K_AMB, P_C_AMB, P_AMB_BIAS1, P_AMB_BIAS2 = _P.indices("amb.stiffness", "amb.damping",
+                                                        "amb1.bias", "amb2.bias")
+# actuator AMBs (spec §5): k cos(alpha), g_0, i_0, current limit, current/gap cap, PID gains,
+# derivative filter, coil lag, lift-off ramp, gravity feed-forward currents of AMB1/AMB2
+(P_AMB_KMAG, P_AMB_G0, P_AMB_I0, P_AMB_ILIM, P_AMB_RMAX, P_AMB_KP, P_AMB_KI, P_AMB_KD,
+ P_AMB_TD, P_AMB_TL, P_AMB_RAMP) = _P.indices(*amb_mod.ACTUATOR_PARAMS)
+P_AMB_IFF1, P_AMB_IFF2 = _P.indices("amb1.feedforward_current", "amb2.feedforward_current")
+# support (spec §1) and semi-active damper (spec §6): K_s, housing mass, C_min, C_max, lag
+P_KS, P_MH, P_CS_MIN, P_CS_MAX, P_CS_TAU = _P.indices(
+    "support.stiffness", "support.housing_mass", "support.damping_min", "support.damping_max",
+    "support.damper_time_constant")
+# rotor-stator contact (physics/stator.py) and the stator mount (effects.stator_mount)
+P_ST_GAP, P_ST_K, P_ST_C, P_ST_MU, P_ST_R, P_ST_VL, P_STM_K, P_STM_C, P_STM_M = _P.indices(
+    "stator.gap", "stator.stiffness", "stator.damping", "stator.friction", "stator.rotor_radius",
+    "stator.threshold_velocity", "stator.mount_stiffness", "stator.mount_damping",
+    "stator.mount_mass")
+# sleeve heating (effects.thermal, physics/thermal.py), one block in thermal.PARAM_NAMES order
+P_TH_C, P_TH_G, P_TH_A, P_TH_SLOPE, P_TH_RMIN, P_TH_RMAX, P_TH_B = _P.indices(*thermal.PARAM_NAMES)
 # position sensing (scene group sensor, physics/sensor.py): delay tau
-P_SENS_TAU, N_P = N_P, N_P + 1
+P_SENS_TAU = _P["sensor.delay"]
+N_P = _P.size
 
 # ------------------------------------------------------------------- flags and indices I --
-(F_GRAV, F_UNB, F_GYRO, F_AMB, F_RB, F_FILM, F_BFRIC, F_HOUSING, F_SLEEVE_J, F_FRIC, F_AUDIT,
- S_X, S_Y, S_A, S_B, S_VX, S_VY, S_VA, S_VB, S_W, S_PHI, S_EDISS, S_WEXT, I_PLANES) = range(24)
+F_GRAV, F_UNB, F_GYRO, F_AMB, F_RB, F_FILM, F_BFRIC, F_HOUSING, F_SLEEVE_J, F_FRIC, F_AUDIT = (
+    _I.indices("flag.gravity", "flag.unbalance", "flag.gyroscopic", "flag.amb",
+               "flag.retainer_bearing", "flag.ehl_film", "flag.bearing_friction", "flag.housing",
+               "flag.sleeve_inertia", "flag.friction", "flag.audit"))
+# flags: rotor-stator contact on/off, rotor-sleeve contact law (LAW_*), position sensing (on
+# when sensor.delay or sensor.noise > 0)
+F_STATOR, F_LAW, F_SENSOR = _I.indices("flag.stator", "flag.law", "flag.sensor")
+S_X, S_Y, S_A, S_B, S_VX, S_VY, S_VA, S_VB, S_W, S_PHI = _I.indices(
+    *("state." + n for n in rotor.STATE_NAMES + ("phi",)))
+S_EDISS, S_WEXT = _I.indices("state.E_dissipated", "state.W_external")
 # per retainer plane k, the block I[I_PLANES + k*N_PLANE_IDX + j]:
-(J_SX, J_SY, J_SVX, J_SVY, J_TH, J_WS, J_HX, J_HY, J_HVX, J_HVY, N_PLANE_IDX) = range(11)
-N_I_CORE = I_PLANES + 2 * N_PLANE_IDX
-# appended blocks (first state index, -1 when absent): actuator PID integrals, derivative-filter
-# states and coil currents (4 axes each: AMB1 x, AMB1 y, AMB2 x, AMB2 y), damper C_s (2 housings)
-I_AMB_INT, I_AMB_FILT, I_AMB_COIL, I_CS, N_I_BASE = range(N_I_CORE, N_I_CORE + 5)
-# flags: rotor-stator contact on/off, rotor-sleeve contact law (LAW_*)
-F_STATOR, F_LAW, N_I = range(N_I_BASE, N_I_BASE + 3)
-# sleeve temperatures of RB1 and RB2, then the heat audit's heat_lost and friction_work
-# (thermal.STATE_NAMES; -1 when effects.thermal is off)
-I_THERM, N_I = N_I, N_I + 1
-# stator on its mount: x, y, vx, vy of AMB1's stator, then AMB2's (-1 without effects.stator_mount)
-I_STM, N_I = N_I, N_I + 1
-# position sensing (physics/sensor.py): on when sensor.delay or sensor.noise > 0; the Pade delay
-# states q1, q2 of AMB1 x, AMB1 y, AMB2 x, AMB2 y (-1 without sensor.delay)
-F_SENSOR, I_SENS, N_I = N_I, N_I + 1, N_I + 2
-AMB_AXES = ("AMB1.x", "AMB1.y", "AMB2.x", "AMB2.y")
-
-AMB_NONE, AMB_LINEAR, AMB_ACTUATOR = 0, 1, 2
-RB_RIGID, RB_LINEAR, RB_SM = 0, 1, 2
-FRIC_NONE, FRIC_PAPER, FRIC_KINEMATIC = 0, 1, 2
-LAW_PAPER, LAW_HERTZ_LINE = 0, 1
+I_PLANES = _I["planes"]
+J_SX, J_SY, J_SVX, J_SVY, J_TH, J_WS = _J.indices(*ball_bearing.PLANE_STATES)
+J_HX, J_HY, J_HVX, J_HVY = _J.indices(*support.PLANE_STATES)
+N_PLANE_IDX = _J.size
+# first state of a block (-1 when absent): actuator PID integrals, derivative-filter states and
+# coil currents (4 axes each: AMB_AXES), damper C_s (2 housings), sleeve temperatures of RB1 and
+# RB2 then the heat audit's heat_lost and friction_work (thermal.STATE_NAMES), the stators on
+# their mounts (x, y, vx, vy of AMB1's, then AMB2's), the Pade delay states q1, q2 of AMB1 x,
+# AMB1 y, AMB2 x, AMB2 y (physics/sensor.py)
+I_AMB_INT, I_AMB_FILT, I_AMB_COIL, I_CS, I_THERM, I_STM, I_SENS = _I.indices(
+    "state.amb_integral", "state.amb_filter", "state.amb_current", "state.damper",
+    "state.thermal", "state.stator_mount", "state.sensor")
+N_I = _I.size
+MOUNT_STRIDE = len(stator.MOUNT_STATES)      # the stator-mount states of one AMB plane
 
 # ------------------------------------------------------------------------- controls U --
 # U_AMB_POWER > 0: the AMBs run under their built-in controller (linear law or PID);
@@ -96,26 +151,29 @@ LAW_PAPER, LAW_HERTZ_LINE = 0, 1
 # (:func:`orbit_offset`) and scales the three PID gains by U_AMB_GAIN (1 = the scene's gains).
 # With position sensing (I[F_SENSOR]) U_SENS_NOISE + j is the noise sample [m] of AMB axis j
 # (AMB_AXES) that the sensed displacement carries until the next sample (physics/sensor.py).
-(U_AMB_POWER, U_CS1, U_CS2, U_AMB_DIRECT, U_ICMD, U_T_ON, U_REF0, U_REF_OFF, U_AMB_GAIN,
- U_SENS_NOISE, N_U) = 0, 1, 2, 3, 4, 8, 9, 13, 17, 18, 22
+U_AMB_POWER, U_AMB_DIRECT, U_ICMD, U_T_ON, U_REF0, U_REF_OFF, U_AMB_GAIN = _U.indices(
+    "amb.power", "amb.direct", "amb.current_command", "amb.t_on", "amb.reference0",
+    "amb.reference_offset", "amb.gain")
+U_CS1, U_CS2 = _U.indices("rb1.support_damping", "rb2.support_damping")
+U_SENS_NOISE = _U["sensor.noise"]
+N_U = _U.size
 
 # ------------------------------------------------------------------- diagnostics aux --
-# per plane k at aux[k*N_AUX_PLANE + j]; A_P* are the powers [W] each dissipative element takes
-# out of the mechanical energy (physics/dissipation.py checks each is >= 0): contact friction,
-# contact normal damping, ball-bearing dashpot, bearing drag, support dashpot
+# per plane k at aux[k*N_AUX_PLANE + j] (contact.PLANE_DIAGNOSTICS); A_P* are the powers [W]
+# each dissipative element takes out of the mechanical energy (physics/dissipation.py checks
+# each is >= 0): contact friction, contact normal damping, ball-bearing dashpot, bearing drag,
+# support dashpot
 (A_FR, A_FMU, A_DELTA, A_LOAD, A_WS, A_DRAG, A_PFRIC, A_QMAX, A_PCDAMP, A_PBDAMP, A_PDRAG,
- A_PSUPPORT, N_AUX_PLANE) = range(13)
+ A_PSUPPORT) = _AP.indices(*contact.PLANE_DIAGNOSTICS)
+N_AUX_PLANE = _AP.size
 # then per AMB plane k: the stator's normal force at aux[A_STATOR + k] (zero without stator
-# contact), the stator contact's dashpot and friction powers at A_ST_PDAMP + k, A_ST_PFRIC + k
-A_STATOR = 2 * N_AUX_PLANE
-A_ST_PDAMP = A_STATOR + 2
-A_ST_PFRIC = A_STATOR + 4
-A_ST_PMOUNT = A_STATOR + 6               # ... and its mount's dashpot (effects.stator_mount)
-N_AUX = A_STATOR + 8
+# contact), the stator contact's dashpot and friction powers at A_ST_PDAMP + k, A_ST_PFRIC + k,
+# and its mount's dashpot (effects.stator_mount) at A_ST_PMOUNT + k
+A_STATOR, A_ST_PDAMP, A_ST_PFRIC, A_ST_PMOUNT = _A.indices(
+    "stator.normal_force", "stator.damping_power", "stator.friction_power", "stator.mount_power")
+N_AUX = _A.size
 
 PLANES = ("RB1", "RB2")
-STANDARD_GRAVITY = 9.80665  # m/s^2: sets the hertz_line reference impact speed sqrt(2 g c)
-VELOCITY = 0.1      # m/s: size of translational velocities (a free fall through the gap: 0.077 m/s)
 
 
 @dataclass(frozen=True)
@@ -123,7 +181,10 @@ class Model:
     """A scene compiled for the kernels. ``names[i]`` names state i; ``scale[i]`` its size for
     the integrator's absolute tolerance (rtol x scale) and ``obs_scale[i]`` its physical size for
     observations (``full_state``): equal except where the tolerance is deliberately tighter
-    (tilt rates, housing, energy-audit quadratures; see :func:`build_model`)."""
+    (tilt rates, housing, energy-audit quadratures; see :func:`build_model`).
+
+    Code above physics reads the packed arrays by name: :meth:`state_index`, :meth:`param`,
+    :meth:`param_index`, :meth:`control_index`, :meth:`flag`, and the helpers below."""
     scene: Scene
     P: np.ndarray
     I: np.ndarray
@@ -135,8 +196,74 @@ class Model:
     def n_state(self) -> int:
         return len(self.names)
 
+    @property
+    def layout(self) -> Layout:
+        """The packed arrays' named slots (the same for every model)."""
+        return LAYOUT
+
     def index(self, name: str) -> int:
         return self.names.index(name)
+
+    def state_index(self, name: str) -> int:
+        """Index of state ``name`` (``model.names``) in the state vector; KeyError naming it
+        when this model has no such state (its effect is off, or the name is wrong)."""
+        try:
+            return self.names.index(name)
+        except ValueError:
+            raise KeyError(f"unknown state {name!r}: this model's states are "
+                           + ", ".join(self.names)) from None
+
+    def has_state(self, name: str) -> bool:
+        return name in self.names
+
+    def param_index(self, name: str) -> int:
+        """Index of parameter ``name`` in ``P`` (``physics.model.LAYOUT.params``); KeyError
+        naming it when there is no such parameter."""
+        return LAYOUT.params[name]
+
+    def param(self, name: str) -> float:
+        """The packed value of parameter ``name`` (SI units)."""
+        return float(self.P[LAYOUT.params[name]])
+
+    def control_index(self, name: str) -> int:
+        """First index of control ``name`` in ``U`` (``physics.model.LAYOUT.controls``)."""
+        return LAYOUT.controls[name]
+
+    def flag(self, name: str) -> int:
+        """The runtime flag ``name`` (``"amb"``, ``"retainer_bearing"`` ...: ``flag.<name>``
+        of ``physics.model.LAYOUT.index``)."""
+        return int(self.I[LAYOUT.index["flag." + name]])
+
+    @property
+    def has_ball_bearing(self) -> bool:
+        """The retainer bearings are Sopanen-Mikkola ball bearings."""
+        return self.flag("retainer_bearing") == RB_SM
+
+    @property
+    def has_ambs(self) -> bool:
+        """The scene has AMBs (``effects.amb`` is not ``none``)."""
+        return self.flag("amb") != AMB_NONE
+
+    @property
+    def sizes(self) -> dict[str, int]:
+        """Lengths of the packed arrays a kernel caller allocates: ``P``, ``I``, ``U``, ``aux``."""
+        return {"P": N_P, "I": N_I, "U": N_U, "aux": N_AUX}
+
+    def retainer_z(self) -> tuple[float, float]:
+        """Axial stations of the retainer planes RB1, RB2 [m]."""
+        return self.param("rb1.z"), self.param("rb2.z")
+
+    def amb_z(self) -> tuple[float, float]:
+        """Axial stations of the AMB (sensor) planes AMB1, AMB2 [m]."""
+        return self.param("amb1.z"), self.param("amb2.z")
+
+    def sensor_positions(self, y: np.ndarray) -> np.ndarray:
+        """(4,) x1, y1, x2, y2 [m]: the rotor axis at the AMB (sensor) planes in state ``y``."""
+        return np.array([v for z in self.amb_z() for v in axis_motion(y, self.I, z)[:2]])
+
+    def rotor_axis_indices(self) -> np.ndarray:
+        """State indices of the rotor's centre and tilt: x, y, a, b."""
+        return np.array([self.state_index(n) for n in ("x", "y", "a", "b")])
 
     def controls(self, amb_power: bool) -> np.ndarray:
         """The control vector for a segment: AMB power and the support damping of each housing."""
@@ -148,8 +275,10 @@ class Model:
 
 
 def build_model(scene: Scene) -> Model:
-    """Compile a scene: pack parameters, lay out only the enabled states."""
-    s, fx = scene, scene.effects
+    """Compile a scene: each effect packs its parameters and flags, then lays out its states
+    (only the enabled ones): the rotor's, each retainer plane's (sleeve, housing), then the other
+    effects' in :data:`EFFECTS` order."""
+    s = scene
     P = np.zeros(N_P)
     I = np.full(N_I, -1, dtype=np.int64)
     names: list[str] = []
@@ -165,150 +294,22 @@ def build_model(scene: Scene) -> Model:
         obs_scale.append(size if obs is None else obs)
         return len(names) - 1
 
-    # flags
-    I[F_GRAV] = fx.gravity
-    I[F_UNB] = fx.unbalance and s.unbalance.mass * s.unbalance.radius > 0.0
-    I[F_GYRO] = fx.gyroscopic
-    I[F_AMB] = {"none": AMB_NONE, "linear": AMB_LINEAR, "actuator": AMB_ACTUATOR}[fx.amb]
-    I[F_RB] = {"rigid": RB_RIGID, "linear": RB_LINEAR, "sopanen_mikkola": RB_SM}[fx.retainer_bearing]
-    I[F_FILM] = fx.ehl_film and fx.retainer_bearing == "sopanen_mikkola"
-    I[F_BFRIC] = fx.bearing_friction
-    I[F_HOUSING] = fx.housing
-    I[F_SLEEVE_J] = fx.sleeve_inertia
-    I[F_FRIC] = {"none": FRIC_NONE, "paper": FRIC_PAPER, "kinematic": FRIC_KINEMATIC}[fx.friction]
-    I[F_AUDIT] = 1
-    I[F_STATOR] = fx.stator_contact
-    I[F_LAW] = {"paper": LAW_PAPER, "hertz_line": LAW_HERTZ_LINE}[s.contact.law]
-
-    # rotor states (positions, then velocities). Observation sizes are physical: the clearance,
-    # VELOCITY, and for tilt rates VELOCITY over the lever arm to the farther retainer plane
-    # (0.1 m/s / 0.38 m = 0.26 rad/s). Where a tolerance size is tighter (tilt rates, housing,
-    # energy audit) it is kept as it is: it sets the step sizes.
+    for effect in EFFECTS:
+        effect.pack(s, P, I, LAYOUT)
     lever = max(abs(s.positions.rb1), abs(s.positions.rb2), 1e-3)
-    tilt, spin = c / lever, max(omega0, 100.0)
-    for key, name, size, obs in ((S_X, "x", c, None), (S_Y, "y", c, None), (S_A, "a", tilt, None),
-                                 (S_B, "b", tilt, None), (S_VX, "vx", VELOCITY, None),
-                                 (S_VY, "vy", VELOCITY, None),
-                                 (S_VA, "va", 0.1 * tilt, VELOCITY / lever),
-                                 (S_VB, "vb", 0.1 * tilt, VELOCITY / lever),
-                                 (S_W, "Omega", spin, None)):
-        I[key] = add(name, size, obs)
-    if I[F_UNB]:
-        I[S_PHI] = add("phi", math.pi)
-    has_sleeve_xy = fx.retainer_bearing != "rigid"
+    spin = max(omega0, 100.0)
+    sizes = StateSizes(clearance=c, tilt=c / lever, spin=spin, velocity=VELOCITY, lever=lever,
+                       energy=0.5 * s.rotor.mass * VELOCITY ** 2,
+                       spin_energy=0.5 * s.rotor.polar_inertia * spin ** 2)
+    rotor.states(s, I, LAYOUT, sizes, add)
     for k, plane in enumerate(PLANES):
-        base = I_PLANES + k * N_PLANE_IDX
-        if has_sleeve_xy:
-            for j, n, sz in ((J_SX, "sx", c), (J_SY, "sy", c), (J_SVX, "svx", VELOCITY),
-                             (J_SVY, "svy", VELOCITY)):
-                I[base + j] = add(f"{plane}.{n}", sz)
-        if fx.retainer_bearing == "sopanen_mikkola":
-            I[base + J_TH] = add(f"{plane}.theta", math.pi)
-        if fx.sleeve_inertia:
-            I[base + J_WS] = add(f"{plane}.omega_s", spin)
-        if fx.housing:
-            for j, n, sz, obs in ((J_HX, "hx", 0.1 * c, c), (J_HY, "hy", 0.1 * c, c),
-                                  (J_HVX, "hvx", 0.01, VELOCITY), (J_HVY, "hvy", 0.01, VELOCITY)):
-                I[base + j] = add(f"{plane}.{n}", sz, obs)
-    if fx.amb == "actuator":            # PID and coil states per AMB axis (spec §5)
-        I[I_AMB_INT] = len(names)
-        for ax in AMB_AXES:
-            add(f"{ax}.integral", 0.01 * c)
-        I[I_AMB_FILT] = len(names)
-        for ax in AMB_AXES:
-            add(f"{ax}.filter", c)
-        if s.amb.coil_time_constant > 0.0:
-            I[I_AMB_COIL] = len(names)
-            for ax in AMB_AXES:
-                add(f"{ax}.current", max(s.amb.current_limit, 1e-3))
-    if fx.semi_active_damper:           # damper C_s of each housing (spec §6)
-        I[I_CS] = len(names)
-        for plane in PLANES:
-            add(f"{plane}.Cs", s.support.damping_max)
-    # energy-audit quadratures: dissipated energy and work of external / non-potential forces;
-    # tolerance size the rotor's kinetic energy at VELOCITY, observation size its spin energy
-    # (about all a drop can dissipate: the observations stay within about [-1, 1])
-    e_scale = 0.5 * s.rotor.mass * VELOCITY ** 2
-    e_spin = 0.5 * s.rotor.polar_inertia * spin ** 2
-    I[S_EDISS] = add("E_dissipated", e_scale, e_spin)
-    I[S_WEXT] = add("W_external", e_scale, e_spin)
-    if fx.thermal:
-        I[I_THERM] = len(names)
-        for name in thermal.STATE_NAMES:
-            if name.endswith("temperature"):
-                add(name, thermal.TEMPERATURE_SIZE, thermal.TEMPERATURE_OBS)
-            else:
-                add(name, e_scale, e_spin)
-    if fx.stator_contact and fx.stator_mount:
-        I[I_STM] = len(names)
-        for plane in ("AMB1", "AMB2"):
-            for n, sz, obs in (("x", 0.1 * c, c), ("y", 0.1 * c, c), ("vx", 0.01, VELOCITY),
-                               ("vy", 0.01, VELOCITY)):
-                add(f"{plane}.stator_{n}", sz, obs)
-    I[F_SENSOR] = s.sensor.delay > 0.0 or s.sensor.noise > 0.0
-    if s.sensor.delay > 0.0:            # Pade delay states q1, q2 per AMB axis (physics/sensor.py)
-        I[I_SENS] = len(names)
-        for ax in AMB_AXES:
-            add(f"{ax}.sensor_q1", c)
-            add(f"{ax}.sensor_q2", c)
-    P[P_SENS_TAU] = s.sensor.delay
-
-    # parameters
-    g = s.world.gravity if fx.gravity else 0.0
-    P[P_M], P[P_IP], P[P_ID], P[P_G] = s.rotor.mass, s.rotor.polar_inertia, s.rotor.diametral_inertia, g
-    P[P_RJ], P[P_CLR] = s.rotor.journal_radius, c
-    P[P_RS] = s.rotor.journal_radius + c
-    P[P_Z_RB1], P[P_Z_RB2] = s.positions.rb1, s.positions.rb2
-    P[P_Z_AMB1], P[P_Z_AMB2] = s.positions.amb1, s.positions.amb2
-    P[P_MUE] = s.unbalance.mass * s.unbalance.radius
-    P[P_UB_PHASE] = math.radians(s.unbalance.angle_deg)
-    P[P_Z_UB] = s.unbalance.z
-    P[P_K_AMB], P[P_C_AMB] = s.amb.stiffness, s.amb.damping
-    P[P_AMB_BIAS1], P[P_AMB_BIAS2] = amb_mod.weight_shares(s.rotor.mass * g, s.positions.amb1,
-                                                           s.positions.amb2)
-    P[P_KC], P[P_EC], P[P_CMAX], P[P_DC] = (s.contact.stiffness, s.contact.exponent,
-                                            s.contact.damping, s.contact.damping_depth)
-    P[P_MU] = s.contact.friction
-    P[P_WL] = s.contact.threshold_rpm * math.pi / 30.0
-    P[P_VL] = P[P_WL] * s.rotor.journal_radius
-    P[P_MS], P[P_JS] = s.sleeve.mass, s.sleeve.spin_inertia
-    b = s.bearing
-    # film reference load (spec §4: Q_n = 5 x static bearing load / z)
-    bc = bearing_constants(b, amb_mod.static_weight_share(s))
-    P[P_NB], P[P_HALF_PLAY], P[P_KTOT], P[P_FILM] = b.balls, b.clearance / 2.0, bc.K_tot, bc.film_coef
-    P[P_CB], P[P_KLIN], P[P_CAGE] = b.damping, b.linear_stiffness, cage_ratio(b)
-    P[P_M0_LOW], P[P_M0_COEF], P[P_M1_COEF], P[P_MSEAL] = bc.m0_low, bc.m0_coef, bc.m1_coef, b.seal_torque
-    P[P_KS] = s.support.stiffness
-    P[P_MH] = s.support.housing_mass + (0.0 if has_sleeve_xy else s.sleeve.mass)
-    if fx.amb == "actuator":
-        a = s.amb
-        ac = amb_mod.actuator_constants(a, P[P_AMB_BIAS1], P[P_AMB_BIAS2])
-        P[P_AMB_KMAG], P[P_AMB_G0], P[P_AMB_I0] = ac.force_constant, a.air_gap, a.bias_current
-        P[P_AMB_ILIM], P[P_AMB_RMAX] = a.current_limit, ac.ratio_max
-        P[P_AMB_KP], P[P_AMB_KI], P[P_AMB_KD], P[P_AMB_TD] = a.kp, a.ki, a.kd, a.derivative_filter
-        P[P_AMB_TL], P[P_AMB_RAMP] = a.coil_time_constant, a.liftoff_ramp_time
-        P[P_AMB_IFF1], P[P_AMB_IFF2] = ac.feedforward
-    P[P_CS_MIN], P[P_CS_MAX] = s.support.damping_min, s.support.damping_max
-    P[P_CS_TAU] = s.support.damper_time_constant
-    if fx.thermal:
-        P[P_TH_C:P_TH_B + 1] = thermal.parameters(s)
-    _pack_contact_extensions(s, P)
+        for effect in EFFECTS:
+            if hasattr(effect, "plane_states"):
+                effect.plane_states(s, I, I_PLANES + k * N_PLANE_IDX, LAYOUT, sizes, plane, add)
+    for effect in EFFECTS:
+        if effect is not rotor and hasattr(effect, "states"):
+            effect.states(s, I, LAYOUT, sizes, add)
     return Model(scene, P, I, tuple(names), np.asarray(scale), np.asarray(obs_scale))
-
-
-def _pack_contact_extensions(s: Scene, P: np.ndarray) -> None:
-    """Parameters of the stator contact and the hertz_line law (docs/physics.md)."""
-    st = s.stator
-    share = abs(amb_mod.weight_shares(s.rotor.mass, s.positions.amb1, s.positions.amb2)[0])
-    P[P_ST_GAP], P[P_ST_K], P[P_ST_MU], P[P_ST_R] = s.amb.air_gap, st.stiffness, st.friction, st.rotor_radius
-    P[P_ST_C] = stator_damping(st.stiffness, max(share, 1e-3), st.restitution)
-    P[P_ST_VL] = s.contact.threshold_rpm * math.pi / 30.0 * st.rotor_radius
-    b, c = s.bearing, s.contact
-    e_star = b.youngs_modulus / (2.0 * (1.0 - b.poisson ** 2))     # steel journal in a steel sleeve
-    P[P_HL_A] = math.pi * c.length * e_star
-    P[P_HL_CHI] = hysteresis_factor(c.restitution, math.sqrt(2.0 * STANDARD_GRAVITY * c.clearance))
-    P[P_STM_K], P[P_STM_M] = st.mount_stiffness, st.mount_mass
-    P[P_STM_C] = 2.0 * st.mount_damping_ratio * math.sqrt(st.mount_stiffness * st.mount_mass)
 
 
 # ------------------------------------------------------------------------------- kernels --
@@ -326,7 +327,7 @@ def stator_motion(y, I, k):
     i = I[I_STM]
     if i < 0:
         return 0.0, 0.0, 0.0, 0.0
-    i += 4 * k
+    i += MOUNT_STRIDE * k
     return y[i], y[i + 1], y[i + 2], y[i + 3]
 
 
@@ -400,16 +401,16 @@ def rhs(t, y, P, I, U, dy, aux):
     p_diss = 0.0        # power dissipated by dampers, friction and drag
     p_ext = 0.0         # power of external and non-potential forces (unbalance, AMB, film, cage)
 
-    # unbalance
+    # unbalance (physics/rotor.py)
     if dy is not None and I[F_UNB]:
         iphi = I[S_PHI]
-        ux, uy = unbalance_force(P[P_MUE], W, y[iphi] + P[P_UB_PHASE])
-        z = P[P_Z_UB]
+        ux, uy, mx, my, p = unbalance_load(P[P_MUE], W, y[iphi], P[P_UB_PHASE], P[P_Z_UB],
+                                           vx, vy, va, vb)
         Fx += ux
         Fy += uy
-        Ma += z * ux
-        Mb += z * uy
-        p_ext += ux * (vx + z * va) + uy * (vy + z * vb)
+        Ma += mx
+        Mb += my
+        p_ext += p
         dy[iphi] = W
 
     # AMBs (hold the rotor until the fault)
@@ -438,7 +439,7 @@ def rhs(t, y, P, I, U, dy, aux):
                     j = 2 * k + a
                     d = dyy if a == 1 else dx
                     i_int, i_q = I[I_AMB_INT] + j, I[I_AMB_FILT] + j
-                    i_cmd, e, de_int = _actuator_command(
+                    i_cmd, e, de_int = amb_mod.actuator_command(
                         t, sy if a == 1 else sx, y[i_int], y[i_q], U[U_AMB_DIRECT],
                         U[U_AMB_POWER], U[U_ICMD + j],
                         U[U_T_ON], U[U_REF0 + j], oy if a == 1 else ox, P[P_AMB_ILIM],
@@ -470,9 +471,7 @@ def rhs(t, y, P, I, U, dy, aux):
         tau = P[P_SENS_TAU]
         for k in range(2):
             dx, dyy, _, _ = axis_motion(y, I, P[P_Z_AMB1 + k])
-            i = i_sens + sensor_mod.STATES_PER_PLANE * k
-            dy[i], dy[i + 1] = sensor_mod.pade_rates(dx, y[i], y[i + 1], tau)
-            dy[i + 2], dy[i + 3] = sensor_mod.pade_rates(dyy, y[i + 2], y[i + 3], tau)
+            sensor_mod.delay_rates(dx, dyy, y, i_sens + sensor_mod.STATES_PER_PLANE * k, tau, dy)
 
     # retainer planes: rotor-sleeve contact, sleeve on ball bearing, housing
     twin = False
@@ -623,30 +622,25 @@ def rhs(t, y, P, I, U, dy, aux):
             dy[I[base + J_SVX]] = (cfx + bfx) / ms
             dy[I[base + J_SVY]] = (cfy + bfy) / ms - g
         # --- housing ---
+        # --- housing (physics/support.py) ---
         p_support = 0.0                          # power of the support dashpot C_s
         if i_hx >= 0:
             cs = U[U_CS1 + k]
             if I[I_CS] >= 0:                     # semi-active damper lags its command (spec §6)
                 cs = y[I[I_CS] + k]
-            p_support = cs * (hvx * hvx + hvy * hvy)
+            p_support = support_power(hvx, hvy, cs)
             p_diss += p_support
         if dy is not None and i_hx >= 0:
             if I[I_CS] >= 0:
-                # the clamp is needed: U is a public input, and even the env's command
-                # C_min + frac (C_max - C_min) can exceed C_max by one ulp at frac = 1
-                i_cs = I[I_CS] + k
-                dy[i_cs] = (amb_mod.clamp(U[U_CS1 + k], P[P_CS_MIN], P[P_CS_MAX]) - cs) / P[P_CS_TAU]
-            gx, gy = housing_force(hx, hy, hvx, hvy, P[P_KS], cs)
+                dy[I[I_CS] + k] = damper_rate(U[U_CS1 + k], cs, P[P_CS_MIN], P[P_CS_MAX],
+                                              P[P_CS_TAU])
             if i_sx >= 0:                        # reaction of the bearing
-                gx -= bfx
-                gy -= bfy
+                rx, ry = -bfx, -bfy
             else:                                # sleeve in the housing: contact acts directly
-                gx += cfx
-                gy += cfy
-            dy[i_hx] = hvx
-            dy[i_hx + 1] = hvy
-            dy[I[base + J_HVX]] = gx / P[P_MH]
-            dy[I[base + J_HVY]] = gy / P[P_MH] - g
+                rx, ry = cfx, cfy
+            i_hvx = I[base + J_HVX]
+            dy[i_hx], dy[i_hx + 1], dy[i_hvx], dy[i_hvx + 1] = housing_rates(
+                hx, hy, hvx, hvy, P[P_KS], cs, rx, ry, P[P_MH], g)
 
         o = k * N_AUX_PLANE
         aux[o + A_FR] = f_r
@@ -664,18 +658,8 @@ def rhs(t, y, P, I, U, dy, aux):
 
     i_heat = I[I_THERM]
     if dy is not None and i_heat >= 0:           # effects.thermal: sleeve heating, heat audit
-        q_lost = 0.0
-        w_fric = 0.0
-        for k in range(2):
-            o = k * N_AUX_PLANE
-            p = aux[o + A_PFRIC]
-            d = aux[o + A_PDRAG]                 # bearing friction power M omega_s
-            dy[i_heat + k], q = thermal.heat_rates(p, d, y[i_heat + k], P[P_TH_C], P[P_TH_G],
-                                                   P[P_TH_A], P[P_TH_B])
-            q_lost += q
-            w_fric += p + d
-        dy[i_heat + 2] = q_lost
-        dy[i_heat + 3] = w_fric
+        thermal.rates(y, dy, i_heat, aux[A_PFRIC], aux[A_PDRAG], aux[N_AUX_PLANE + A_PFRIC],
+                      aux[N_AUX_PLANE + A_PDRAG], P[P_TH_C], P[P_TH_G], P[P_TH_A], P[P_TH_B])
     if I[F_STATOR]:                              # rotor-stator contact at the AMB planes
         for k in range(2):
             z = P[P_Z_AMB1 + k]
@@ -687,14 +671,12 @@ def rhs(t, y, P, I, U, dy, aux):
             p_mount = 0.0
             i_q = I[I_STM]
             if i_q >= 0:                         # the stator on its mount takes the reaction
-                i_q += 4 * k
-                p_mount = P[P_STM_C] * (qvx * qvx + qvy * qvy)
+                i_q += MOUNT_STRIDE * k
+                p_mount = mount_power(qvx, qvy, P[P_STM_C])
                 p_diss += p_mount
                 if dy is not None:
-                    dy[i_q] = qvx
-                    dy[i_q + 1] = qvy
-                    dy[i_q + 2] = (-sfx - P[P_STM_K] * qx - P[P_STM_C] * qvx) / P[P_STM_M]
-                    dy[i_q + 3] = (-sfy - P[P_STM_K] * qy - P[P_STM_C] * qvy) / P[P_STM_M]
+                    dy[i_q], dy[i_q + 1], dy[i_q + 2], dy[i_q + 3] = mount_rates(
+                        sfx, sfy, qx, qy, qvx, qvy, P[P_STM_K], P[P_STM_C], P[P_STM_M])
             Fx += sfx
             Fy += sfy
             Ma += z * sfx
@@ -750,33 +732,6 @@ def twin_planes(y, P, I):
     return i < 0 or _same(y[i], y[i + 1])
 
 
-@njit
-def _actuator_command(t, d, z_int, q, u_direct, u_power, u_icmd, t_on, ref0, offset, lim, ramp,
-                      i_ff, kp, ki, kd, td):
-    """Commanded control current of one actuator axis, its error e and integral rate (spec §5).
-
-    ``d``: displacement at the axis; ``z_int``, ``q``: its PID integral and derivative-filter
-    states; ``u_*``, ``t_on``, ``ref0``: its controls (``U_AMB_DIRECT``, ``U_AMB_POWER``,
-    ``U_ICMD + j``, ``U_T_ON``, ``U_REF0 + j``, ``U_REF_OFF + j``); the rest its parameters
-    (``P_AMB_*``, the gains already scaled by ``U_AMB_GAIN``; ``i_ff`` the gravity feed-forward
-    current, zero on x axes). Scalars only, so that ``rhs`` inlines it.
-
-    Direct mode: ``u_icmd`` clipped to the current limit (U is a public input). PID mode:
-    feed-forward minus PID of e = d - ramped reference, with conditional-integration anti-windup
-    (the integral stops while the current is saturated and the error would saturate it further).
-    Off: zero.
-    """
-    if u_direct > 0.0:
-        return amb_mod.clamp(u_icmd, -lim, lim), 0.0, 0.0
-    if u_power <= 0.0:
-        return 0.0, 0.0, 0.0
-    e = d - amb_mod.ramp_reference(t, t_on, ref0, ramp) - offset
-    raw = amb_mod.pid_current(e, z_int, q, kp, ki, kd, td, i_ff)
-    if (raw > lim and e < 0.0) or (raw < -lim and e > 0.0):
-        return (lim if raw > lim else -lim), e, 0.0
-    return amb_mod.clamp(raw, -lim, lim), e, e
-
-
 #: the orbit frame's unit vectors are regularised within this fraction of the clearance of the
 #: centre (an offset fades out there instead of jumping with the direction of a tiny orbit)
 ORBIT_FRAME_CORE = 0.05
@@ -809,7 +764,7 @@ def amb_currents(t, y, P, I, U, out):
             dx, dyy, _, _ = sensed_motion(y, P, I, U, k, dx, dyy, ddx, ddy)
         ox, oy = orbit_offset(dx, dyy, U[U_REF_OFF + 2 * k], U[U_REF_OFF + 2 * k + 1], y[I[S_W]],
                               P[P_CLR])
-        out[j] = _actuator_command(
+        out[j] = amb_mod.actuator_command(
             t, dyy if j % 2 == 1 else dx, y[I[I_AMB_INT] + j], y[I[I_AMB_FILT] + j],
             U[U_AMB_DIRECT], U[U_AMB_POWER], U[U_ICMD + j], U[U_T_ON], U[U_REF0 + j],
             oy if j % 2 == 1 else ox, P[P_AMB_ILIM], P[P_AMB_RAMP],
@@ -826,7 +781,7 @@ def mechanical_energy(y, P, I):
     yy = y[I[S_Y]]
     vx, vy, va, vb = y[I[S_VX]], y[I[S_VY]], y[I[S_VA]], y[I[S_VB]]
     W = y[I[S_W]]
-    E = 0.5 * m * (vx * vx + vy * vy) + 0.5 * P[P_ID] * (va * va + vb * vb) + 0.5 * P[P_IP] * W * W
+    E = rotor_energy(m, P[P_ID], P[P_IP], vx, vy, va, vb, W)
     E += m * g * yy
     for k in range(2):
         base = I_PLANES + k * N_PLANE_IDX
@@ -834,14 +789,14 @@ def mechanical_energy(y, P, I):
         hx, hy, hvx, hvy = housing_motion(y, I, k)
         sx, sy, svx, svy = sleeve_motion(y, I, k)
         if I[base + J_HX] >= 0:
-            E += 0.5 * P[P_MH] * (hvx * hvx + hvy * hvy) + P[P_MH] * g * hy
-            E += 0.5 * P[P_KS] * (hx * hx + hy * hy)
+            E += body_energy(P[P_MH], hvx, hvy, g, hy)
+            E += spring_energy(P[P_KS], hx, hy)
         if I[base + J_SX] >= 0:
-            E += 0.5 * P[P_MS] * (svx * svx + svy * svy) + P[P_MS] * g * sy
+            E += body_energy(P[P_MS], svx, svy, g, sy)
         i_ws = I[base + J_WS]
         ws = y[i_ws] if i_ws >= 0 else 0.0
         if i_ws >= 0:
-            E += 0.5 * P[P_JS] * ws * ws
+            E += spin_energy(P[P_JS], ws)
         er, _, _ = geometry(px - sx, py - sy)
         if I[F_LAW] == LAW_PAPER:
             E += contact_potential(er - P[P_CLR], P[P_KC], P[P_EC])
@@ -851,7 +806,7 @@ def mechanical_energy(y, P, I):
             ax, ay, _, _ = axis_motion(y, I, P[P_Z_AMB1 + k])
             qx, qy, qvx, qvy = stator_motion(y, I, k)
             E += stator_potential(ax - qx, ay - qy, P[P_ST_GAP], P[P_ST_K])
-            E += 0.5 * P[P_STM_M] * (qvx * qvx + qvy * qvy) + 0.5 * P[P_STM_K] * (qx * qx + qy * qy)
+            E += mount_energy(qx, qy, qvx, qvy, P[P_STM_K], P[P_STM_M])
         ux, uy = sx - hx, sy - hy
         if I[F_RB] == RB_SM:        # zero film without sleeve inertia (see rhs)
             h = film_thickness(ws, P[P_FILM])[0] if I[F_FILM] and i_ws >= 0 else 0.0
@@ -859,7 +814,7 @@ def mechanical_energy(y, P, I):
                                            P[P_HALF_PLAY], h, P[P_KTOT])
             E += V
         elif I[F_RB] == RB_LINEAR:
-            E += 0.5 * P[P_KLIN] * (ux * ux + uy * uy)
+            E += spring_energy(P[P_KLIN], ux, uy)
     return E
 
 

@@ -35,12 +35,50 @@ from ._jit import njit
 
 #: states per AMB plane: q1, q2 of the x axis, then of the y axis (S1)
 STATES_PER_PLANE = 4
+SCENE_KEYS = ("sensor.delay", "sensor.noise")
+#: the AMB axes whose displacement is sensed (the order of the delay states and noise controls)
+AXES = ("AMB1.x", "AMB1.y", "AMB2.x", "AMB2.y")
+
+
+def declare(layout) -> None:
+    """The delay tau, the sensing flag (on when sensor.delay or sensor.noise > 0), the first
+    delay state's slot, and the held noise samples ``sensor.noise`` + j [m] of AMB axis j that
+    the sensed displacement carries until the next sample."""
+    layout.params.add("sensor.delay")
+    layout.index.add("flag.sensor")
+    layout.index.add("state.sensor")
+    layout.controls.add("sensor.noise", len(AXES))
+
+
+def pack(scene, P, I, layout) -> None:
+    I[layout.index["flag.sensor"]] = scene.sensor.delay > 0.0 or scene.sensor.noise > 0.0
+    P[layout.params["sensor.delay"]] = scene.sensor.delay
+
+
+def states(scene, I, layout, sizes, add) -> None:
+    """The Pade delay states q1, q2 per AMB axis (only with sensor.delay)."""
+    if scene.sensor.delay <= 0.0:
+        return
+    first = -1
+    for ax in AXES:
+        i = add(f"{ax}.sensor_q1", sizes.clearance)
+        add(f"{ax}.sensor_q2", sizes.clearance)
+        first = i if first < 0 else first
+    I[layout.index["state.sensor"]] = first
 
 
 @njit
 def pade_rates(d, q1, q2, tau):
     """(q1', q2') of an axis's delay states (S1) at the true displacement ``d``."""
     return q2 / tau, 12.0 / tau * (d - q1 - 0.5 * q2)
+
+
+@njit
+def delay_rates(dx, dy_, y, i, tau, dy):
+    """Write the rates of one AMB plane's delay states y[i:i + 4] (x axis q1, q2, then y axis)
+    at the true displacements (dx, dy_) into ``dy``."""
+    dy[i], dy[i + 1] = pade_rates(dx, y[i], y[i + 1], tau)
+    dy[i + 2], dy[i + 3] = pade_rates(dy_, y[i + 2], y[i + 3], tau)
 
 
 @njit

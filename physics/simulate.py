@@ -66,11 +66,11 @@ class Integrator:
         if not self.fixed:
             self.h = h
         if status != OK:
-            raise IntegrationError(_explain(status, t, h, self.model))
+            raise IntegrationError(explain_status(status, t, h, self.model))
         return pos
 
 
-def _explain(status: int, t: float, h: float, model: Model) -> str:
+def explain_status(status: int, t: float, h: float, model: Model) -> str:
     """The error message of an integrator status; its advice stays inside the allowed ranges."""
     sv = model.scene.solver
     if status == STEP_COLLAPSE:

@@ -18,8 +18,59 @@ from __future__ import annotations
 import math
 
 from ._jit import njit
+from .amb import weight_shares
 from .contact import geometry, half_width_approach, smooth_sign
 from .roots import bisect_decreasing
+
+SCENE_KEYS = ("stator.*", "amb.air_gap", "contact.threshold_rpm", "rotor.mass", "positions.amb1",
+              "positions.amb2", "effects.stator_contact", "effects.stator_mount")
+#: the stator on its mount at each AMB plane (4 states per plane, effects.stator_mount)
+MOUNT_STATES = ("x", "y", "vx", "vy")
+
+
+def declare(layout) -> None:
+    """The stator contact's and mount's parameters (gap, stiffness, damping, friction, rotor
+    radius, threshold speed; mount stiffness, damping, mass per AMB plane), flag, state slot and
+    per-AMB-plane diagnostics: the stator's normal force (zero without stator contact), the
+    contact's dashpot and friction powers, its mount's dashpot power."""
+    for name in ("stator.gap", "stator.stiffness", "stator.damping", "stator.friction",
+                 "stator.rotor_radius", "stator.threshold_velocity", "stator.mount_stiffness",
+                 "stator.mount_damping", "stator.mount_mass"):
+        layout.params.add(name)
+    layout.index.add("flag.stator")
+    layout.index.add("state.stator_mount")
+    for name in ("stator.normal_force", "stator.damping_power", "stator.friction_power",
+                 "stator.mount_power"):
+        layout.aux.add(name, 2)
+
+
+def pack(scene, P, I, layout) -> None:
+    """The stator contact's parameters and flag."""
+    s, p = scene, layout.params
+    I[layout.index["flag.stator"]] = s.effects.stator_contact
+    st = s.stator
+    share = abs(weight_shares(s.rotor.mass, s.positions.amb1, s.positions.amb2)[0])
+    P[p["stator.gap"]], P[p["stator.stiffness"]] = s.amb.air_gap, st.stiffness
+    P[p["stator.friction"]], P[p["stator.rotor_radius"]] = st.friction, st.rotor_radius
+    P[p["stator.damping"]] = damping_coefficient(st.stiffness, max(share, 1e-3), st.restitution)
+    P[p["stator.threshold_velocity"]] = s.contact.threshold_rpm * math.pi / 30.0 * st.rotor_radius
+    P[p["stator.mount_stiffness"]], P[p["stator.mount_mass"]] = st.mount_stiffness, st.mount_mass
+    P[p["stator.mount_damping"]] = 2.0 * st.mount_damping_ratio * math.sqrt(st.mount_stiffness
+                                                                            * st.mount_mass)
+
+
+def states(scene, I, layout, sizes, add) -> None:
+    """The stators on their mounts: x, y, vx, vy of AMB1's stator, then AMB2's."""
+    if not (scene.effects.stator_contact and scene.effects.stator_mount):
+        return
+    c, v = sizes.clearance, sizes.velocity
+    first = -1
+    for plane in ("AMB1", "AMB2"):
+        for n, sz, obs in (("x", 0.1 * c, c), ("y", 0.1 * c, c), ("vx", 0.01, v),
+                           ("vy", 0.01, v)):
+            i = add(f"{plane}.stator_{n}", sz, obs)
+            first = i if first < 0 else first
+    I[layout.index["state.stator_mount"]] = first
 
 
 def restitution_of_damping(zeta: float) -> float:
@@ -84,6 +135,25 @@ def stator_force(px, py, pvx, pvy, W, gap, k, c, mu, radius, v_l):
     f_mu = mu * f_n * smooth_sign(slip, v_l)
     return (-f_n * nx - f_mu * tx, -f_n * ny - f_mu * ty, -radius * f_mu, f_n, elastic,
             (f_n - elastic) * ddelta, f_mu * slip)
+
+
+@njit
+def mount_rates(sfx, sfy, qx, qy, qvx, qvy, k, c, m):
+    """(x', y', vx', vy') of a stator (mass m) on its mount (stiffness k, damping c) at (qx, qy)
+    moving at (qvx, qvy), under the reaction of the rotor's contact force (sfx, sfy)."""
+    return qvx, qvy, (-sfx - k * qx - c * qvx) / m, (-sfy - k * qy - c * qvy) / m
+
+
+@njit
+def mount_energy(qx, qy, qvx, qvy, k, m):
+    """Kinetic energy of a stator (mass m) on its mount plus the mount spring's (stiffness k)."""
+    return 0.5 * m * (qvx * qvx + qvy * qvy) + 0.5 * k * (qx * qx + qy * qy)
+
+
+@njit
+def mount_power(qvx, qvy, c):
+    """Power [W] the mount's dashpot c dissipates."""
+    return c * (qvx * qvx + qvy * qvy)
 
 
 @njit

@@ -21,8 +21,41 @@ from __future__ import annotations
 from ._jit import njit
 
 STATE_NAMES = ("RB1.temperature", "RB2.temperature", "heat_lost", "friction_work")
+SCENE_KEYS = ("thermal.*", "effects.thermal", "sleeve.mass", "contact.friction")
+#: the parameters, in the order of :func:`parameters`: heat capacity, loss conductance, contact
+#: heat partition, relative mu slope, mu ratio floor and ceiling, bearing heat partition
+PARAM_NAMES = ("thermal.heat_capacity", "thermal.conductance", "thermal.heat_partition",
+               "thermal.mu_slope", "thermal.mu_ratio_min", "thermal.mu_ratio_max",
+               "thermal.drag_heat_partition")
 TEMPERATURE_SIZE = 10.0          # K: tolerance size of a temperature state (atol = rtol x size)
 TEMPERATURE_OBS = 100.0          # K: its observation size
+
+
+def declare(layout) -> None:
+    """The thermal parameters (one block, in PARAM_NAMES order) and the first state's slot."""
+    layout.params.block(*PARAM_NAMES)
+    layout.index.add("state.thermal")
+
+
+def pack(scene, P, I, layout) -> None:
+    """The thermal parameters (only with effects.thermal; zero otherwise)."""
+    if scene.effects.thermal:
+        first = layout.params[PARAM_NAMES[0]]
+        P[first:first + len(PARAM_NAMES)] = parameters(scene)
+
+
+def states(scene, I, layout, sizes, add) -> None:
+    """Sleeve temperatures of RB1 and RB2, then the heat audit's heat_lost and friction_work."""
+    if not scene.effects.thermal:
+        return
+    first = -1
+    for name in STATE_NAMES:
+        if name.endswith("temperature"):
+            i = add(name, TEMPERATURE_SIZE, TEMPERATURE_OBS)
+        else:
+            i = add(name, sizes.energy, sizes.spin_energy)
+        first = i if first < 0 else first
+    I[layout.index["state.thermal"]] = first
 
 
 def heat_capacity(scene) -> float:
@@ -58,6 +91,23 @@ def friction_coefficient(mu0, theta, kappa, r_min, r_max):
     elif r > r_max:
         r = r_max
     return mu0 * r
+
+
+@njit
+def rates(y, dy, i, p_fric1, p_drag1, p_fric2, p_drag2, C, G, a, b):
+    """Write the rates of the thermal states y[i:i + 4] (STATE_NAMES: the two sleeve
+    temperatures, heat_lost, friction_work) into ``dy`` for each plane's contact friction power
+    ``p_fric`` and bearing friction power ``p_drag``."""
+    dy[i], q1 = heat_rates(p_fric1, p_drag1, y[i], C, G, a, b)
+    dy[i + 1], q2 = heat_rates(p_fric2, p_drag2, y[i + 1], C, G, a, b)
+    q_lost = 0.0
+    q_lost += q1
+    q_lost += q2
+    w_fric = 0.0
+    w_fric += p_fric1 + p_drag1
+    w_fric += p_fric2 + p_drag2
+    dy[i + 2] = q_lost
+    dy[i + 3] = w_fric
 
 
 @njit

@@ -99,7 +99,7 @@ class Batch:
         self.envs = envs
         n = len(envs)
         first = envs[0]
-        self.stack = Buffers(*first._b.dims, n_envs=n)
+        self.stack = Buffers(*first._b.dims, packed=first._b.packed, n_envs=n)
         for e, env in enumerate(envs):
             env._bind(self.stack.row(e))
         self._args = self.stack.args()

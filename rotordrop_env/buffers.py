@@ -8,8 +8,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from physics.model import N_AUX, N_I, N_P, N_U
-
 from .kernels import N_C, N_M, N_O
 
 FIELDS = ("act", "y", "P", "I", "U", "atol", "work", "t_sub", "Y_sub", "aux", "cur", "C", "M",
@@ -19,15 +17,20 @@ FIELDS = ("act", "y", "P", "I", "U", "atol", "work", "t_sub", "Y_sub", "aux", "c
 class Buffers:
     """Arrays passed to the step kernels (see :mod:`rotordrop_env.kernels`), in kernel order."""
 
-    def __init__(self, n_state: int, n_obs: int, n_act: int, n_sub: int, n_envs: int | None = None):
+    def __init__(self, n_state: int, n_obs: int, n_act: int, n_sub: int, packed: dict[str, int],
+                 n_envs: int | None = None):
+        """``packed``: lengths of the physics' packed arrays ``P``, ``I``, ``U``, ``aux``
+        (:attr:`physics.model.Model.sizes`)."""
         lead = () if n_envs is None else (n_envs,)
-        shapes = dict(act=(n_act,), y=(n_state,), P=(N_P,), I=(N_I,), U=(N_U,), atol=(n_state,),
-                      work=(9, n_state), t_sub=(n_sub,), Y_sub=(n_sub, n_state), aux=(N_AUX,),
+        shapes = dict(act=(n_act,), y=(n_state,), P=(packed["P"],), I=(packed["I"],),
+                      U=(packed["U"],), atol=(n_state,), work=(9, n_state), t_sub=(n_sub,),
+                      Y_sub=(n_sub, n_state), aux=(packed["aux"],),
                       cur=(4,), C=(N_C,), M=(N_M,), scale=(n_obs,), obs=(n_obs,), out=(N_O,))
         for name in FIELDS:
             dtype = np.int64 if name == "I" else np.float64
             setattr(self, name, np.zeros(lead + shapes[name], dtype=dtype))
         self.dims = (n_state, n_obs, n_act, n_sub)
+        self.packed = dict(packed)
 
     def row(self, e: int) -> "Buffers":
         """Views of environment ``e``'s arrays in a stack."""
@@ -35,6 +38,7 @@ class Buffers:
         for name in FIELDS:
             setattr(view, name, getattr(self, name)[e])
         view.dims = self.dims
+        view.packed = self.packed
         return view
 
     def args(self) -> tuple:

@@ -13,9 +13,8 @@ import numpy as np
 from physics.amb import static_weight_share
 from physics.metrics import WHIRL_MIN_REVOLUTIONS, WHIRL_RADIUS_FRACTION
 from physics.ball_bearing import max_contact_pressure
-from physics.model import F_RB, I_CS, P_Z_RB1, RB_SM, S_A, S_B, S_W, S_X, S_Y
 from physics.scene import Scene, SceneError, load_scene
-from physics.simulate import IntegrationError, _explain
+from physics.simulate import IntegrationError, explain_status
 from physics.validity import validity_bound
 
 from . import kernels as K
@@ -37,7 +36,6 @@ DAMPING_ACTIONS = {"linear": K.DAMP_LINEAR, "from_max": K.DAMP_FROM_MAX}
 SUPERVISOR_OFFSET = 1.0
 SUPERVISOR_OCTAVES = 1.0
 DEFAULT_POWER_RETURN = 0.05
-_AXIS = np.array([S_X, S_Y, S_A, S_B])     # the rotor's centre and tilt, for the episode view
 #: reward weight -> its slot in the kernel configuration: settable at any time, used from the
 #: next step on (``env.w_whirl = 5``, ``vec_env.set_attr("w_whirl", 5)``)
 WEIGHT_SLOTS = {"w_whirl": K.C_W_WHIRL, "w_contact": K.C_W_CONTACT, "w_displacement": K.C_W_DISP,
@@ -238,8 +236,9 @@ class RotorDropEnv(gym.Env):
         self._act_shape = () if self._discrete else self.action_space.shape
         n_act = 1 if self._discrete else self.action_space.shape[0]
         self._sensing = Sensing(self.sensor_noise, self.obs_latency_steps, self.obs_names,
-                                self.obs_scale, self.base_scene.contact.clearance)
-        self._bind(Buffers(model.n_state, n_obs, n_act, int(samples_per_step)))
+                                self.obs_scale, self.base_scene.contact.clearance,
+                                model.control_index("sensor.noise"))
+        self._bind(Buffers(model.n_state, n_obs, n_act, int(samples_per_step), model.sizes))
         self._configure_static(relevitation_hold, _flag("terminate_on_failure", terminate_on_failure))
         self._renderer = None
         self._values = np.zeros(K.N_V)          # the info numbers (rotordrop_env.info)
@@ -507,7 +506,7 @@ class RotorDropEnv(gym.Env):
         if out[K.O_ERR]:
             self._action_error(out[K.O_ERR], action)
         if out[K.O_STATUS]:
-            raise IntegrationError(_explain(int(out[K.O_STATUS]), b.M[K.M_T], b.M[K.M_H], self.model))
+            raise IntegrationError(explain_status(int(out[K.O_STATUS]), b.M[K.M_T], b.M[K.M_H], self.model))
         terminated = bool(out[K.O_TERM])
         truncated = bool(out[K.O_TRUNC])
         self._ended |= terminated or truncated
@@ -559,11 +558,13 @@ class RotorDropEnv(gym.Env):
         """One row of the episode view (``rotordrop_env.render.COLUMNS``) and the orbit at the
         step's monitor samples (at reset: the present state only)."""
         b = self._b
-        y, I, M = b.y, b.I, b.M
-        axis = I[_AXIS]                                 # x, y, a, b of the rotor
-        damping = (y[I[I_CS]], y[I[I_CS] + 1]) if I[I_CS] >= 0 else (math.nan, math.nan)
+        y, M, model = b.y, b.M, self.model
+        axis = model.rotor_axis_indices()               # x, y, a, b of the rotor
+        damping = ((y[model.state_index("RB1.Cs")], y[model.state_index("RB2.Cs")])
+                   if model.has_state("RB1.Cs") else (math.nan, math.nan))
         amb = (M[K.M_POWER], M[K.M_CTRL_ON]) if self._relevitate else (math.nan, math.nan)
-        self._renderer.add((self.time, b.out[K.O_FORCE], y[I[S_W]], M[K.M_REV1], M[K.M_REV2],
+        self._renderer.add((self.time, b.out[K.O_FORCE], y[model.state_index("Omega")],
+                            M[K.M_REV1], M[K.M_REV2],
                             M[K.M_WHIRL], *damping, *amb),
                            b.Y_sub[:, axis] if step else y[None, axis])
 
@@ -586,9 +587,9 @@ class RotorDropEnv(gym.Env):
         return self._renderer
 
     def _reset_view(self) -> None:
-        s, P = self.scene, self._b.P
+        s = self.scene
         self._ensure_renderer().reset(s.contact.friction, s.contact.clearance, s.amb.air_gap,
-                                      (P[P_Z_RB1], P[P_Z_RB1 + 1]))
+                                      self.model.retainer_z())
 
     def close(self):
         """Release the view; afterwards reset(), step() and render() raise
@@ -614,7 +615,7 @@ def pressure_coef(model, scene) -> float:
     """c of the worst ball's Hertz contact pressure c x cbrt(ball load) [Pa]
     (:func:`physics.ball_bearing.max_contact_pressure`); ``MISSING`` without Sopanen-Mikkola
     balls (then the ball KPIs are ``MISSING``)."""
-    if model.I[F_RB] != RB_SM:
+    if not model.has_ball_bearing:
         return MISSING
     return float(max_contact_pressure(scene.bearing, 1.0))
 

@@ -23,7 +23,7 @@ from physics.rotor import axis_at
 #: one recorded row per control step (SI units, NaN where the environment lacks the quantity)
 COLUMNS = ("t", "force", "speed", "rev1", "rev2", "whirl", "damping1", "damping2", "amb_power",
            "controller_on")
-(T, FORCE, SPEED, REV1, REV2, WHIRL, DAMP1, DAMP2, POWER, CTRL) = range(len(COLUMNS))
+(T, FORCE, SPEED, REV1, REV2, WHIRL, DAMP1, DAMP2, POWER, CTRL) = map(COLUMNS.index, COLUMNS)
 
 WIDTH, HEIGHT = 768, 432                    # multiples of 16: MP4 encoders take them unscaled
 ORBIT = 248                                 # side of an orbit panel [px]

@@ -10,7 +10,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from physics.equilibrium import levitated_state
-from physics.model import AMB_NONE, F_AMB, Model, build_model
+from physics.model import Model, build_model
 from physics.scene import Scene, SceneError, param_meta
 from physics.simulate import Integrator, run_segments
 
@@ -119,7 +119,7 @@ class FaultState:
         self.y = levitated_state(self.model)
         self.integrator = Integrator(self.model)
         t_off = scene.amb.off_time
-        if self.model.I[F_AMB] == AMB_NONE or t_off <= 0.0:
+        if not self.model.has_ambs or t_off <= 0.0:
             self.t_fault = 0.0                  # no AMBs: the drop starts at t = 0
         else:
             self.t_fault = t_off

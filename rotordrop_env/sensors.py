@@ -12,7 +12,7 @@ true motion.
 * **Noise**: the four displacements x1, y1, x2, y2 get independent Gaussian noise of standard
   deviation σ = ``sensor_noise`` [m], one sample per control step; the same sample is what the
   built-in PID and the supervisor's orbit frame see during the next control step (the U entries
-  ``U_SENS_NOISE``: a sample taken at t_n is held until t_n+1). The four velocities, which a
+  ``sensor.noise``: a sample taken at t_n is held until t_n+1). The four velocities, which a
   real machine estimates by differencing the displacement signal, get σ_v = √2 σ /
   ``VELOCITY_ESTIMATE_DT`` (the noise of a difference over 1 ms, the same for every control
   step; observations only). With ``command="supervisor"`` the orbit radius and rate are
@@ -32,8 +32,6 @@ import math
 import numbers
 
 import numpy as np
-
-from physics.model import U_SENS_NOISE
 
 from .kernels import SUP_MIN_RADIUS
 from .layout import SUPERVISOR_OBS
@@ -88,9 +86,10 @@ class Sensing:
     ``clearance`` [m] for the orbit's dead zone."""
 
     def __init__(self, noise: float, latency: tuple[int, int], obs_names, obs_scale,
-                 clearance: float):
+                 clearance: float, noise_control: int):
         names = list(obs_names)
         self.noise, self.latency = noise, latency
+        self.noise_control = noise_control      # first of the 4 noise controls in U
         self.active = noise > 0.0 or latency[1] > 0
         self.time_col = names.index("time")
         if noise > 0.0:
@@ -139,7 +138,7 @@ class Sensing:
             z = rng.standard_normal(len(self.cols))
             m[self.cols] += self.sigma * z
             if U is not None:                   # x1, y1, x2, y2: the AMB axes' order
-                U[U_SENS_NOISE:U_SENS_NOISE + 4] = self.noise * z[:4]
+                U[self.noise_control:self.noise_control + 4] = self.noise * z[:4]
             if self.orbit is not None:
                 self._orbit(m)
         return m

@@ -65,10 +65,10 @@ MUTANTS = (
            "f_mu = mu * f_n * smooth_sign(slip, v_l)", "f_mu = -mu * f_n * smooth_sign(slip, v_l)"),
     Mutant("stator_damping", "physics/stator.py",
            "f_n = elastic + c * ddelta", "f_n = elastic - c * ddelta"),
-    Mutant("stator_mount_damping", "physics/model.py",
-           "(-sfy - P[P_STM_K] * qy - P[P_STM_C] * qvy)", "(-sfy - P[P_STM_K] * qy + P[P_STM_C] * qvy)"),
-    Mutant("stator_mount_reaction", "physics/model.py",
-           "(-sfy - P[P_STM_K] * qy - P[P_STM_C] * qvy)", "(sfy - P[P_STM_K] * qy - P[P_STM_C] * qvy)"),
+    Mutant("stator_mount_damping", "physics/stator.py",
+           "(-sfy - k * qy - c * qvy) / m", "(-sfy - k * qy + c * qvy) / m"),
+    Mutant("stator_mount_reaction", "physics/stator.py",
+           "(-sfy - k * qy - c * qvy) / m", "(sfy - k * qy - c * qvy) / m"),
 )
 
 

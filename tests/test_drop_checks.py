@@ -12,7 +12,7 @@ from physics.integrate import NOT_FINITE, STEP_COLLAPSE, TOO_MANY_STEPS
 from physics.metrics import PEAK_TOLERANCE, SAMPLES_PER_PERIOD, contact_period
 from physics.model import axis_motion
 from physics.scene import param_meta
-from physics.simulate import _explain
+from physics.simulate import explain_status
 
 
 def _drop(tmp_path, capsys, *args):
@@ -140,7 +140,7 @@ def test_fixed_step_budget_advice_names_dt_not_rtol(tmp_path, capsys):
 
 
 def _message(status, h=1e-13, **overrides):
-    return _explain(status, 0.1, h, build_model(load_scene("paper", overrides)))
+    return explain_status(status, 0.1, h, build_model(load_scene("paper", overrides)))
 
 
 def test_solver_advice_never_points_outside_the_allowed_range():

@@ -14,6 +14,11 @@ def test_editing_any_kernel_file_changes_the_cache_directory(tmp_path):
     model.write_text(model.read_text() + "\n# edited\n")
     assert _jit._kernel_sources_hash(tmp_path) != before
     assert _jit.CACHE_DIR.endswith(before)
+    # the slot layout the kernels compile in as constants counts as kernel source too
+    layout = tmp_path / "physics" / "layout.py"
+    edited = _jit._kernel_sources_hash(tmp_path)
+    layout.write_text(layout.read_text() + "\n# edited\n")
+    assert _jit._kernel_sources_hash(tmp_path) != edited
 
 
 def test_decorating_leaves_numba_global_cache_setting_alone():

@@ -26,8 +26,12 @@ import math
 
 import numpy as np
 
-DOF_PER_NODE = 4
-X, Y, A, B = 0, 1, 2, 3  # the node's DOF offsets: x, y, a = dx/dz, b = dy/dz
+from ..layout import Slots
+
+#: the node's DOF offsets: x, y, a = dx/dz, b = dy/dz
+NODE_DOFS = Slots("node DOF")
+X, Y, A, B = NODE_DOFS.add_each("x", "y", "a", "b")
+DOF_PER_NODE = NODE_DOFS.freeze().size
 
 
 def section(outer_diameter: float, inner_diameter: float) -> tuple[float, float]:

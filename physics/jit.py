@@ -1,0 +1,5 @@
+"""The numba decorators every kernel uses (:mod:`physics._jit`: compiled once, cached on disk, no
+Python objects), under a public name for kernels outside physics (rotordrop_env's batch step)."""
+from ._jit import njit, njit_borrow, njit_parallel
+
+__all__ = ["njit", "njit_borrow", "njit_parallel"]
