@@ -103,7 +103,7 @@ class Scenario:
 def passive_threshold(phases=PHASES, grid=THRESHOLD_GRID, progress=None, session=None) -> dict:
     """Whirl fraction of the passive drop on the friction grid and the threshold μ* (module doc);
     one task per friction on ``session`` (default: one after the other here)."""
-    from physics.backend import Session
+    from physics.runs.backend import Session
     session = session if session is not None else Session()
     fractions = [0.0] * len(grid)
     bar = progress if session.name == "local" else None
@@ -337,7 +337,7 @@ def benchmark(out: str | Path, quick: bool = False, policies: list[str] | None =
     On ``backend`` ray every friction of the threshold sweep and every controller is one Ray
     task (learned policies travel as their paths and are loaded again on the node). The robust
     suite: :mod:`agents.robust`."""
-    from physics.backend import Backend
+    from physics.runs.backend import Backend
     backend = backend if backend is not None else Backend()
     check_score(score)
     if power_return is not None:

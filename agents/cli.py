@@ -12,9 +12,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from physics import accuracy, study
 from physics import cli as physics_cli
-from physics.backend import add_backend_args
+from physics.runs.backend import add_backend_args
 from physics.cli import at_least
 
 from . import imitation, research
@@ -73,7 +72,7 @@ def _number(text: str):
 
 
 def cmd_train(args) -> int:
-    from physics.backend import Backend
+    from physics.runs.backend import Backend
     from .hyperparams import ConfigError
     from .train import command_line, train
     try:
@@ -127,7 +126,7 @@ def cmd_export_policy(args) -> int:
 
 
 def cmd_benchmark(args) -> int:
-    from physics.backend import Backend
+    from physics.runs.backend import Backend
     from .robust import run_suite
     try:
         run_suite(args.suite, args.out, quick=args.quick, policies=args.policy,
@@ -160,7 +159,7 @@ def cmd_ride_through(args) -> int:
 
 
 def cmd_tune(args) -> int:
-    from physics.backend import Backend
+    from physics.runs.backend import Backend
     from .tune import tune
     try:
         r = tune(args.policy, args.env, args.gain, args.out, iterations=args.iterations,
@@ -456,7 +455,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="rotordrop", description="AMB rotor drop onto retainer "
                                      "bearings: simulation, studies, Gymnasium environments and agents")
     sub = parser.add_subparsers(dest="command", required=True)
-    for register_commands in (physics_cli.register, study.register, accuracy.register, register,
+    for register_commands in (physics_cli.register, register,
                               register_results, research.register):
         register_commands(sub)
     return parser

@@ -21,7 +21,7 @@ def minimise(objective: Callable[[np.ndarray], float], names: list[str], iterati
              backend, storage: Path, progress: bool = True, desc: str = "cross-entropy search",
              **search):
     """The cross-entropy search (``search``: :class:`CrossEntropy`'s arguments) of
-    ``objective`` on ``backend`` (:class:`physics.backend.Backend`): here one candidate after the
+    ``objective`` on ``backend`` (:class:`physics.runs.backend.Backend`): here one candidate after the
     other, or on Ray Tune (trials under ``storage``); the same result either way."""
     if backend.name != "ray":
         return cross_entropy(objective, iterations=iterations, progress=progress, desc=desc,

@@ -150,7 +150,7 @@ def robust_benchmark(out, quick: bool = False, policies: list[str] | None = None
     import time
     from pathlib import Path
 
-    from physics.backend import Backend
+    from physics.runs.backend import Backend
     from tqdm.auto import tqdm
 
     from .benchmark import EPISODE_TIME, entry_rows, leaderboard, robust_entries

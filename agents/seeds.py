@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from physics.backend import Backend
+from physics.runs.backend import Backend
 
 from .train import TrainResult, resolve_config, train
 

@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from physics.backend import Backend
+from physics.runs.backend import Backend
 
 from .benchmark import TASKS, Validator, check_suite, controller_env_kwargs
 from .controllers import BASELINES, Controller, controller_class, make_controller

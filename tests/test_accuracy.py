@@ -4,7 +4,7 @@ import json
 
 import pytest
 
-from physics.accuracy import TOLERANCE, recommend
+from physics.runs.accuracy import TOLERANCE, recommend
 from agents.cli import main as cli_main
 from physics.scene import Scene
 

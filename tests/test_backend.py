@@ -11,11 +11,11 @@ import time
 
 import pytest
 
-from physics.backend import Backend, BackendError, plan_threads, probe, run_drops
-from physics.cli import UsageError
+from physics.runs.backend import Backend, BackendError, plan_threads, probe, run_drops
+from physics.runs import UsageError
 from agents.cli import main as cli_main
-from physics.store import DropStore
-from physics.sweep import Run
+from physics.runs.store import DropStore
+from physics.runs.sweep import Run
 
 SHORT = {"solver.t_end": 0.14}                  # 40 ms after the fault: first impacts
 

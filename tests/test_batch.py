@@ -1,13 +1,13 @@
-"""Drops in batches (physics.sweep.run_chunk): the numbers of a batch are the single drop's, bit for bit."""
+"""Drops in batches (physics.runs.sweep.run_chunk): the numbers of a batch are the single drop's, bit for bit."""
 import json
 
 import pytest
 
 from physics import load_scene, simulate
-from physics.sweep import run_chunk
+from physics.runs.sweep import run_chunk
 from physics.metrics import compute_metrics
-from physics.study.observables import drop_observables
-from physics.sweep import Outcome, Run
+from physics.runs.study.observables import drop_observables
+from physics.runs.sweep import Outcome, Run
 
 TIMING = ("wall_time_s", "compile_time_s")
 
@@ -74,7 +74,7 @@ def test_a_drop_after_another_takes_its_arrays_from_the_memory_the_first_one_fre
     the previous drop freed, not from fresh pages faulted in one by one (without it each of
     these drops faults in its output arrays again, ~900 pages)."""
     import resource
-    from physics.sweep import keep_freed_memory, simulate_drop
+    from physics.runs.sweep import keep_freed_memory, simulate_drop
     if not keep_freed_memory():
         pytest.skip("the C library has no mallopt (not glibc)")
     simulate_drop(RUNS[0], drop_observables)

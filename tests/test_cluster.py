@@ -150,9 +150,9 @@ def test_one_node_ray_gives_the_local_numbers_of_the_paper_study_drops(tmp_path)
     """A Ray started for the run (no --address) and the local backend: identical outcomes,
     including the study's extra observables."""
     pytest.importorskip("ray")
-    from physics.backend import Backend, run_drops
-    from physics.study.observables import drop_observables
-    from physics.sweep import Run
+    from physics.runs.backend import Backend, run_drops
+    from physics.runs.study.observables import drop_observables
+    from physics.runs.sweep import Run
     runs = [Run.of("paper", {"solver.t_end": 0.2, "contact.friction": mu}, friction=mu)
             for mu in (0.2, 0.3, 0.45, 3.0)]                               # the last one fails
     local, _ = run_drops(runs, drop_observables, Backend("local"), progress=False)

@@ -10,9 +10,9 @@ from physics.cli import summary_table
 from physics.contact import (half_width_approach, half_width_load, line_deflection,
                              line_elastic_force)
 from physics.metrics import BEFORE_INVALID, INVALID_KEYS, compute_metrics
-from physics.study.checks import beyond_validity, split_valid
-from physics.study.parametric import summarize_cell
-from physics.sweep import Outcome
+from physics.runs.study.checks import beyond_validity, split_valid
+from physics.runs.study.parametric import summarize_cell
+from physics.runs.sweep import Outcome
 from physics.validity import validity_bound
 from rotordrop_env.env import RotorDropEnv
 
@@ -164,9 +164,9 @@ def test_terminate_on_failure_ends_the_episode_past_the_bound():
 def test_paper_study_medians_and_claims_leave_drops_beyond_validity_out(drops):
     """The friction-class medians take the calm drop alone and count the heavy one apart; a
     support-stiffness claim whose nominal drop left validity says so instead of a ratio."""
-    from physics.study.claims import _stiff_ratio_base
-    from physics.study.observables import drop_observables
-    from physics.study.paper import _medians
+    from physics.runs.study.claims import _stiff_ratio_base
+    from physics.runs.study.observables import drop_observables
+    from physics.runs.study.paper import _medians
     outs = [Outcome(run=None, ok=True, metrics=drops[k][1], extra=drop_observables(drops[k][0]))
             for k in ("calm", "heavy")]
     med = _medians(outs)

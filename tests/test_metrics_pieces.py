@@ -6,9 +6,9 @@ import pytest
 from physics import load_scene, simulate
 from physics.metrics import compute_metrics, whirl
 from physics.model import PLANES
-from physics.study.observables import drop_observables
-from physics.study.paper import Plan, StudyInput, plan_runs
-from physics.sweep import Run, outcome_of
+from physics.runs.study.observables import drop_observables
+from physics.runs.study.paper import Plan, StudyInput, plan_runs
+from physics.runs.sweep import Run, outcome_of
 
 
 @pytest.fixture(scope="module")

@@ -8,7 +8,7 @@ from physics import load_scene, simulate
 from physics.ball_bearing import ball_forces, ball_stiffness, max_contact_pressure, static_max_ball_load
 from physics.metrics import compute_metrics, rating_pressure
 from physics.model import build_model
-from physics.plots import pressure_levels
+from physics.runs.plots import pressure_levels
 
 
 def test_full_state_observation_sizes_keep_every_state_order_one():

@@ -7,7 +7,7 @@ import math
 import pytest
 
 from physics import SceneError, load_scene, simulate
-from physics.accuracy import AccuracyPlan, plan_runs
+from physics.runs.accuracy import AccuracyPlan, plan_runs
 from agents.cli import main as cli_main
 from physics.metrics import compute_metrics, worst_plane
 from physics.scene import Scene, param_meta

@@ -10,11 +10,11 @@ import pytest
 
 from physics import load_scene
 from agents.cli import main as cli_main
-from physics.study.ensemble import JITTER_S, logistic_fit, onset, perturbations, probability_curve
-from physics.study.paper import DAMPING
-from physics.study.checks import WARNING_KINDS
-from physics.study.parametric import PLANE_KPIS
-from physics.sweep import Run, reproduce_command, run_sweep
+from physics.runs.study.ensemble import JITTER_S, logistic_fit, onset, perturbations, probability_curve
+from physics.runs.study.paper import DAMPING
+from physics.runs.study.checks import WARNING_KINDS
+from physics.runs.study.parametric import PLANE_KPIS
+from physics.runs.sweep import Run, reproduce_command, run_sweep
 
 
 # ----------------------------------------------------------------------- onset statistics --
@@ -181,7 +181,7 @@ def test_parametric_sweep_sees_the_whirl_and_its_forces(tmp_path, capsys):
 
 def test_parametric_sweep_grid_values_and_errors():
     from physics.scene import SceneError
-    from physics.study.parametric import ensemble_keys, make_axes, parse_vary, plan_runs
+    from physics.runs.study.parametric import ensemble_keys, make_axes, parse_vary, plan_runs
     assert parse_vary("contact.friction=0.3:0.5:0.1") == ("contact.friction", ["0.3", "0.4", "0.5"])
     # ranges step in decimals: tiny values keep their scale, a range through zero hits 0 exactly
     assert make_axes("paper", {}, ["solver.min_step=1e-14:3e-14:1e-14"])[0].values == (1e-14, 2e-14, 3e-14)

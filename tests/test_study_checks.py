@@ -9,12 +9,12 @@ import pytest
 
 from physics import SceneError, load_scene, simulate
 from agents.cli import main as cli_main
-from physics.cli import UsageError
+from physics.runs import UsageError
 from physics.metrics import compute_metrics
-from physics.study.ensemble import perturbations
-from physics.study.paper import StudyInput
-from physics.study.parametric import MAX_RUNS, make_axes, plan_runs
-from physics.sweep import Run, run_sweep
+from physics.runs.study.ensemble import perturbations
+from physics.runs.study.paper import StudyInput
+from physics.runs.study.parametric import MAX_RUNS, make_axes, plan_runs
+from physics.runs.sweep import Run, run_sweep
 
 CPUS = len(os.sched_getaffinity(0))
 
@@ -39,13 +39,13 @@ def test_study_paper_refuses_set_on_the_keys_it_varies(tmp_path, capsys, key, va
 
 
 def test_study_paper_keeps_other_overrides_and_labels_the_held_values():
-    from physics.study.paper import STUDY_KEYS
+    from physics.runs.study.paper import STUDY_KEYS
     assert set(STUDY_KEYS) >= {"contact.friction", "support.damping", "support.stiffness",
                                "effects.friction", "unbalance.angle_deg", "amb.off_time"}
     StudyInput("paper", {"bearing.f0": 2.0})                        # allowed
     with pytest.raises(SceneError, match="contact.friction, support.damping itself"):
         StudyInput("paper", {"contact.friction": 0.3, "support.damping": 2e4})
-    from physics.study.report import _held, _soft_case
+    from physics.runs.study.report import _held, _soft_case
     a = {"held": {"contact.friction": 0.3, "support.stiffness": 5e7, "support.damping": 2e4}}
     assert _soft_case(a) == "K_s = 5e6, μ = 0.3"
     assert (_held(a, "support.stiffness"), _held(a, "support.damping")) == ("5e7", "20000")
@@ -63,7 +63,7 @@ def test_a_run_that_ends_before_the_fault_is_a_failed_drop_not_a_calm_one(tmp_pa
     assert not any(run["ok"] for run in r["runs"])
     assert "| 0.05 | - | - | - | 2 | 0 | no_fault 2 |" in text
     assert "2 drops without a fault (counted as failed)" in text
-    from physics.study.checks import WARNING_KINDS
+    from physics.runs.study.checks import WARNING_KINDS
     head, row = (out / "sweep.csv").read_text().splitlines()
     assert head.endswith(",".join(f"warnings_{k}" for k in WARNING_KINDS))
     assert row.endswith(",2" + ",0" * (len(WARNING_KINDS) - 1))
@@ -91,7 +91,7 @@ def test_sweep_cells_count_the_warnings_rotordrop_drop_prints(tmp_path, capsys):
 
 
 def test_as_drop_and_warning_counts():
-    from physics.study.checks import as_drop, warning_counts
+    from physics.runs.study.checks import as_drop, warning_counts
     runs = [Run.of("paper", {"solver.t_end": 0.05}), Run.of("paper", {"solver.t_end": 0.12}),
             Run.of("paper", {"contact.friction": 2.0})]
     calm, dropped, bad = (as_drop(o) for o in run_sweep(runs, jobs=1, progress=False))
@@ -107,7 +107,7 @@ def test_too_many_members_fail_before_any_member_is_drawn(monkeypatch):
 
     def drawn(*args, **kwargs):
         raise AssertionError("members drawn before the drop count was checked")
-    monkeypatch.setattr("physics.study.parametric.perturbations", drawn)
+    monkeypatch.setattr("physics.runs.study.parametric.perturbations", drawn)
     with pytest.raises(SceneError, match=f"would simulate 2000000 drops; at most {MAX_RUNS}"):
         plan_runs("paper", {}, axes, 10 ** 6, 0)
 
@@ -129,7 +129,7 @@ def test_seeds_and_jobs_below_their_range_are_one_line_errors(tmp_path, capsys):
 
 
 def test_jobs_are_capped_at_the_cpus_and_the_drops():
-    from physics.sweep import plan_jobs
+    from physics.runs.sweep import plan_jobs
     assert plan_jobs(None, 100) == (CPUS, "")
     assert plan_jobs(1, 100) == (1, "")
     used, note = plan_jobs(100, 3)

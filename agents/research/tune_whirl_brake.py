@@ -25,7 +25,7 @@ from agents.benchmark import EVAL_KWARGS, Entry, Scenario, controller_env_kwargs
 from agents.controllers import WhirlBrake
 from agents.rollout import run_episodes
 from agents.ray_search import minimise
-from physics.backend import Backend
+from physics.runs.backend import Backend
 
 NAMES = ("kp", "kd", "kc", "kt", "kr", "ff")
 LOW = np.array([0.0, 0.0, -3.0, -0.5, -1.0, 0.0])

@@ -14,7 +14,7 @@ FIRST_IMPACT_BOUND_N = dict(zip(STIFFNESS, (1685.0, 2858.0, 3402.0)))
 
 
 def claims(a: dict, clearance_um: float) -> list[dict]:
-    """Claims table from the analysis dict of :func:`physics.study.paper.analyse`."""
+    """Claims table from the analysis dict of :func:`physics.runs.study.paper.analyse`."""
     rows = []
     for make in (_threshold, _orbit_grows, _late_peak, _leaves_circle, _whirl_forces,
                  _spin_up, _bounces, _soft_600, _soft_settles, _stiff_ratio_base, _stiff_ratio_soft,

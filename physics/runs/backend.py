@@ -1,7 +1,7 @@
 """Where batches of drops run: in this process (``local``) or on a Ray cluster (``ray``).
 
-A batch (a study, a sweep) is cut into chunks of :class:`physics.sweep.Run` s; each chunk is
-simulated by :func:`physics.sweep.run_chunk` in one process, the only function a backend calls:
+A batch (a study, a sweep) is cut into chunks of :class:`physics.runs.sweep.Run` s; each chunk is
+simulated by :func:`physics.runs.sweep.run_chunk` in one process, the only function a backend calls:
 
 * ``local`` runs the chunks one after the other in this process (``run_chunk`` spreads a chunk
   over ``--jobs`` threads);
@@ -12,7 +12,7 @@ simulated by :func:`physics.sweep.run_chunk` in one process, the only function a
 
 A task carries only picklable values: the chunk's runs (scene name, overrides, labels), the
 ``evaluate`` function by reference and the thread count; only the per-drop metrics come back.
-Every finished drop goes to a :class:`physics.store.DropStore` at once, so a killed worker
+Every finished drop goes to a :class:`physics.runs.store.DropStore` at once, so a killed worker
 (Ray re-runs its chunk) or a killed driver (``--resume``) loses nothing. Ray is imported only
 here and only for ``--backend ray``: the package works without the ``cluster`` extra.
 """
@@ -30,7 +30,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any, Callable, Iterator, Sequence
 
-from .cli import UsageError
+from . import UsageError
 from .sweep import Evaluate, Outcome, Run, _bar, _tick, run_chunk
 
 BACKENDS = ("local", "ray")
@@ -298,7 +298,7 @@ def record(o: Outcome) -> dict:
 
 
 def plan_threads(backend: Backend, jobs: int | None, runs: int) -> tuple[int | None, str]:
-    """Threads of the local backend (:func:`physics.sweep.plan_jobs`) and its note; on Ray every
+    """Threads of the local backend (:func:`physics.runs.sweep.plan_jobs`) and its note; on Ray every
     task takes one CPU and the cluster's CPUs set the parallelism, so ``--jobs`` is refused."""
     if backend.name == "local":
         from .sweep import plan_jobs
@@ -315,7 +315,7 @@ def run_drops(runs: Sequence[Run], evaluate: Evaluate | None = None, backend: Ba
     """Simulate ``runs`` on ``backend``; outcomes in input order and how they ran.
 
     With ``out`` every drop is written to ``out/drops`` as it finishes
-    (:class:`physics.store.DropStore`); with ``resume`` the drops already there are kept and
+    (:class:`physics.runs.store.DropStore`); with ``resume`` the drops already there are kept and
     only the missing ones run. Each outcome is read back from its JSON record, so both backends
     (and a resumed run) return identical numbers.
     """

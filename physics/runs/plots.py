@@ -9,11 +9,11 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .ball_bearing import max_contact_pressure  # noqa: E402
-from .metrics import (ISO76_C0_PRESSURE, RPM, friction_heat, rating_pressure,  # noqa: E402
+from ..ball_bearing import max_contact_pressure  # noqa: E402
+from ..metrics import (ISO76_C0_PRESSURE, RPM, friction_heat, rating_pressure,  # noqa: E402
                       retainer_loading)
-from .model import F_RB, F_STATOR, PLANES, RB_SM  # noqa: E402
-from .results import AMB_PLANES, Result  # noqa: E402
+from ..model import F_RB, F_STATOR, PLANES, RB_SM  # noqa: E402
+from ..results import AMB_PLANES, Result  # noqa: E402
 
 
 def orbit_panel(ax, result: Result, plane: str, lw: float = 0.5, circle_lw: float = 1.0,

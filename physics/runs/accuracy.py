@@ -22,8 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .metrics import worst_plane
-from .scene import SceneError
+from ..metrics import worst_plane
+from ..scene import SceneError
 
 WINDOW_S = 0.02          # trajectory comparison window after the reference's first contact
 CAPTURE_S = 0.06         # orbit samples kept from each run after the fault (covers the window)
@@ -105,7 +105,7 @@ def accuracy_observables(result) -> dict:
 
 
 def plan_runs(plan: AccuracyPlan, source: str, overrides: dict):
-    from .scene import load_scene
+    from ..scene import load_scene
     from .study.ensemble import perturbations
     from .sweep import Run
     scene = load_scene(source, overrides)
@@ -411,7 +411,7 @@ def scene_setting_text(a: dict) -> str:
 # ---------------------------------------------------------------------------------- CLI --
 def run_accuracy(source: str, overrides: dict, out_dir, quick: bool = False,
                  jobs: int | None = None, progress: bool = True) -> tuple[dict, list[Path]]:
-    from .scene import load_scene
+    from ..scene import load_scene
     from .sweep import run_sweep
     plan = AccuracyPlan.make(quick)
     rows, runs = plan_runs(plan, source, overrides)
@@ -424,26 +424,3 @@ def run_accuracy(source: str, overrides: dict, out_dir, quick: bool = False,
                 t_end=plan.t_end if plan.t_end is not None else scene.solver.t_end,
                 wall_time_s=time.perf_counter() - t0)
     return a, write_outputs(a, Path(out_dir), meta)
-
-
-def register(subparsers) -> None:
-    from .cli import add_scene_args, at_least
-    p = subparsers.add_parser("accuracy", help="what accuracy costs in time: solver settings and "
-                              "reduced models against a tight reference (Markdown, JSON, Pareto plot)")
-    add_scene_args(p)
-    p.add_argument("--out", default="out/accuracy", help="output directory")
-    p.add_argument("--quick", action="store_true", help="2 drops of 0.3 s, fewer settings")
-    p.add_argument("--jobs", type=at_least(1), default=None, help="threads (default: all cores)")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
-    p.set_defaults(func=cmd_accuracy)
-
-
-def cmd_accuracy(args) -> int:
-    from .cli import overrides_from_args
-    a, paths = run_accuracy(args.scene, overrides_from_args(args), args.out, quick=args.quick,
-                            jobs=args.jobs, progress=not args.quiet)
-    print(Path(paths[1]).read_text().split("\n\n![")[0])
-    print(f"\nrecommended: {a['recommended']} ({a['recommended_reason']}); "
-          f"scene's setting: {scene_setting_text(a)}")
-    print("wrote " + ", ".join(str(p) for p in paths))
-    return 0

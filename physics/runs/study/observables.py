@@ -1,16 +1,16 @@
 """Numbers of a drop that the paper's statements are about, beyond the standard metrics.
 
 :func:`drop_observables` runs inside the sweep workers (it is the ``evaluate`` hook of
-:func:`physics.sweep.run_sweep`), so only these small dicts travel back. All times are measured
+:func:`physics.runs.sweep.run_sweep`), so only these small dicts travel back. All times are measured
 from the fault; forces in N, displacements in µm, speeds in rpm.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from ..metrics import RPM, after, first_contact_time, per_plane
-from ..model import PLANES
-from ..results import Result
+from ...metrics import RPM, after, first_contact_time, per_plane
+from ...model import PLANES
+from ...results import Result
 
 WINDOW_S = 0.01            # window of the contact-force fluctuation used for settling
 SETTLE_FRACTION = 0.25     # settled: window mean and std within this fraction of the late mean

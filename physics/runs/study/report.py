@@ -10,7 +10,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from ..plots import RPM, orbit_panel, save_figure  # noqa: E402
-from ..results import Result  # noqa: E402
+from ...results import Result  # noqa: E402
 from .checks import counts_text, warnings_note  # noqa: E402
 from .claims import PAPER_SOFT_Y_UM, PAPER_THRESHOLD  # noqa: E402
 from .paper import BASE, PRIMARY_SLIP, SOFT  # noqa: E402
@@ -155,7 +155,7 @@ def plot_sensitivity(a: dict, out: Path) -> str:
 
 
 def _whirls(r: Result) -> bool:
-    from ..metrics import compute_metrics
+    from ...metrics import compute_metrics
     return bool(compute_metrics(r)["backward_whirl"])
 
 
@@ -166,7 +166,7 @@ def _f(x, spec=".2f"):
 
 def _nominal(r: dict, key: str, spec: str = ".0f") -> str:
     """A nominal drop's number, or "n/a (beyond validity at t = …)" when the drop left the contact
-    laws' validity (``physics.study.checks.beyond_validity``)."""
+    laws' validity (``physics.runs.study.checks.beyond_validity``)."""
     t = r.get("beyond_validity_at_s")
     return f"n/a (beyond validity at t = {t:.3f} s)" if t is not None else _f(r.get(key), spec)
 

@@ -17,7 +17,7 @@ import os
 from pathlib import Path
 from typing import IO, Sequence
 
-from .cli import UsageError
+from . import UsageError
 from .sweep import Evaluate, Run
 
 FORMAT = "rotordrop-drops/1"

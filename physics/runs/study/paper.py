@@ -1,10 +1,10 @@
 """The paper's three studies (spec §7) as one batch of drops: friction, support stiffness,
 support damping, plus the sensitivity of the results to every assumed [A] parameter.
 
-:func:`plan_runs` turns a :class:`Plan` into :class:`physics.sweep.Run` s (each labelled with the
+:func:`plan_runs` turns a :class:`Plan` into :class:`physics.runs.sweep.Run` s (each labelled with the
 study it belongs to), :func:`run_study` simulates them on a backend (keeping the full results of
 the nominal drops the figures draw) and :func:`analyse` reduces
-the outcomes to the numbers written to ``study.json``; :mod:`physics.study.report` draws the
+the outcomes to the numbers written to ``study.json``; :mod:`physics.runs.study.report` draws the
 figures and writes the Markdown report.
 """
 from __future__ import annotations
@@ -14,10 +14,10 @@ from typing import Any
 
 import numpy as np
 
-from ..metrics import worst_plane
-from ..results import Result
-from ..scene import Scene, SceneError, load_scene
-from ..simulate import IntegrationError, simulate
+from ...metrics import worst_plane
+from ...results import Result
+from ...scene import Scene, SceneError, load_scene
+from ...simulate import IntegrationError, simulate
 from ..backend import Backend, Dispatch, run_drops
 from ..sweep import Outcome, Run, changes, outcome_of, reproduce_command
 from .checks import as_drop, beyond_validity, split_valid, warning_counts
@@ -166,9 +166,9 @@ def run_study(plan: Plan, base: StudyInput, jobs: int | None = None, progress: b
     The nominal drops of the support studies (``member`` -1) are drawn in the figures, so they
     run here in this process and their full results come back too, as ``{study: {value:
     result}}``; an error in one of them stops the study, as a figure cannot be drawn without it.
-    The rest run on ``backend`` (:func:`physics.backend.run_drops`; with ``out`` each finished
+    The rest run on ``backend`` (:func:`physics.runs.backend.run_drops`; with ``out`` each finished
     drop is kept in ``out/drops``, and with ``resume`` only the missing ones run). A run that
-    ended before the fault is a failed drop (:func:`physics.study.checks.as_drop`).
+    ended before the fault is a failed drop (:func:`physics.runs.study.checks.as_drop`).
     """
     runs = plan_runs(plan, base)
     nominal = {r: simulate_figure_drop(r, f"the nominal drop of the support {r.label['study']} study"

@@ -28,8 +28,8 @@ from dataclasses import dataclass, field
 from numbers import Integral
 from typing import Any, Callable, Iterable, Sequence
 
-from .metrics import compute_metrics
-from .results import Result
+from ..metrics import compute_metrics
+from ..results import Result
 
 
 @dataclass(frozen=True)
@@ -57,7 +57,7 @@ class Run:
 
     def to_scene(self):
         """The :class:`physics.scene.Scene` this run simulates."""
-        from .scene import load_scene
+        from ..scene import load_scene
         return load_scene(self.scene, self.settings)
 
     def to_dict(self) -> dict:
@@ -122,8 +122,8 @@ def failed_outcome(run: Run, exc: Exception) -> Outcome:
 
 
 def _expected(exc: Exception) -> bool:
-    from .scene import SceneError
-    from .simulate import IntegrationError
+    from ..scene import SceneError
+    from ..simulate import IntegrationError
     return isinstance(exc, (SceneError, IntegrationError))
 
 
@@ -131,7 +131,7 @@ def plan_jobs(jobs: int | None, runs: int) -> tuple[int, str]:
     """Threads for ``runs`` drops: ``jobs`` (>= 1; None: all available cores) capped at the CPU
     count and at the number of drops, and a note saying so when ``jobs`` was capped ("" else)."""
     if jobs is not None and (isinstance(jobs, bool) or not isinstance(jobs, Integral) or jobs < 1):
-        from .cli import UsageError
+        from . import UsageError
         raise UsageError(f"--jobs must be an integer >= 1, got {jobs!r}")
     cpus = available_cores()
     used = max(1, min(cpus if jobs is None else jobs, cpus, runs))
@@ -240,8 +240,8 @@ def simulate_drop(run: Run, evaluate: Evaluate | None = None, compile_s: float =
                   bases: dict | None = None) -> Outcome:
     """One drop of a chunk whose kernels are loaded (``compile_s``: its share of the warm-up;
     ``bases``: the chunk's scenes without overrides by source, :func:`_base_scenes`)."""
-    from .model import build_model
-    from .simulate import run_model
+    from ..model import build_model
+    from ..simulate import run_model
     try:
         base = (bases or {}).get(run.scene)
         scene = base.with_overrides(run.settings) if base is not None else run.to_scene()
@@ -254,7 +254,7 @@ def _base_scenes(runs: Sequence[Run]) -> dict:
     """Each scene source of ``runs`` loaded once (``load_scene(source, overrides)`` is
     ``load_scene(source).with_overrides(overrides)``; parsing the TOML per drop cost more than
     the metrics). A source that fails to load is left out: its drops report the error."""
-    from .scene import load_scene
+    from ..scene import load_scene
     bases = {}
     for source in {run.scene for run in runs}:
         try:
@@ -267,8 +267,8 @@ def _base_scenes(runs: Sequence[Run]) -> dict:
 def _warm_up(run: Run) -> float:
     """Load the kernels once before the threads start (seconds; 0 when the scene is bad: its
     drop reports the error)."""
-    from .model import build_model
-    from .simulate import warm_up
+    from ..model import build_model
+    from ..simulate import warm_up
     try:
         return warm_up(build_model(run.to_scene()))
     except Exception:                                          # the drop itself reports it

@@ -5,7 +5,7 @@ import json
 import time
 from pathlib import Path
 
-from ..scene import load_scene
+from ...scene import load_scene
 from ..backend import Backend, plan_threads
 from . import report
 from .checks import warnings_note
@@ -70,7 +70,7 @@ def where(backend: dict, jobs: int | None) -> str:
 
 def friction_runs(base: StudyInput, plan: Plan) -> dict:
     """The nominal drops at the figure frictions (full time series, simulated here; the support
-    studies' nominal drops come from :func:`physics.study.paper.run_study`)."""
+    studies' nominal drops come from :func:`physics.runs.study.paper.run_study`)."""
     return {mu: simulate_figure_drop(base.run({"contact.friction": mu}),
                                      f"the friction figure's drop at contact.friction = {mu:g}")
             for mu in plan.figure_frictions}

@@ -1,6 +1,6 @@
 """How a parameter study names what it shows: the per-plane KPIs of a sweep cell and the grid
-values, shared by the tables and CSV of :mod:`physics.study.parametric` and the figures of
-:mod:`physics.study.report`."""
+values, shared by the tables and CSV of :mod:`physics.runs.study.parametric` and the figures of
+:mod:`physics.runs.study.report`."""
 from __future__ import annotations
 
 PLANE_KPIS = {"whirl_revolutions": "whirl revolutions", "peak_contact_force_N": "peak contact force [N]",

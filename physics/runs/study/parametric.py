@@ -3,12 +3,12 @@
 For retainer-bearing design: how do whirl, contact force and displacement change with, say,
 the support damping and the friction coefficient? Every grid cell is an ensemble of
 ``members`` equally plausible drops (unbalance angle and fault time perturbed as in the paper
-study, :mod:`physics.study.ensemble`), because near the whirl threshold one drop per cell is a
+study, :mod:`physics.runs.study.ensemble`), because near the whirl threshold one drop per cell is a
 coin toss. Per cell: whirl probability, whirl revolutions, peak contact force, maximum
 displacement, peak retainer-bearing load, contact friction heat and ball-race contact pressure
 (worst retainer plane; median and range over the members that have it), the runs that
 failed, with their errors (never dropped; a run that ended before the fault is a failed drop),
-and the drops per failed ``rotordrop drop`` check (:mod:`physics.study.checks`). Every run can
+and the drops per failed ``rotordrop drop`` check (:mod:`physics.runs.study.checks`). Every run can
 be repeated with the ``rotordrop drop`` command stored next to it.
 
 Values: ``KEY=V1,V2,...`` (numbers or choices, e.g. ``effects.friction=paper,kinematic``) or
@@ -27,8 +27,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..metrics import worst_plane
-from ..scene import SceneError, load_scene
+from ...metrics import worst_plane
+from ...scene import SceneError, load_scene
 from ..backend import Backend, plan_threads, run_drops
 from ..sweep import Outcome, Run
 from .checks import (WARNING_KINDS, as_drop, counts_text, split_valid, warning_counts,
@@ -101,7 +101,7 @@ def ensemble_keys(overrides: dict, axes: list[Axis]) -> list[str]:
 
 
 def plan_runs(source: str, overrides: dict, axes: list[Axis], members: int, seed: int) -> list[Run]:
-    """Cells (the product of the axes) × ensemble members, as :class:`~physics.sweep.Run`."""
+    """Cells (the product of the axes) × ensemble members, as :class:`~physics.runs.sweep.Run`."""
     if members < 1:
         raise SceneError(f"--members must be >= 1, got {members}")
     keys = ensemble_keys(overrides, axes)
@@ -125,8 +125,8 @@ def plan_runs(source: str, overrides: dict, axes: list[Axis], members: int, seed
 def summarize_cell(outcomes: list[Outcome]) -> dict:
     """Whirl probability and the median / min / max of each plane KPI over the members that ran
     and have it (None where none has it, e.g. the ball-race pressure of a linear mount), and the
-    drops per failed drop check (``warnings``, :mod:`physics.study.checks`). A run without a
-    fault is a failed drop (:func:`~physics.study.checks.as_drop`). Drops beyond the contact
+    drops per failed drop check (``warnings``, :mod:`physics.runs.study.checks`). A run without a
+    fault is a failed drop (:func:`~physics.runs.study.checks.as_drop`). Drops beyond the contact
     laws' validity count in ``beyond_validity`` and in the whirl probability, never in the KPIs."""
     ok = [o for o in outcomes if o.ok]
     valid, beyond = split_valid(ok)
