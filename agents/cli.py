@@ -16,8 +16,9 @@ from physics import cli as physics_cli
 from physics.runs.backend import add_backend_args
 from physics.cli import at_least
 
-from . import imitation, research
-from .hyperparams import ALGOS
+from . import research
+from .training import imitation
+from .learning.hyperparams import ALGOS
 
 OPTIONAL_RL_MODULES = ("gymnasium", "stable_baselines3", "torch", "tensorboard", "yaml")
 
@@ -73,8 +74,8 @@ def _number(text: str):
 
 def cmd_train(args) -> int:
     from physics.runs.backend import Backend
-    from .hyperparams import ConfigError
-    from .train import command_line, train
+    from .learning.hyperparams import ConfigError
+    from .training.train import command_line, train
     try:
         backend = Backend.from_args(args)
         common = dict(timesteps=args.timesteps, n_envs=args.n_envs, config=args.config,
@@ -85,7 +86,7 @@ def cmd_train(args) -> int:
             print(train(args.env, args.algo, args.out, seed=args.seed, resume=args.resume,
                         threads=args.threads, progress=not args.quiet, **common).summary())
             return 0
-        from .seeds import parse_seeds, seed_dir, train_seeds
+        from .training.seeds import parse_seeds, seed_dir, train_seeds
         if args.resume is not None:
             raise ValueError("--resume continues one run on --backend local; leave out --seeds "
                              "and --backend ray")
@@ -101,7 +102,7 @@ def cmd_train(args) -> int:
 
 
 def cmd_evaluate(args) -> int:
-    from .evaluate import evaluate, print_summary
+    from .benchmarking.evaluate import evaluate, print_summary
     try:
         report = evaluate(args.policy, args.env, args.episodes, args.out, env_kwargs=_env_kwargs(args),
                           seed=args.seed, plots=not args.no_plots, compare_passive=not args.no_passive,
@@ -113,7 +114,7 @@ def cmd_evaluate(args) -> int:
 
 
 def cmd_export_policy(args) -> int:
-    from .policies import export_policy, export_zoo
+    from .learning.policies import export_policy, export_zoo
     try:
         path = (export_zoo(args.source, args.zoo, args.env) if args.zoo
                 else export_policy(args.source, args.out, args.env))
@@ -127,7 +128,7 @@ def cmd_export_policy(args) -> int:
 
 def cmd_benchmark(args) -> int:
     from physics.runs.backend import Backend
-    from .robust import run_suite
+    from .benchmarking.robust import run_suite
     try:
         run_suite(args.suite, args.out, quick=args.quick, policies=args.policy,
                   max_scenarios=args.scenarios, episodes=args.episodes, progress=not args.quiet,
@@ -140,8 +141,8 @@ def cmd_benchmark(args) -> int:
 
 
 def cmd_ride_through(args) -> int:
-    from .ride_through import DELAYS, FRICTIONS, QUICK, ride_through, summary_table
-    from .benchmark import PHASES
+    from .benchmarking.ride_through import DELAYS, FRICTIONS, QUICK, ride_through, summary_table
+    from .benchmarking.benchmark import PHASES
     grid = QUICK if args.quick else dict(frictions=FRICTIONS, delays=DELAYS, phases=PHASES)
     try:
         report = ride_through(args.out, args.env, args.policy,
@@ -160,7 +161,7 @@ def cmd_ride_through(args) -> int:
 
 def cmd_tune(args) -> int:
     from physics.runs.backend import Backend
-    from .tune import tune
+    from .benchmarking.tune import tune
     try:
         r = tune(args.policy, args.env, args.gain, args.out, iterations=args.iterations,
                  population=args.population, elite=args.elite, seed=args.seed,
@@ -190,7 +191,7 @@ def _number_list(sep: str, count: int | None):
 
 
 def cmd_oracle(args) -> int:
-    from .oracle import oracle
+    from .research.oracle import oracle
     try:
         report = oracle(args.out, scenarios=args.scenarios, population=args.population,
                         iterations=args.iterations, seed=args.seed, policies=args.policy,
@@ -207,7 +208,7 @@ def cmd_oracle(args) -> int:
 
 
 def cmd_dataset(args) -> int:
-    from .dataset import load_snippet, parse_env_kwargs, write_dataset
+    from .training.dataset import load_snippet, parse_env_kwargs, write_dataset
     try:
         r = write_dataset(args.policy, args.env, args.episodes, args.out, seed=args.seed,
                           env_kwargs=parse_env_kwargs(args.env_kwarg), dataset_id=args.name,
@@ -439,12 +440,12 @@ def register(sub) -> None:
 
 
 def cmd_results(args) -> int:
-    from . import results
+    from .benchmarking import results
     return results.run(args)
 
 
 def register_results(sub) -> None:
-    from . import results
+    from .benchmarking import results
     p = sub.add_parser("results", help="docs/results.md and the README leaderboard from the "
                                        "benchmark output committed in docs/data")
     results.add_arguments(p)

@@ -3,7 +3,7 @@ import json
 
 import pytest
 
-from agents.controllers import BASELINES
+from agents.control.controllers import BASELINES
 
 from agents.cli import main
 
@@ -86,7 +86,7 @@ def test_evaluate_a_current_commanding_baseline_in_the_relevitation_env(tmp_path
 
 def test_ride_through_times_take_the_unbroken_run_of_safe_delays():
     import numpy as np
-    from agents.ride_through import ride_through_times
+    from agents.benchmarking.ride_through import ride_through_times
     delays = (0.0, 0.02, 0.04, 0.06)
     revs = np.array([[0.1, 0.2, 0.3, 0.4],        # safe throughout
                      [0.1, 3.2, 0.3, 0.4],        # a whirl at 20 ms: later luck does not count
@@ -125,12 +125,12 @@ def test_ride_through_errors_name_the_option(tmp_path, capsys):
     assert "re-levitation environment" in capsys.readouterr().err
     assert main(["ride-through", "--policy", "ppo-damping", "--out", str(tmp_path)]) == 2
     assert "trained on RotorDrop-Damping-v1" in capsys.readouterr().err
-    assert main(["ride-through", "--policy", "agents.plots:_plt", "--out", str(tmp_path)]) == 2
+    assert main(["ride-through", "--policy", "agents.benchmarking.plots:_plt", "--out", str(tmp_path)]) == 2
     assert "not a subclass" in capsys.readouterr().err
 
 
 def test_ride_through_cells_of_single_value_grids_have_a_width():
-    from agents.plots import _cell_edges
+    from agents.benchmarking.plots import _cell_edges
     assert _cell_edges([0.5], 0.05) == pytest.approx([0.475, 0.525])
     assert _cell_edges([0.0, 40.0, 100.0], 10.0) == pytest.approx([-20.0, 20.0, 70.0, 130.0])
 
@@ -141,7 +141,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from agents.controllers import Controller
+from agents.control.controllers import Controller
 
 
 @dataclass
@@ -169,8 +169,8 @@ class NotAController:
 
 def test_a_users_controller_class_is_evaluated_and_benchmarked_like_a_baseline(tmp_path, capsys,
                                                                                monkeypatch):
-    from agents.benchmark import _entries
-    from agents.controllers import load_controller
+    from agents.benchmarking.benchmark import _entries
+    from agents.control.controllers import load_controller
     path = tmp_path / "my_controllers.py"
     path.write_text(USER_CONTROLLER)
     spec = f"{path}:MidDamping"
@@ -185,7 +185,7 @@ def test_a_users_controller_class_is_evaluated_and_benchmarked_like_a_baseline(t
     assert tasks == {"damping", "full"}                  # not in relevitate: it has no damper
     monkeypatch.chdir(tmp_path)                          # module:Class finds modules next to you
     assert load_controller("my_controllers:MidDamping").name == "mid-damping"
-    monkeypatch.setattr("agents.benchmark.passive_threshold", None)      # fails before it
+    monkeypatch.setattr("agents.benchmarking.benchmark.passive_threshold", None)      # fails before it
     assert main(["benchmark", "--quick", "--quiet", "--policy", spec, "--policy",
                  f"{path}:SameName", "--out", str(tmp_path / "b")]) == 2
     assert "two controllers are named mid-damping" in capsys.readouterr().err
@@ -199,7 +199,7 @@ def test_a_users_controller_class_is_evaluated_and_benchmarked_like_a_baseline(t
 
 
 def test_benchmark_power_return_applies_to_every_scenario_without_its_own():
-    from agents.benchmark import _group, scenario_suite
+    from agents.benchmarking.benchmark import _group, scenario_suite
     suite = scenario_suite(0.38, power_return=0.04)
     late = [s for s in suite if s.name == "power back at 0.15 s"]
     assert late and late[0].env_kwargs == {"power_return_time": 0.15}
@@ -212,7 +212,7 @@ def test_benchmark_power_return_applies_to_every_scenario_without_its_own():
 
 
 def test_runs_of_one_policy_get_labels_that_tell_them_apart(tmp_path, monkeypatch):
-    from agents.benchmark import run_label
+    from agents.benchmarking.benchmark import run_label
     assert run_label("runs/s1/best/best_model.zip") == "s1/best"
     assert run_label("runs/s2/best/best_model.zip") == "s2/best"
     assert run_label("runs/s1/model.zip") == run_label("runs/s1") == run_label("runs/s1/") == "s1"
@@ -244,7 +244,7 @@ def test_evaluate_at_a_given_power_return(tmp_path, capsys):
 
 LEVEL_CONTROLLER = '''
 import numpy as np
-from agents.controllers import Controller
+from agents.control.controllers import Controller
 
 
 class Level(Controller):
@@ -274,8 +274,8 @@ def test_tune_moves_a_damper_level_towards_more_damping(tmp_path, capsys):
     """Between C_min and C_max more damping scores better (it holds the whirl off longer), so
     the search must raise the level from its start at mid-range; the reported validation score
     is what the validator gives for the reported gains."""
-    from agents.benchmark import Validator
-    from agents.controllers import load_controller
+    from agents.benchmarking.benchmark import Validator
+    from agents.control.controllers import load_controller
     path = tmp_path / "level.py"
     path.write_text(LEVEL_CONTROLLER)
     spec = f"{path}:Level"
@@ -312,8 +312,8 @@ def test_tune_moves_a_damper_level_towards_more_damping(tmp_path, capsys):
 
 def test_tune_json_holds_what_recomputes_its_validation_score(tmp_path):
     """The passive rows are in tune.json: J and the score follow from the file alone."""
-    from agents.benchmark import EPISODE_TIME
-    from agents.score import overall_score, row_cost
+    from agents.benchmarking.benchmark import EPISODE_TIME
+    from agents.benchmarking.score import overall_score, row_cost
     out = tmp_path / "tune"
     assert main(["tune", "--policy", "whirl-brake", "--env", "RotorDrop-Relevitate-v1",
                  "--gain", "kp=0.8:0.9", "--iterations", "0", "--quiet", "--no-plots",
@@ -332,7 +332,7 @@ def test_evaluate_actions_are_named_and_the_planes_tell_apart(tmp_path, monkeypa
     """actions.png: the legend names the actions (it said action[0..5]), and the plane-1 and
     plane-2 lines of a channel share a colour but not a line style (whirl-brake commands
     equal currents and dampers in both planes: one line hid the other)."""
-    import agents.plots as plots
+    import agents.benchmarking.plots as plots
     seen = {}
     finish = plots._finish_time_plot
 

@@ -27,7 +27,7 @@ def _flag_error(argv, capsys) -> str:
 
 # ---------------------------------------------------------------------------- JSON reports --
 def test_write_json_writes_null_for_non_finite_floats(tmp_path):
-    from agents.score import write_json
+    from agents.benchmarking.score import write_json
     path = write_json(tmp_path / "r.json", {"a": float("nan"), "b": np.float32(np.inf),
                                             "c": [1.5, np.nan], "d": np.array([2.0, -np.inf]),
                                             "e": (np.int64(3), True)})
@@ -85,7 +85,7 @@ def test_power_return_after_the_episode_is_an_error(tmp_path, capsys):
 def test_a_ride_through_time_at_the_end_of_the_grid_is_a_lower_bound(tmp_path):
     """At mu = 0.3 (the passive drop rests) whirl-brake holds at every delay of the grid: the
     JSON says that 10 ms is a lower bound, as the table's "≥" does."""
-    from agents.ride_through import summary_table
+    from agents.benchmarking.ride_through import summary_table
     out = tmp_path / "rt"
     assert main(["ride-through", "--policy", "whirl-brake", "--friction", "0.3", "--delay-ms", "0",
                  "--delay-ms", "10", "--phase", "0", "--quiet", "--no-plots", "--out", str(out)]) == 0
@@ -110,7 +110,7 @@ def test_a_negative_seed_is_a_flag_error(argv, capsys, tmp_path):
 # ----------------------------------------------------------------------------------- tune --
 SWITCH_CONTROLLER = '''
 import numpy as np
-from agents.controllers import Controller
+from agents.control.controllers import Controller
 
 
 class Switch(Controller):
@@ -141,12 +141,12 @@ def test_tune_names_only_the_gains_the_class_does_not_take(tmp_path, capsys):
 
 # ------------------------------------------------------------- controller file's neighbours --
 def test_a_controller_file_imports_the_modules_next_to_it(tmp_path, monkeypatch):
-    from agents.controllers import load_controller
+    from agents.control.controllers import load_controller
     folder = tmp_path / "mine"
     folder.mkdir()
     (folder / "eval_fix_helper_gains.py").write_text("LEVEL = 0.25\n")
     (folder / "ctrl.py").write_text(
-        "import numpy as np\nfrom agents.controllers import Controller\n"
+        "import numpy as np\nfrom agents.control.controllers import Controller\n"
         "from eval_fix_helper_gains import LEVEL\n\n\n"
         "class H(Controller):\n    name = 'h-damping'\n    needs = ('damping',)\n\n"
         "    def commands(self, obs):\n        return {'damping': np.full((len(obs), 2), LEVEL)}\n")
@@ -158,8 +158,8 @@ def test_a_controller_file_imports_the_modules_next_to_it(tmp_path, monkeypatch)
 # ---------------------------------------------------------------------- learned policies --
 def _checkpoint_run(tmp_path, with_stats: bool = True):
     """A run directory holding the shipped ppo-damping as SB3's CheckpointCallback names it."""
-    from agents.hyperparams import dump_yaml
-    from agents.policies import shipped_dir
+    from agents.learning.hyperparams import dump_yaml
+    from agents.learning.policies import shipped_dir
     run = tmp_path / "myrun"
     (run / "checkpoints").mkdir(parents=True)
     meta = json.loads((shipped_dir() / "ppo-damping.json").read_text())
@@ -176,7 +176,7 @@ def _checkpoint_run(tmp_path, with_stats: bool = True):
 
 
 def test_a_checkpoint_loads_its_vecnormalize_statistics(tmp_path):
-    from agents.policies import LearnedPolicy, load_shipped
+    from agents.learning.policies import LearnedPolicy, load_shipped
     pol = LearnedPolicy.load(_checkpoint_run(tmp_path))
     shipped = load_shipped("ppo-damping")
     assert pol.vecnormalize is not None
@@ -219,7 +219,7 @@ def test_evaluate_labels_a_run_and_compares_returns_at_its_control_step(tmp_path
 
 # --------------------------------------------------------- user controllers fail fast --
 BROKEN_CONTROLLER = '''
-from agents.controllers import Controller
+from agents.control.controllers import Controller
 
 
 class Broken(Controller):
@@ -245,11 +245,11 @@ def _long_work(*args, **kwargs):
 
 
 @pytest.mark.parametrize("cmd, cls, patch", [
-    (["benchmark", "--quick", "--quiet"], "Broken", "agents.benchmark.passive_threshold"),
-    (["ride-through", "--quiet", "--quick"], "BrokenCurrents", "agents.ride_through.run_episodes"),
+    (["benchmark", "--quick", "--quiet"], "Broken", "agents.benchmarking.benchmark.passive_threshold"),
+    (["ride-through", "--quiet", "--quick"], "BrokenCurrents", "agents.benchmarking.ride_through.run_episodes"),
     (["tune", "--env", "RotorDrop-Damping-v1", "--gain", "k=0:1", "--quiet"], "Broken",
-     "agents.tune.Validator"),
-    (["evaluate", "--env", "RotorDrop-Damping-v1"], "Broken", "agents.evaluate.run_episodes")])
+     "agents.benchmarking.tune.Validator"),
+    (["evaluate", "--env", "RotorDrop-Damping-v1"], "Broken", "agents.benchmarking.evaluate.run_episodes")])
 def test_a_broken_user_controller_fails_before_long_work(cmd, cls, patch, tmp_path, capsys,
                                                          monkeypatch):
     path = tmp_path / "broken.py"
@@ -264,8 +264,8 @@ def test_a_broken_user_controller_fails_before_long_work(cmd, cls, patch, tmp_pa
 # ------------------------------------------------- review 2: names, refusals, table digits --
 def _named_run(tmp_path, run: str, name: str):
     """A run directory holding the shipped ppo-damping under the policy name ``name``."""
-    from agents.hyperparams import dump_yaml
-    from agents.policies import shipped_dir
+    from agents.learning.hyperparams import dump_yaml
+    from agents.learning.policies import shipped_dir
     folder = tmp_path / run
     folder.mkdir()
     meta = json.loads((shipped_dir() / "ppo-damping.json").read_text())
@@ -283,15 +283,15 @@ class _Stop(Exception):
 def test_the_benchmark_names_every_run_name_at_run_as_evaluate_does(tmp_path, monkeypatch):
     """Two runs of a policy no shipped one is named like: both are name@run (the first was
     bare, the second got @run only because of the clash); evaluate's label is the same."""
-    from agents.benchmark import benchmark, policy_label
-    from agents.policies import LearnedPolicy
+    from agents.benchmarking.benchmark import benchmark, policy_label
+    from agents.learning.policies import LearnedPolicy
     run_a, run_b = _named_run(tmp_path, "runA", "ppo-mine"), _named_run(tmp_path, "runB", "ppo-mine")
     seen = []
 
     def entries_then_stop(entries):
         seen.extend(e.name for e in entries)
         raise _Stop                                 # before the long work
-    monkeypatch.setattr("agents.benchmark.check_unique_names", entries_then_stop)
+    monkeypatch.setattr("agents.benchmarking.benchmark.check_unique_names", entries_then_stop)
     with pytest.raises(_Stop):
         benchmark(tmp_path / "b", policies=[run_a, run_b, "ppo-damping"], progress=False)
     mine = [n for n in seen if n.startswith("ppo-mine")]
@@ -309,7 +309,7 @@ def test_ride_through_refuses_a_controller_that_cannot_relevitate_up_front(
         argv, name, commands, tmp_path, capsys, monkeypatch):
     """It failed after 6 of 24 episodes with a channels message (Relevitate) or printed a row
     of "none" (Full): the power return the map varies never reaches such a controller."""
-    monkeypatch.setattr("agents.ride_through.run_episodes", _long_work)
+    monkeypatch.setattr("agents.benchmarking.ride_through.run_episodes", _long_work)
     assert main(["ride-through", *argv, "--policy", "whirl-brake", "--policy", name, "--quiet",
                  "--out", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err.strip()
@@ -322,7 +322,7 @@ def test_ride_through_refuses_a_controller_that_cannot_relevitate_up_front(
 def test_ride_through_refuses_a_users_damping_class_alike(tmp_path, capsys, monkeypatch):
     path = tmp_path / "switch.py"
     path.write_text(SWITCH_CONTROLLER)
-    monkeypatch.setattr("agents.ride_through.run_episodes", _long_work)
+    monkeypatch.setattr("agents.benchmarking.ride_through.run_episodes", _long_work)
     assert main(["ride-through", "--env", "RotorDrop-Full-v1", "--policy", f"{path}:Switch",
                  "--quiet", "--out", str(tmp_path / "o")]) == 2
     assert "switch-damping commands damping only" in capsys.readouterr().err
@@ -330,7 +330,7 @@ def test_ride_through_refuses_a_users_damping_class_alike(tmp_path, capsys, monk
 
 def test_leaderboard_scores_show_the_digits_that_rank_them():
     """13.08 and 13.07 rank apart: the table must not show both as 13.1."""
-    from agents.benchmark import leaderboard_markdown
+    from agents.benchmarking.benchmark import leaderboard_markdown
     entry = dict(task="damping", whirl_rate=0.73, whirl_rate_where_passive_whirls=0.97,
                  force_ratio=0.75, max_force_ratio=1.09, displacement_ratio=0.84,
                  relevitation_rate=None, stator_contact_rate=0.85)

@@ -4,9 +4,9 @@ and per-episode state that leaks from one episode into the next."""
 import numpy as np
 import pytest
 
-from agents.controllers import BASELINES, Controller, Passive, check_controller, make_controller
-from agents.plant import ControllerError, Plant, make_env
-from agents.rollout import check_actor, run_episodes
+from agents.control.controllers import BASELINES, Controller, Passive, check_controller, make_controller
+from agents.control.plant import ControllerError, Plant, make_env
+from agents.benchmarking.rollout import check_actor, run_episodes
 
 SHORT = dict(episode_time=0.03, terminate_on_failure=False)
 CONTINUOUS = dict(command="continuous", **SHORT)
@@ -145,7 +145,7 @@ def test_a_reset_that_skips_the_base_reset_is_named(damping):
 
 
 BAD_FILE = '''
-from agents.controllers import Controller
+from agents.control.controllers import Controller
 
 
 class Typo(Controller):
@@ -226,7 +226,7 @@ def test_check_actor_passes_every_supported_baseline(env_id, kw):
 
 @pytest.mark.parametrize("name", ["ppo-damping", "ppo-full"])
 def test_check_actor_passes_shipped_policies(name):
-    from agents.policies import load_shipped
+    from agents.learning.policies import load_shipped
     policy = load_shipped(name)
     check_actor(policy.env_id, policy.bound, dict(policy.env_kwargs, **SHORT))
 

@@ -2,10 +2,10 @@
 import numpy as np
 import pytest
 
-from agents.controllers import (BASELINES, BuiltinRelevitate, MaxDamping, Passive, PidRelevitate,
+from agents.control.controllers import (BASELINES, BuiltinRelevitate, MaxDamping, Passive, PidRelevitate,
                                 WhirlBrake, WhirlSwitch, make_baseline)
-from agents.plant import Plant, make_env
-from agents.rollout import run_episodes
+from agents.control.plant import Plant, make_env
+from agents.benchmarking.rollout import run_episodes
 from physics.metrics import WHIRL_MIN_REVOLUTIONS
 
 SHORT = dict(episode_time=0.03, terminate_on_failure=False)
@@ -111,7 +111,7 @@ def _kpis(env_id, cls, mu, **kw):
 
 
 def _shipped_full(plant):
-    from agents.policies import load_shipped
+    from agents.learning.policies import load_shipped
     return load_shipped("ppo-full").bound(plant)
 
 

@@ -7,12 +7,12 @@ import pytest
 import torch
 import yaml
 
-from agents.config_checks import ConfigError
-from agents.hyperparams import algo_class, load_hyperparams, split
-from agents.plant import Plant
-from agents.policies import LearnedPolicy
+from agents.learning.config_checks import ConfigError
+from agents.learning.hyperparams import algo_class, load_hyperparams, split
+from agents.control.plant import Plant
+from agents.learning.policies import LearnedPolicy
 from agents.sb3_policy import FrameStack
-from agents.train import train
+from agents.training.train import train
 
 torch.set_num_threads(1)
 ENV = "RotorDrop-Damping-v1"

@@ -4,10 +4,10 @@ policies trained on the full state evaluate, rl-zoo3's ``train_freq: [1, episode
 import numpy as np
 import pytest
 
-from agents.controllers import Controller, make_baseline
-from agents.hyperparams import ConfigError, algo_class, split
-from agents.plant import ControllerError, Plant, make_env
-from agents.rollout import run_episodes
+from agents.control.controllers import Controller, make_baseline
+from agents.learning.hyperparams import ConfigError, algo_class, split
+from agents.control.plant import ControllerError, Plant, make_env
+from agents.benchmarking.rollout import run_episodes
 
 SHORT = dict(episode_time=0.03, terminate_on_failure=False)
 WHIRL = dict(overrides={"contact.friction": 0.45}, **SHORT)
@@ -130,7 +130,7 @@ def test_passive_on_the_full_state_is_the_passive_drop_and_records_the_sensor_or
 
 def _save_policy(path, env_id, env_kwargs, algo="td3", best=False):
     """A freshly initialised SB3 model saved as ``rotordrop train`` would (its config.yaml)."""
-    from agents.hyperparams import dump_yaml
+    from agents.learning.hyperparams import dump_yaml
     env = make_env(env_id, **env_kwargs)
     model = algo_class(algo)("MlpPolicy", env, seed=0, device="cpu", learning_starts=0)
     env.close()
@@ -143,7 +143,7 @@ def _save_policy(path, env_id, env_kwargs, algo="td3", best=False):
 
 
 def test_a_policy_trained_on_the_full_state_is_evaluated_against_passive(tmp_path):
-    from agents.evaluate import evaluate
+    from agents.benchmarking.evaluate import evaluate
     _save_policy(tmp_path / "run", "RotorDrop-Damping-v1", dict(full_state=True))
     report = evaluate(str(tmp_path / "run"), None, 1, tmp_path / "ev", env_kwargs=dict(WHIRL),
                       randomize=False)
@@ -153,7 +153,7 @@ def test_a_policy_trained_on_the_full_state_is_evaluated_against_passive(tmp_pat
 
 
 def test_a_residual_on_a_sensor_controller_refuses_full_state_training():
-    from agents.train import check_env
+    from agents.training.train import check_env
     meta, _ = split(dict(residual="whirl-switch", env_kwargs=dict(full_state=True)))
     with pytest.raises(ConfigError, match="residual: .*needs the sensor observations.*full_state"):
         check_env("RotorDrop-Damping-v1", "td3", meta)
@@ -178,7 +178,7 @@ def test_train_freq_per_episode_with_several_envs_is_refused_naming_n_envs():
 def test_a_runs_best_directory_loads_as_a_policy(tmp_path):
     """``--policy RUN/best``: best_model.zip and vecnormalize.pkl there, config.yaml in RUN."""
     from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
-    from agents.policies import LearnedPolicy
+    from agents.learning.policies import LearnedPolicy
     model = _save_policy(tmp_path, "RotorDrop-Damping-v1", SHORT, best=True)
     vn = VecNormalize(DummyVecEnv([lambda: make_env("RotorDrop-Damping-v1", **SHORT)]))
     vn.obs_rms.mean[:] = 0.5

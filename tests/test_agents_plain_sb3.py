@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 import torch
 
-from agents.controllers import BASELINES, make_baseline
-from agents.hyperparams import algo_class
-from agents.plant import Plant
-from agents.policies import LearnedPolicy, export_policy, load_shipped, shipped_dir, shipped_names
-from agents.residual import residual_action
+from agents.control.controllers import BASELINES, make_baseline
+from agents.learning.hyperparams import algo_class
+from agents.control.plant import Plant
+from agents.learning.policies import LearnedPolicy, export_policy, load_shipped, shipped_dir, shipped_names
+from agents.control.residual import residual_action
 from agents.sb3_policy import export_self_contained, is_self_contained
 
 torch.set_num_threads(1)
@@ -151,7 +151,7 @@ def test_export_reads_env_and_residual_from_the_models_training_env(tmp_path):
     """export_self_contained(model, vecnormalize, path): what the run's env says is inside."""
     from stable_baselines3 import PPO
     from stable_baselines3.common.vec_env import VecNormalize
-    from agents.residual import ResidualAction
+    from agents.control.residual import ResidualAction
     from rotordrop_env import make_batched
     kw = dict(command="continuous", episode_time=0.02)
     venv = VecNormalize(ResidualAction(make_batched("RotorDrop-Relevitate-v1", 2, seed=0,

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from agents.plant import Plant, make_env
-from agents.policies import load_shipped, shipped_names
+from agents.control.plant import Plant, make_env
+from agents.learning.policies import load_shipped, shipped_names
 
 
 def test_three_policies_ship_with_their_recipe():
@@ -26,8 +26,8 @@ def test_shipped_policy_command_names_the_config_that_gave_its_hyperparameters(n
     import ast
     import shlex
     from agents.cli import build_parser
-    from agents.hyperparams import RUN_DEFAULTS
-    from agents.train import resolve_config
+    from agents.learning.hyperparams import RUN_DEFAULTS
+    from agents.training.train import resolve_config
     pol = load_shipped(name)
     argv = shlex.split(pol.meta["command"].split("#")[0])
     assert argv[:2] == ["rotordrop", "train"] and "--config" in argv

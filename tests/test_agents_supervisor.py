@@ -2,10 +2,10 @@
 import numpy as np
 import pytest
 
-from agents.benchmark import controller_env_kwargs
-from agents.controllers import BASELINES, InnerLoop, WhirlBrake, WhirlBrakeSupervisor, command_for
-from agents.plant import Plant, make_env
-from agents.rollout import run_episodes
+from agents.benchmarking.benchmark import controller_env_kwargs
+from agents.control.controllers import BASELINES, InnerLoop, WhirlBrake, WhirlBrakeSupervisor, command_for
+from agents.control.plant import Plant, make_env
+from agents.benchmarking.rollout import run_episodes
 
 FULL = "RotorDrop-Full-v1"
 KW = dict(command="supervisor", episode_time=0.15, terminate_on_failure=False,
@@ -69,7 +69,7 @@ def test_inner_loop_lift_commands_constants_and_switches_on_at_the_power_return(
     on both planes (no tangential offset) at every step, at its 5 ms control step; the built-in
     PID engages in the step the power returns (20 ms), not before; and the lift-assist
     re-levitates sooner than the plain inner loop on the same drop."""
-    from agents.controllers import InnerLoopLift
+    from agents.control.controllers import InnerLoopLift
     kw = {**KW, **controller_env_kwargs(InnerLoopLift, FULL)}
     assert kw["control_dt"] == 0.005 and BASELINES["inner-loop-lift"] is InnerLoopLift
     env = make_env(FULL, **kw)
@@ -102,7 +102,7 @@ def test_inner_loop_constants_are_checked():
 
 
 def test_inner_loop_lift_is_a_full_task_baseline_of_both_suites():
-    from agents.benchmark import _entries, robust_entries
+    from agents.benchmarking.benchmark import _entries, robust_entries
     entries = {(e.task, e.name): e for e in _entries([])}
     assert entries[("full", "inner-loop-lift")].env_kwargs == {"command": "supervisor",
                                                                 "control_dt": 0.005}

@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 import torch
 
-from agents.hyperparams import ConfigError, algo_class, load_hyperparams, split
-from agents.policies import LearnedPolicy
+from agents.learning.hyperparams import ConfigError, algo_class, load_hyperparams, split
+from agents.learning.policies import LearnedPolicy
 from agents.sb3_policy import is_self_contained, zip_algo
-from agents.train import train
+from agents.training.train import train
 
 torch.set_num_threads(1)
 ENV = "RotorDrop-Relevitate-v1"

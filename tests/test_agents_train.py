@@ -5,7 +5,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from agents.hyperparams import (ConfigError, load_hyperparams, parse_literal, read_yaml, schedule,
+from agents.learning.hyperparams import (ConfigError, load_hyperparams, parse_literal, read_yaml, schedule,
                                 split)
 
 from helpers import phys
@@ -16,7 +16,7 @@ ENV_IDS = ("RotorDrop-Damping-v1", "RotorDrop-Relevitate-v1", "RotorDrop-Full-v1
 @pytest.mark.parametrize("algo", ["ppo", "sac", "td3", "tqc"])
 def test_shipped_configs_parse(algo):
     from gymnasium.spaces import Box
-    from agents.plant import make_env
+    from agents.control.plant import make_env
     for env_id in ENV_IDS:
         meta, kwargs = split(load_hyperparams(algo, env_id))
         assert meta["n_timesteps"] > 0 and meta["n_envs"] >= 1
@@ -35,8 +35,8 @@ ENTRIES = [(algo, key) for algo in ("ppo", "sac", "td3", "tqc")
 
 
 def _check(algo, env_id, config):
-    from agents.hyperparams import check_sb3
-    from agents.train import check_env, resolve_config
+    from agents.learning.hyperparams import check_sb3
+    from agents.training.train import check_env, resolve_config
     meta, kwargs = split(resolve_config(env_id, algo, config))
     check_sb3(algo, env_id, meta, kwargs)
     check_env(env_id, algo, meta)
@@ -133,7 +133,7 @@ def test_scientific_notation_in_a_config_is_a_number(tmp_path):
 @pytest.fixture(scope="module")
 def trained(tmp_path_factory):
     """A 2048-step PPO run on the damping task with checkpoints every 1024 steps."""
-    from agents.train import train
+    from agents.training.train import train
     out = tmp_path_factory.mktemp("ppo")
     cfg = out / "tiny.yaml"
     cfg.write_text("RotorDrop-Damping-v1:\n  n_steps: 256\n  batch_size: 128\n  n_epochs: 2\n"
@@ -145,8 +145,8 @@ def trained(tmp_path_factory):
 
 
 def test_training_saves_a_loadable_model(trained):
-    from agents.plant import Plant, make_env
-    from agents.policies import LearnedPolicy
+    from agents.control.plant import Plant, make_env
+    from agents.learning.policies import LearnedPolicy
     res, _ = trained
     run = res.out
     for f in ("model.zip", "vecnormalize.pkl", "config.yaml", "training.json",
@@ -172,7 +172,7 @@ def test_training_saves_a_loadable_model(trained):
 
 
 def test_training_resumes_from_a_checkpoint(trained, tmp_path):
-    from agents.train import find_checkpoint, train
+    from agents.training.train import find_checkpoint, train
     res, cfg = trained
     ckpt, vn, _ = find_checkpoint(res.out)
     assert ckpt.name == "rl_model_2048_steps.zip" and vn is not None
@@ -212,7 +212,7 @@ W = dict(w_whirl=2.0, w_verdict=0.5, w_severity=0.3, w_force=0.25, w_disp=0.75, 
 def test_kpi_potential_charges_the_whirl_verdict_at_three_revolutions():
     """w_verdict is a step at the benchmark's whirl verdict (3 net backward revolutions), on top
     of the capped ramp; with w_whirl 0.25 and w_verdict 0.75 a whirl costs 1, as in J."""
-    from agents.reward import kpi_potential
+    from agents.learning.reward import kpi_potential
     w = dict(w_whirl=0.25, w_verdict=0.75, w_force=0.0, w_disp=0.0, force_ref=1.0, disp_ref_um=1.0)
     phi = kpi_potential(np.array([0.0, 1.5, 2.999, 3.0, 7.0]), 0.0, 0.0, **w)
     np.testing.assert_allclose(phi, [0.0, 0.125, 0.25 * 2.999 / 3, 1.0, 1.0])
@@ -221,14 +221,14 @@ def test_kpi_potential_charges_the_whirl_verdict_at_three_revolutions():
 
 
 def _final_potential(info: dict) -> float:
-    from agents.reward import PEAK_KEYS, kpi_potential
+    from agents.learning.reward import PEAK_KEYS, kpi_potential
     return kpi_potential(*(info[k] for k in PEAK_KEYS), **W)
 
 
 def test_kpi_reward_returns_minus_the_episode_cost():
     """The KPI reward telescopes: an episode's return is minus the potential of its final KPIs
     (peak backward revolutions capped at 3, peak force, max displacement; weights as given)."""
-    from agents.training_env import make_vec_env
+    from agents.training.training_env import make_vec_env
     venv = make_vec_env("RotorDrop-Damping-v1", 2, 0, dict(
         episode_time=0.06, terminate_on_failure=False, overrides={"contact.friction": 0.6}),
         reward="kpi", reward_kwargs=W)
@@ -251,7 +251,7 @@ def test_kpi_reward_returns_minus_the_episode_cost():
 def test_residual_zero_action_is_the_base_controller():
     """With residual: max-damping, an agent action of 0 commands C_max: the damper state follows
     its 10 ms first-order lag to C_max (spec §6); an action of -1 commands C_min."""
-    from agents.training_env import make_vec_env
+    from agents.training.training_env import make_vec_env
     from physics.scene import load_scene
     s = load_scene("paper").support
     for a, target in ((0.0, s.damping_max), (-1.0, s.damping_min)):
@@ -267,7 +267,7 @@ def test_residual_zero_action_is_the_base_controller():
 def test_kpi_reward_charges_the_time_before_relevitation():
     """Re-levitation tasks: the return is minus the final KPI potential, plus w_relevitate once,
     minus w_time * dt / T for every step before re-levitation (the score's T_R / T term)."""
-    from agents.training_env import make_vec_env
+    from agents.training.training_env import make_vec_env
     kw = dict(episode_time=0.15, terminate_on_failure=False, command="discrete",
               power_return_time=0.02, overrides={"contact.friction": 0.1})
     venv = make_vec_env("RotorDrop-Relevitate-v1", 1, 0, kw, reward="kpi",
@@ -291,10 +291,10 @@ def test_validation_keeps_the_best_model_by_validation_score(tmp_path):
     """validation: true scores each evaluation on the validation suite, records the score in the
     learning curve and keeps the best-scoring model in best/; residual_scale is saved and a
     residual policy at a ~zero action scores what its base scores."""
-    from agents.benchmark import Validator
-    from agents.controllers import WhirlBrake
-    from agents.policies import LearnedPolicy
-    from agents.train import train
+    from agents.benchmarking.benchmark import Validator
+    from agents.control.controllers import WhirlBrake
+    from agents.learning.policies import LearnedPolicy
+    from agents.training.train import train
     cfg = tmp_path / "val.yaml"
     cfg.write_text("RotorDrop-Full-v1:\n  n_steps: 128\n  batch_size: 128\n  n_epochs: 1\n"
                    "  eval_freq: 512\n  n_eval_episodes: 1\n  checkpoint_freq: 0\n"
@@ -332,7 +332,7 @@ def _tiny(tmp_path, extra: str = "", name: str = "tiny.yaml"):
 
 
 def _train(cfg, out, timesteps, **kw):
-    from agents.train import train
+    from agents.training.train import train
     return train("RotorDrop-Damping-v1", kw.pop("algo", "ppo"), out, timesteps=timesteps,
                  config=cfg, progress=False, **kw)
 
@@ -358,7 +358,7 @@ def test_config_errors_name_the_key_before_anything_is_written(tmp_path, extra, 
 
 
 def test_config_errors_of_the_action_space_and_the_algorithm(tmp_path):
-    from agents.train import train
+    from agents.training.train import train
     cfg = tmp_path / "relev.yaml"
     cfg.write_text("RotorDrop-Relevitate-v1:\n  env_kwargs: {command: discrete}\n")
     # the shipped Relevitate config trains a residual on whirl-brake, which needs the currents
@@ -386,7 +386,7 @@ def test_config_errors_reach_the_cli_as_one_line(tmp_path, capsys):
 
 def test_resume_checks_the_algorithm_and_the_env_of_the_run(trained, tmp_path):
     import shutil
-    from agents.train import train
+    from agents.training.train import train
     res, cfg = trained
     with pytest.raises(ConfigError, match=r"--algo sac does not match the run resumed from .*"
                                           r"rl_model_2048_steps.zip, trained with --algo ppo"):

@@ -162,7 +162,7 @@ def test_a_killed_driver_loses_no_finished_drop(tmp_path):
 
 
 def test_train_seeds_are_checked_before_anything_runs(tmp_path, capsys):
-    from agents.seeds import parse_seeds
+    from agents.training.seeds import parse_seeds
     assert parse_seeds("0,1, 2") == [0, 1, 2]
     for bad in ("", "a,b", "0,0", "-1"):
         with pytest.raises(ValueError, match="--seeds expects distinct integers >= 0"):

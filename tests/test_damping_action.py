@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import rotordrop_env  # noqa: F401  (registers the ids)
-from agents.plant import Plant
+from agents.control.plant import Plant
 
 from helpers import run_env_checkers
 

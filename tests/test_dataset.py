@@ -9,9 +9,9 @@ import pytest
 minari = pytest.importorskip("minari")
 
 from agents.cli import main
-from agents.dataset import info_arrays, info_columns, write_dataset
-from agents.evaluate import _actor, _merge_kwargs
-from agents.plant import Plant, make_env
+from agents.training.dataset import info_arrays, info_columns, write_dataset
+from agents.benchmarking.evaluate import _actor, _merge_kwargs
+from agents.control.plant import Plant, make_env
 
 FULL = "RotorDrop-Full-v1"
 DAMPING = "RotorDrop-Damping-v1"
@@ -19,7 +19,7 @@ DAMPING = "RotorDrop-Damping-v1"
 
 def _replay(policy, env_id, user_kwargs, seeds, randomize=True):
     """The episodes as evaluate would run them, written out here step by step (not through
-    agents.dataset): [(observations, actions, rewards, terminated, truncated, infos)]."""
+    agents.training.dataset): [(observations, actions, rewards, terminated, truncated, infos)]."""
     make_actor, env_id, base, _ = _actor(policy, env_id)
     env = make_env(env_id, **_merge_kwargs(base, user_kwargs, randomize))
     plant = Plant.from_env(env)
@@ -68,7 +68,7 @@ def _check_round_trip(ds, expected, seeds):
 
 
 def test_whirl_brake_on_full_round_trips_through_minari(tmp_path, monkeypatch):
-    monkeypatch.setattr("agents.dataset.CHUNK", 2)          # written in two parts: 2 + 1
+    monkeypatch.setattr("agents.training.dataset.CHUNK", 2)          # written in two parts: 2 + 1
     seeds = [5, 6, 7]
     kw = {"episode_time": 0.06}
     r = write_dataset("whirl-brake", FULL, 3, tmp_path / "root", seed=5, env_kwargs=kw,
@@ -95,7 +95,7 @@ def test_damping_controller_round_trips_with_fixed_scene(tmp_path):
                  "--seed", "3", "--out", str(tmp_path), "--name", "damping/switch-v1", "--quiet",
                  "--env-kwarg", "episode_time=0.05", "--env-kwarg", "randomize=False",
                  "--env-kwarg", "overrides={'contact.friction': 0.45}"]) == 0
-    from agents.dataset import load
+    from agents.training.dataset import load
     ds = load("damping/switch-v1", tmp_path)
     assert ds.storage.metadata["rotordrop"]["policy_name"] == "whirl-switch"
     _check_round_trip(ds, _replay("whirl-switch", DAMPING, kw, [3, 4], randomize=False), [3, 4])
@@ -143,9 +143,9 @@ def test_bad_input_is_one_line_naming_the_parameter(tmp_path, capsys, args, name
 
 
 def test_bc_clones_the_teacher_and_runs_in_the_benchmark(tmp_path):
-    from agents.benchmark import Entry, scenario_suite, suite_rows, extras
-    from agents.dataset import load
-    from agents.imitation import dataset_arrays, train_bc
+    from agents.benchmarking.benchmark import Entry, scenario_suite, suite_rows, extras
+    from agents.training.dataset import load
+    from agents.training.imitation import dataset_arrays, train_bc
     root = tmp_path / "root"
     r = write_dataset("whirl-brake", FULL, 6, root, env_kwargs={"episode_time": 0.06},
                       progress=False)
@@ -181,7 +181,7 @@ def test_bc_clones_the_teacher_and_runs_in_the_benchmark(tmp_path):
 
 
 def test_bc_refuses_discrete_actions(tmp_path):
-    from agents.imitation import train_bc
+    from agents.training.imitation import train_bc
     r = write_dataset("builtin-relevitate", "RotorDrop-Relevitate-v1", 1, tmp_path,
                       env_kwargs={"episode_time": 0.06}, progress=False)
     with pytest.raises(ValueError, match="Box"):
@@ -212,7 +212,7 @@ def test_dataset_without_minari_names_the_offline_extra(tmp_path):
 
 
 def test_duplicate_columns_names_pairs_equal_in_every_sample():
-    from agents.imitation import duplicate_columns
+    from agents.training.imitation import duplicate_columns
     x = np.array([[1.0, 1.0, 5.0, 0.0, 2.0], [2.0, 2.0, 5.0, 0.0, 2.0], [3.0, 3.0, 5.0, 0.0, 3.0]])
     assert duplicate_columns(x, ["a", "b", "c", "d", "e"]) == [("a", "b")]   # constants do not count
     x[1, 1] += 1e-6
@@ -220,7 +220,7 @@ def test_duplicate_columns_names_pairs_equal_in_every_sample():
 
 
 FAILING = """
-from agents.controllers import Controller
+from agents.control.controllers import Controller
 import numpy as np
 
 class Flaky(Controller):
@@ -240,7 +240,7 @@ class Flaky(Controller):
 
 
 def test_a_failure_midway_leaves_no_data_set(tmp_path, capsys, monkeypatch):
-    monkeypatch.setattr("agents.dataset.CHUNK", 1)          # episodes 0 and 1 are on disk then
+    monkeypatch.setattr("agents.training.dataset.CHUNK", 1)          # episodes 0 and 1 are on disk then
     (tmp_path / "flaky.py").write_text(FAILING)
     spec = f"{tmp_path / 'flaky.py'}:Flaky"
     assert main(["dataset", "--policy", spec, "--env", DAMPING, "--episodes", "4", "--quiet",
@@ -254,7 +254,7 @@ def test_a_shipped_policy_round_trips_on_its_own_environment(tmp_path):
     r = write_dataset("ppo-damping", None, 2, tmp_path, seed=11,
                       env_kwargs={"episode_time": 0.03}, progress=False)
     assert r["env_id"] == DAMPING and r["dataset_id"] == "rotordrop/damping/ppo-damping-v0"
-    from agents.dataset import load, replay
+    from agents.training.dataset import load, replay
     ds = load(r["dataset_id"], tmp_path)
     for i in range(2):
         again = replay(ds, i)
@@ -272,7 +272,7 @@ def test_bc_command_line(tmp_path, capsys):
     assert main(["bc", "--dataset", "rotordrop/damping/whirl-switch-v0", "--root", str(root),
                  "--out", str(tmp_path / "bc"), "--epochs", "2", "--quiet"]) == 0
     assert "MSE / action variance" in capsys.readouterr().out
-    from agents.policies import LearnedPolicy
+    from agents.learning.policies import LearnedPolicy
     pol = LearnedPolicy.load(tmp_path / "bc")                 # the directory loads too
     assert pol.name == "bc-whirl-switch" and pol.env_id == DAMPING and pol.self_contained
     for argv, name in ((["--dataset", "rotordrop/damping/nothing-v0", "--root", str(root)],

@@ -159,9 +159,9 @@ def test_the_kpi_reward_returns_minus_the_final_potential():
 
 def test_the_default_reward_is_unchanged_and_the_kpi_reward_equals_the_sb3_wrapper():
     """The default reward is the sum of its terms; the env's reward="kpi" is what the SB3
-    wrapper agents.reward.KpiReward computes on default-reward envs (one implementation),
+    wrapper agents.learning.reward.KpiReward computes on default-reward envs (one implementation),
     also for re-levitation (bonus, time charge) and after auto-resets."""
-    from agents.reward import KpiReward
+    from agents.learning.reward import KpiReward
     kw = dict(command="discrete", power_return_time=0.002, episode_time=0.05,
               terminate_on_failure=False, overrides={"contact.friction": 0.1})
     wk = dict(W, w_relevitate=0.7, w_time=1.5)

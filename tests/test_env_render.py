@@ -119,7 +119,7 @@ def test_write_video_round_trip(tmp_path, suffix):
 def test_evaluate_video_writes_the_first_episode(tmp_path, monkeypatch):
     """``rotordrop evaluate --video``: the first episode, one frame per step and the reset; a
     GIF through Pillow when ffmpeg is missing."""
-    from agents.evaluate import evaluate
+    from agents.benchmarking.evaluate import evaluate
     from rotordrop_env import video
     for suffix in ([".mp4"] if mp4_available() else []) + [".gif"]:
         monkeypatch.setattr(video, "default_suffix", lambda s=suffix: s)

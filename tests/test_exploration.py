@@ -1,4 +1,4 @@
-"""Initial exploration spread per action entry (agents/exploration.py): the named entries of
+"""Initial exploration spread per action entry (agents/learning/exploration.py): the named entries of
 PPO's log std start where the config says, the others at log_std_init; a resumed model keeps
 what it learned; both config forms mean the same; bad values are named."""
 import numpy as np
@@ -7,9 +7,9 @@ from stable_baselines3 import PPO
 from stable_baselines3.common.env_util import make_vec_env
 
 import rotordrop_env  # noqa: F401  (registers the environments)
-from agents.exploration import ActionSpread
-from agents.hyperparams import ConfigError, load_hyperparams, project_keys, split
-from agents.train import train
+from agents.learning.exploration import ActionSpread
+from agents.learning.hyperparams import ConfigError, load_hyperparams, project_keys, split
+from agents.training.train import train
 
 SPREAD = {"damping2": -0.5}
 TINY = ("RotorDrop-Damping-v1:\n  n_steps: 64\n  batch_size: 64\n  n_epochs: 1\n  n_envs: 2\n"
@@ -48,7 +48,7 @@ def test_a_resumed_model_keeps_the_spread_it_learned():
 
 def test_the_rl_zoo3_entry_and_the_key_mean_the_same(tmp_path):
     cfg = tmp_path / "c.yaml"
-    cfg.write_text("callback:\n  - agents.exploration.ActionSpread: {log_std: {damping2: -0.5}}\n")
+    cfg.write_text("callback:\n  - agents.learning.exploration.ActionSpread: {log_std: {damping2: -0.5}}\n")
     meta, _ = split(load_hyperparams("ppo", "RotorDrop-Damping-v1", cfg))
     cfg.write_text("action_log_std: {damping2: -0.5}\n")
     meta2, _ = split(load_hyperparams("ppo", "RotorDrop-Damping-v1", cfg))
@@ -58,7 +58,7 @@ def test_the_rl_zoo3_entry_and_the_key_mean_the_same(tmp_path):
     assert meta["validation"] is False and meta2["validation"] is True
     with pytest.raises(ConfigError, match="action_log_std is given twice"):
         project_keys({"action_log_std": {"damping2": -1.0},
-                      "callback": [{"agents.exploration.ActionSpread": {"log_std": SPREAD}}]})
+                      "callback": [{"agents.learning.exploration.ActionSpread": {"log_std": SPREAD}}]})
 
 
 def test_rotordrop_train_starts_from_the_configured_spread(tmp_path):

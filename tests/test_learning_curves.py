@@ -4,7 +4,7 @@ import json
 
 import numpy as np
 
-from agents.learning_curves import aggregate, main
+from agents.training.learning_curves import aggregate, main
 
 
 def fake_run(path, scores, whirl):

@@ -5,12 +5,12 @@ import json
 import numpy as np
 import pytest
 
-from agents.benchmark import Entry, episode_kwargs
-from agents.controllers import InnerLoop
-from agents.oracle import (CONTROL_DT, ENV_ID, MAX_DELAY, as_benchmark, draw_scenarios,
+from agents.benchmarking.benchmark import Entry, episode_kwargs
+from agents.control.controllers import InnerLoop
+from agents.research.oracle import (CONTROL_DT, ENV_ID, MAX_DELAY, as_benchmark, draw_scenarios,
                            inner_loop_theta, kpi_row, n_params, oracle, rollout,
                            sequence_actions)
-from agents.rollout import run_episodes
+from agents.benchmarking.rollout import run_episodes
 
 NAMES = ["damping1", "damping2", "levitate", "gain", "offset_r1", "offset_t1", "offset_r2",
          "offset_t2"]
@@ -80,7 +80,7 @@ def test_rows_only_on_other_scenarios(tmp_path):
 
 
 def test_whirl_by_friction_bins_the_scenarios():
-    from agents.oracle import whirl_by_friction
+    from agents.research.oracle import whirl_by_friction
     per = [dict(scenario={"contact.friction": mu}, rows={"a": {"backward_whirl": w}})
            for mu, w in ((0.39, 1.0), (0.40, 0.0), (0.52, 1.0), (0.60, 1.0))]
     t = whirl_by_friction(dict(per_scenario=per, summary=[{"controller": "a"}]))
@@ -91,7 +91,7 @@ def test_whirl_by_friction_bins_the_scenarios():
 def test_a_friction_range_draws_there_and_bins_its_whirl_table(tmp_path, capsys):
     """--friction 0.3:0.36: every scenario's mu in the range (the other draws as before), the
     per-friction table on the given edges, printed; a bad range or bad edges fail at once."""
-    from agents.oracle import friction_edges
+    from agents.research.oracle import friction_edges
     wide, low = draw_scenarios(8, 20_000), draw_scenarios(8, 20_000, (0.3, 0.36))
     assert all(0.3 <= s["contact.friction"] <= 0.36 for s in low)
     assert [s["power_return_time"] for s in low] == [s["power_return_time"] for s in wide]
@@ -118,10 +118,10 @@ def test_robust_suite_searches_the_robust_scenario_with_its_sensing(tmp_path):
     """--suite robust: the robust suite's first scenario (seed SUITE_SEED), its plant spread,
     noise and latency in the oracle's rollouts and the rows, the rows' J as the robust
     benchmark scores them; the oracle never scores worse than inner-loop there."""
-    from agents.benchmark import leaderboard, suite_rows
-    from agents.controllers import Passive
-    from agents.oracle import search_kwargs, suite_scenarios
-    from agents.robust import SENSOR_DELAY_S, SENSOR_NOISE, SUITE_SEED, draw_scenario
+    from agents.benchmarking.benchmark import leaderboard, suite_rows
+    from agents.control.controllers import Passive
+    from agents.research.oracle import search_kwargs, suite_scenarios
+    from agents.benchmarking.robust import SENSOR_DELAY_S, SENSOR_NOISE, SUITE_SEED, draw_scenario
     from rotordrop_env import BatchedRotorDropVecEnv
     sc, phase, record = suite_scenarios("robust", 1, SUITE_SEED)[0]
     assert sc == draw_scenario(SUITE_SEED, "#0")
@@ -174,9 +174,9 @@ def test_inner_loop_lift_is_the_oracles_constant_row(tmp_path):
     """On a robust drop: the oracle's --constant 0.5:-0.5 row is inner-loop-lift (same J), and
     the same law as the search's command sequence (constant_theta, batched rollout at 5 ms)
     runs the same drop to the last digit."""
-    from agents.benchmark import controller_entry
-    from agents.controllers import InnerLoopLift
-    from agents.oracle import constant_theta, search_kwargs, suite_scenarios
+    from agents.benchmarking.benchmark import controller_entry
+    from agents.control.controllers import InnerLoopLift
+    from agents.research.oracle import constant_theta, search_kwargs, suite_scenarios
     from rotordrop_env import BatchedRotorDropVecEnv
     rep = oracle(tmp_path, scenarios=1, search=False, suite="robust", constants=[(0.5, -0.5)],
                  progress=False, plots=False)
@@ -196,7 +196,7 @@ def test_inner_loop_lift_is_the_oracles_constant_row(tmp_path):
 def test_the_raw_current_oracle_searches_whirl_brake_corrections_and_never_loses_to_it(tmp_path):
     """--interface currents: open-loop corrections of whirl-brake's coil currents, started from
     no correction, so the searched plan's J is at most whirl-brake's on every drop."""
-    from agents.oracle import oracle
+    from agents.research.oracle import oracle
     rep = oracle(tmp_path, scenarios=1, population=3, iterations=1, progress=False, plots=False,
                  interface="currents")
     assert rep["settings"]["interface"] == "currents"

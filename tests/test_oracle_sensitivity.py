@@ -2,10 +2,10 @@
 copies of their scenarios."""
 import pytest
 
-from agents.oracle import oracle, suite_scenarios
+from agents.research.oracle import oracle, suite_scenarios
 from agents.research.blind_oracle import blind_oracle
 from agents.research.oracle_sensitivity import PERTURBATIONS, largest_gains, perturbed, searches, sensitivity
-from agents.robust import SUITE_SEED
+from agents.benchmarking.robust import SUITE_SEED
 
 
 @pytest.fixture(scope="module")
@@ -34,7 +34,7 @@ def test_copies_change_one_scene_value_by_the_stated_amount():
     assert perturbed(late, phase, PERTURBATIONS["phase +1 deg"])[0].overrides["unbalance.angle_deg"] == 0.5
     assert perturbed(nominal, 359.5, PERTURBATIONS["phase +1 deg"])[1] == 0.5
     # a key the scenario does not override starts from the paper scene's value
-    from agents.benchmark import Scenario
+    from agents.benchmarking.benchmark import Scenario
     from physics.scene import load_scene
     bare = perturbed(Scenario("bare", 0.4), 0.0, PERTURBATIONS["stiffness +0.1 %"])[0]
     assert bare.overrides == {"support.stiffness": load_scene("paper").support.stiffness * 1.001}

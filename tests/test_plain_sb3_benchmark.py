@@ -45,7 +45,7 @@ def test_a_plain_zip_without_env_or_with_a_wrong_one_is_a_one_line_error(plain_z
 
 
 def test_export_policy_makes_a_plain_zip_self_contained_with_env(plain_zip, tmp_path):
-    from agents.policies import LearnedPolicy
+    from agents.learning.policies import LearnedPolicy
     out = tmp_path / "mine.zip"
     assert main(["export-policy", str(plain_zip), "--env", ENV, "--out", str(out)]) == 0
     pol = LearnedPolicy.load(out)

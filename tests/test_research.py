@@ -49,12 +49,12 @@ def test_collapse_diagnosis_tools_agree_with_the_validator_on_the_inner_loop():
     command (both dampers C_max, levitate on, zero gain and offsets) score what the robust
     validator gives the inner loop; it switches on at the first step that sees the power and
     re-levitates every drop."""
-    from agents.controllers import InnerLoop
-    from agents.plant import Plant
+    from agents.control.controllers import InnerLoop
+    from agents.control.plant import Plant
     from agents.research.diagnose_run import diagnose
     from agents.research.probe_commands import ConstantCommands, probe
-    from agents.robust import ENV_ID, robust_validator, training_env_kwargs
-    from agents.rollout import make_env
+    from agents.benchmarking.robust import ENV_ID, robust_validator, training_env_kwargs
+    from agents.benchmarking.rollout import make_env
     validator = robust_validator()
     kw = dict(training_env_kwargs(), command="supervisor")
     ref, _ = validator.score(InnerLoop, kw)

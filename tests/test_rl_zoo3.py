@@ -12,11 +12,11 @@ import yaml
 from stable_baselines3 import PPO
 from stable_baselines3.common.env_util import make_vec_env
 
-from agents.hyperparams import (ConfigError, default_config_path, load_hyperparams,
+from agents.learning.hyperparams import (ConfigError, default_config_path, load_hyperparams,
                                 project_keys, split)
-from agents.policies import export_zoo
-from agents.residual import ResidualAction
-from agents.reward import KpiReward
+from agents.learning.policies import export_zoo
+from agents.control.residual import ResidualAction
+from agents.learning.reward import KpiReward
 from rotordrop_env import make_batched
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -38,7 +38,7 @@ def test_rl_zoo3_trains_from_the_shipped_yaml_with_the_projects_wrappers_and_cal
     """A few hundred steps from agents/configs/ppo.yaml as it is; the validation callback's
     interval shortened (rl-zoo3's -params) so that it runs and keeps a self-contained best."""
     best = tmp_path / "validation"
-    callback = f"[{{'agents.validation.ValidationCallback': {{'eval_freq': 512, 'save_path': '{best}'}}}}]"
+    callback = f"[{{'agents.training.validation.ValidationCallback': {{'eval_freq': 512, 'save_path': '{best}'}}}}]"
     out = _zoo("train", "--algo", "ppo", "--env", "RotorDrop-Damping-v1", "--gym-packages",
                "rotordrop_env", "-conf", "agents/configs/ppo.yaml", "-n", "300", "-f", str(tmp_path),
                "--eval-freq", "-1", "--num-threads", "1", "--seed", "0", "-params",
@@ -46,7 +46,7 @@ def test_rl_zoo3_trains_from_the_shipped_yaml_with_the_projects_wrappers_and_cal
     assert "validation score" in out
     run = tmp_path / "ppo" / "RotorDrop-Damping-v1_1"
     saved = yaml.load((run / "RotorDrop-Damping-v1" / "config.yml").read_text(), Loader=yaml.UnsafeLoader)
-    assert dict(saved)["vec_env_wrapper"][0] == {"agents.residual.ResidualAction":
+    assert dict(saved)["vec_env_wrapper"][0] == {"agents.control.residual.ResidualAction":
                                                  {"base": "max-damping", "scale": 0.5}}
     model = PPO.load(run / "RotorDrop-Damping-v1.zip", device="cpu")
     assert model.num_timesteps == 1024                          # one rollout of 8 x 128 steps
@@ -83,14 +83,14 @@ def test_a_user_config_overrides_the_entries_in_either_form(tmp_path):
 
 
 @pytest.mark.parametrize("block,match", [
-    ({"residual": "passive", "vec_env_wrapper": [{"agents.residual.ResidualAction": {"base": "max-damping"}}]},
+    ({"residual": "passive", "vec_env_wrapper": [{"agents.control.residual.ResidualAction": {"base": "max-damping"}}]},
      "residual is given twice"),
     ({"vec_env_wrapper": "my.Wrapper"}, "vec_env_wrapper my.Wrapper: rotordrop train knows"),
-    ({"vec_env_wrapper": [{"agents.residual.ResidualAction": {"bas": "x"}}]}, "unknown key 'bas'"),
+    ({"vec_env_wrapper": [{"agents.control.residual.ResidualAction": {"bas": "x"}}]}, "unknown key 'bas'"),
     ({"callback": "sb3.Other"}, "callback sb3.Other: rotordrop train knows"),
     ({"env_wrapper": "x.Y"}, "env_wrapper .* is an rl-zoo3 option"),
     ({"vec_env_wrapper": [{"a": 1, "b": 2}]}, "each entry is a class path"),
-    ({"callback": [{"agents.validation.ValidationCallback": {"save_path": "x"}}]},
+    ({"callback": [{"agents.training.validation.ValidationCallback": {"save_path": "x"}}]},
      "save_path is where rl-zoo3 keeps"),
 ])
 def test_entries_rotordrop_train_cannot_run_are_named(block, match):
@@ -118,7 +118,7 @@ def test_every_shipped_yaml_has_only_keys_rl_zoo3_passes_on_correctly():
     of the env id it trains; the entries named after shipped policies are rotordrop train's
     (``--config FILE:ENTRY``) and may use its own keys."""
     import inspect
-    from agents.hyperparams import algo_class
+    from agents.learning.hyperparams import algo_class
     zoo = {"n_timesteps", "n_envs", "policy", "policy_kwargs", "normalize", "env_kwargs",
            "vec_env_wrapper", "callback", "noise_type", "noise_std", "env_wrapper", "frame_stack",
            "monitor_kwargs"}
@@ -133,7 +133,7 @@ def test_every_shipped_yaml_has_only_keys_rl_zoo3_passes_on_correctly():
 
 
 def test_the_run_flags_override_the_config(tmp_path):
-    from agents.train import resolve_config
+    from agents.training.train import resolve_config
     hp = resolve_config("RotorDrop-Damping-v1", "ppo", eval_freq=1000, n_eval_episodes=2,
                         checkpoint_freq=0)
     meta, _ = split(hp)

@@ -1,4 +1,4 @@
-"""The robust suite (``rotordrop benchmark --suite robust``, agents/robust.py): its scenarios,
+"""The robust suite (``rotordrop benchmark --suite robust``, agents/benchmarking/robust.py): its scenarios,
 the latency in each row's control steps, seed groups and the target, the leaderboard on a
 small fixture, and one-line errors for a bad --suite."""
 from types import SimpleNamespace
@@ -6,9 +6,9 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from agents.benchmark import Entry, Scenario, episode_kwargs, latency_steps
-from agents.score import seed_groups
-from agents.robust import (LATENCY_MS, ROBUST_RANGES, SENSOR_DELAY_S, SENSOR_NOISE, SUITE_SEED,
+from agents.benchmarking.benchmark import Entry, Scenario, episode_kwargs, latency_steps
+from agents.benchmarking.score import seed_groups
+from agents.benchmarking.robust import (LATENCY_MS, ROBUST_RANGES, SENSOR_DELAY_S, SENSOR_NOISE, SUITE_SEED,
                            VALIDATION_SEED,
                            draw_scenario, robust_benchmark, robust_scenarios, run_suite,
                            target,
@@ -127,7 +127,7 @@ def test_robust_quick_end_to_end(tmp_path):
 def test_the_test_drops_are_fresh_and_the_legacy_ones_stay_reproducible():
     """The test set shares no seed with the validation drops or the earlier test set, which
     --suite robust-legacy still draws."""
-    from agents.robust import LEGACY_SUITE_SEED, SUITE_SCENARIOS, VALIDATION_SCENARIOS
+    from agents.benchmarking.robust import LEGACY_SUITE_SEED, SUITE_SCENARIOS, VALIDATION_SCENARIOS
     test = set(range(SUITE_SEED, SUITE_SEED + SUITE_SCENARIOS))
     assert test.isdisjoint(range(VALIDATION_SEED, VALIDATION_SEED + VALIDATION_SCENARIOS))
     assert test.isdisjoint(range(LEGACY_SUITE_SEED, LEGACY_SUITE_SEED + SUITE_SCENARIOS))

@@ -1,11 +1,11 @@
-"""The benchmark's scores (agents/score.py): the severity score ranks a shorter whirl better,
+"""The benchmark's scores (agents/benchmarking/score.py): the severity score ranks a shorter whirl better,
 the legacy score is the verdict-only J to the bit, the paired bootstrap of the leaderboards,
 the KPI reward's unsaturated severity term, and one-line errors for a bad --score."""
 import numpy as np
 import pytest
 
-from agents.benchmark import EPISODE_TIME, Scenario, leaderboard
-from agents.score import (SCORES, bootstrap_scores, check_score, drop_costs, overall_score,
+from agents.benchmarking.benchmark import EPISODE_TIME, Scenario, leaderboard
+from agents.benchmarking.score import (SCORES, bootstrap_scores, check_score, drop_costs, overall_score,
                           row_cost)
 
 PASSIVE = dict(backward_whirl=1.0, peak_whirl_revolutions=20.0, peak_contact_force_N=12000.0,

@@ -221,9 +221,9 @@ def test_a_scene_delay_reaches_the_env_and_is_fixed():
 def test_a_raw_current_law_runs_at_a_realistic_control_rate_with_sensing(dt):
     """A digital AMB controller's rate (5-10 kHz): the env steps at control_dt 0.1-0.2 ms
     with the sensors' delay and noise, and whirl-brake (tuned at 1 ms) still re-levitates."""
-    from agents.benchmark import controller_env_kwargs
-    from agents.controllers import BASELINES
-    from agents.rollout import run_episodes
+    from agents.benchmarking.benchmark import controller_env_kwargs
+    from agents.control.controllers import BASELINES
+    from agents.benchmarking.rollout import run_episodes
     cls = BASELINES["whirl-brake"]
     kw = dict(controller_env_kwargs(cls, "RotorDrop-Full-v1"), control_dt=dt, episode_time=0.12,
               terminate_on_failure=False, sensor_delay=1e-4, sensor_noise=5e-7)

@@ -33,7 +33,7 @@ def test_several_torch_threads_warn_once(threads):
 
 
 def test_one_thread_or_a_chosen_count_is_quiet(threads):
-    from agents.train import set_threads
+    from agents.training.train import set_threads
     threads(1)
     with warnings.catch_warnings():
         warnings.simplefilter("error")

@@ -28,8 +28,8 @@ import numpy as np
 
 from .benchmark import (EPISODE_TIME, PHASES, RELEVITATION_ENVS, Entry, Scenario, check_unique_names,
                         controller_entry, episode_kwargs, policy_label, task_of)
-from .controllers import BASELINES, Passive, command_for, controller_class, is_controller_spec
-from .policies import load_shipped, resolve, shipped_names
+from ..control.controllers import BASELINES, Passive, command_for, controller_class, is_controller_spec
+from ..learning.policies import load_shipped, resolve, shipped_names
 from .rollout import check_actor, run_episodes
 from .score import write_json
 

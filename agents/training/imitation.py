@@ -18,7 +18,7 @@ name ``bc-<teacher>``), and ``bc.json`` (data set, fit: training and validation 
 the action variance, epochs, seconds).
 
     python3 -m agents.cli bc --dataset rotordrop/full/whirl-brake-v0 --root data/minari --out runs/bc
-    python3 -m agents.imitation --dataset ... --out ...     # the same
+    python3 -m agents.training.imitation --dataset ... --out ...     # the same
 """
 from __future__ import annotations
 
@@ -76,8 +76,8 @@ def _policy_model(env_id: str, env_kwargs: dict, hidden, meta: dict):
     """A PPO whose policy is the self-contained ``MlpPolicy`` (untrained)."""
     import torch as th
     from stable_baselines3 import PPO
-    from .plant import make_env
-    from .sb3_policy import RotorDropActorCriticPolicy
+    from ..control.plant import make_env
+    from ..sb3_policy import RotorDropActorCriticPolicy
     env = make_env(env_id, **env_kwargs)
     model = PPO(RotorDropActorCriticPolicy, env, n_steps=64, batch_size=64, device="cpu",
                 policy_kwargs=dict(net_arch=dict(pi=list(hidden), vf=[16]),
@@ -99,7 +99,7 @@ def train_bc(dataset: str | Path, out: str | Path, root: str | Path | None = Non
     ``epochs`` passes (or until ``time_limit`` seconds) and write it into ``out``. Returns the
     report written to ``bc.json``."""
     import torch as th
-    from .residual import RESIDUAL_SCALE
+    from ..control.residual import RESIDUAL_SCALE
     if epochs < 1:
         raise ValueError(f"--epochs must be >= 1, got {epochs}")
     if batch_size < 1:
@@ -168,8 +168,8 @@ def train_bc(dataset: str | Path, out: str | Path, root: str | Path | None = Non
         model.save(out / "model.zip")
     finally:
         env.close()
-    from .hyperparams import dump_yaml
-    from .score import write_json
+    from ..learning.hyperparams import dump_yaml
+    from ..benchmarking.score import write_json
     load_meta = dict(name=name, algo="ppo", env_id=meta["env_id"], env_kwargs=meta["env_kwargs"],
                      notes=f"behaviour cloning of {teacher} on the data set {ds.id}")
     write_json(out / "model.json", load_meta, indent=1)
@@ -252,7 +252,7 @@ def cmd_bc(args) -> int:
 
 def main(argv: list[str] | None = None) -> int:
     import argparse
-    p = argparse.ArgumentParser(prog="python -m agents.imitation", description=__doc__.split("\n")[0])
+    p = argparse.ArgumentParser(prog="python -m agents.training.imitation", description=__doc__.split("\n")[0])
     add_arguments(p)
     return cmd_bc(p.parse_args(argv))
 

@@ -1,7 +1,7 @@
 """Learning curves of several training runs (seeds) on one axis: mean ± std over the runs of the
 validation score and of the evaluation backward-whirl rate against environment steps.
 
-    python -m agents.learning_curves --group ppo=runs/ppo-scratch-0,runs/ppo-scratch-1 \\
+    python -m agents.training.learning_curves --group ppo=runs/ppo-scratch-0,runs/ppo-scratch-1 \\
         --group sac=runs/sac-scratch-0 --out docs/img/learning-scratch.png
 
 Writes the PNG and a CSV next to it (label, steps, number of runs, mean and std of each

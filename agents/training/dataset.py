@@ -2,8 +2,8 @@
 
 Any ``--policy`` that ``rotordrop evaluate`` runs (a baseline or designed controller name, a
 shipped policy, a training directory or model zip, a ``module:Class`` controller) is resolved
-exactly as evaluate resolves it (:func:`agents.evaluate._actor`) and run on the environment
-built as evaluate builds it (:func:`agents.evaluate._merge_kwargs`: the policy's env kwargs,
+exactly as evaluate resolves it (:func:`agents.benchmarking.evaluate._actor`) and run on the environment
+built as evaluate builds it (:func:`agents.benchmarking.evaluate._merge_kwargs`: the policy's env kwargs,
 then the user's, scenario randomisation on unless ``randomize=False``, episodes run their
 full length, the KPI monitor at 0.2 ms). Episode ``i`` is ``env.reset(seed=seed + i)``; a
 controller is built afresh for every episode, as in evaluate and the benchmark.
@@ -67,7 +67,7 @@ def parse_env_kwargs(items: list[str] | None) -> dict:
     """``["episode_time=0.05", "overrides={'contact.friction': 0.4}"]`` -> kwargs; values are
     Python literals (numbers, strings, True/False/None, lists, dicts), a bare word stays a
     string."""
-    from .hyperparams import parse_literal
+    from ..learning.hyperparams import parse_literal
     kw: dict = {}
     for item in items or []:
         key, sep, text = item.partition("=")
@@ -156,7 +156,7 @@ def resolve_actor(policy: str, env_id: str | None, env_kwargs: dict | None = Non
     """(make_actor(plant), env id, env kwargs, display name) as ``rotordrop evaluate`` resolves
     and builds them; ValueError / KeyError naming the parameter on bad input."""
     from rotordrop_env import ENV_IDS
-    from .evaluate import _actor, _merge_kwargs
+    from ..benchmarking.evaluate import _actor, _merge_kwargs
     if env_id is not None and env_id not in ENV_IDS:
         raise ValueError(f"--env {env_id!r} is not a rotor-drop environment; known: "
                          f"{', '.join(ENV_IDS)}")
@@ -168,7 +168,7 @@ def resolve_actor(policy: str, env_id: str | None, env_kwargs: dict | None = Non
 
 
 def run_episode(env, plant, actor, seed: int) -> Collected:
-    """One episode, acting as :func:`agents.rollout.run_episodes` does (``predict`` on a batch of
+    """One episode, acting as :func:`agents.benchmarking.rollout.run_episodes` does (``predict`` on a batch of
     one, ``episode_start`` on the first step, deterministic)."""
     obs, info = env.reset(seed=int(seed))
     observations, actions, rewards, terms, truncs, infos = [obs], [], [], [], [], [info]
@@ -187,7 +187,7 @@ def run_episode(env, plant, actor, seed: int) -> Collected:
         infos.append(step_info)
         if terminated or truncated:
             break
-    from .rollout import final_kpis
+    from ..benchmarking.rollout import final_kpis
     return Collected(int(seed), np.asarray(observations, dtype=env.observation_space.dtype),
                      np.asarray(actions, dtype=dtype), np.asarray(rewards, dtype=np.float64),
                      np.asarray(terms), np.asarray(truncs), infos,
@@ -197,8 +197,8 @@ def run_episode(env, plant, actor, seed: int) -> Collected:
 def collect(make_actor, env_id: str, env_kwargs: dict, seeds, progress: bool = False):
     """Run one episode per seed (a controller anew each episode); yields :class:`Collected`."""
     from tqdm.auto import tqdm
-    from .controllers import Controller
-    from .plant import Plant, make_env
+    from ..control.controllers import Controller
+    from ..control.plant import Plant, make_env
     env = make_env(env_id, **env_kwargs)
     try:
         plant = Plant.from_env(env)
@@ -245,8 +245,8 @@ def write_dataset(policy: str, env_id: str | None, episodes: int, out: str | Pat
     if not isinstance(randomize, bool):
         raise ValueError(f"--env-kwarg randomize must be True or False, got {randomize!r}")
     make_actor, env_id, kwargs, name = resolve_actor(policy, env_id, user, randomize)
-    from .controllers import is_controller_spec
-    from .rollout import check_actor
+    from ..control.controllers import is_controller_spec
+    from ..benchmarking.rollout import check_actor
     if is_controller_spec(policy):
         check_actor(env_id, make_actor, kwargs)                 # fail fast: a user's class
     dataset_id = dataset_id or default_dataset_id(name, env_id)
@@ -269,7 +269,7 @@ def write_dataset(policy: str, env_id: str | None, episodes: int, out: str | Pat
     seeds = list(range(seed, seed + episodes))
     t0 = time.perf_counter()
     from minari.data_collector.episode_buffer import EpisodeBuffer
-    from .plant import make_env
+    from ..control.plant import make_env
     meta = dict(policy=policy, policy_name=name, env_id=env_id, env_kwargs=_jsonable(kwargs),
                 user_env_kwargs=_jsonable(user), randomize=randomize, seeds=seeds,
                 command=_command())

@@ -1,4 +1,4 @@
-"""The cross-entropy search (:class:`agents.search.CrossEntropy`) on a backend: locally, or
+"""The cross-entropy search (:class:`agents.benchmarking.search.CrossEntropy`) on a backend: locally, or
 driven by Ray Tune (:func:`minimise`).
 
 Every candidate is one Ray Tune trial (``objective(theta)`` -> ``{"cost": ...}``), scheduled on
@@ -35,7 +35,7 @@ def ray_cross_entropy(objective: Callable[[np.ndarray], float], search: CrossEnt
                       names: list[str], iterations: int, storage: Path, progress: bool = True,
                       desc: str = "cross-entropy search"):
     """Minimise ``objective`` (picklable, module level) with ``search`` as Ray Tune trials;
-    returns ``(best cost, best candidate, history)`` as :func:`agents.search.cross_entropy`."""
+    returns ``(best cost, best candidate, history)`` as :func:`agents.benchmarking.search.cross_entropy`."""
     from ray import tune
     from tqdm.auto import tqdm
     bar = tqdm(total=iterations, desc=desc, unit="gen", disable=not progress)

@@ -2,9 +2,9 @@
 
 The reward itself belongs to the environments: ``gym.make(id, reward="kpi", reward_kwargs=...)``
 (:mod:`rotordrop_env.reward`, which explains it). ``rotordrop train`` passes ``reward="kpi"``
-and the config's ``reward_kwargs`` to its batched environments (:mod:`agents.training_env`).
+and the config's ``reward_kwargs`` to its batched environments (:mod:`agents.training.training_env`).
 :class:`KpiReward` is the same reward as an SB3 ``VecEnvWrapper`` over environments made with
-the default reward (rl-zoo3: ``vec_env_wrapper: agents.reward.KpiReward``), computed by the
+the default reward (rl-zoo3: ``vec_env_wrapper: agents.learning.reward.KpiReward``), computed by the
 same functions from the running KPIs every step's ``info`` carries.
 """
 from __future__ import annotations
@@ -33,7 +33,7 @@ class KpiReward(VecEnvWrapper):
     """The KPI-aligned reward (:mod:`rotordrop_env.reward`) on an SB3 VecEnv of rotor-drop
     environments with the default reward: the batched VecEnv or SB3's DummyVecEnv /
     SubprocVecEnv of ``gym.make`` environments (rl-zoo3: ``vec_env_wrapper:
-    agents.reward.KpiReward``, weights as its keyword arguments). It equals the environments'
+    agents.learning.reward.KpiReward``, weights as its keyword arguments). It equals the environments'
     own ``reward="kpi"``."""
 
     def __init__(self, venv, **weights):

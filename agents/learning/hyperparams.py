@@ -21,16 +21,16 @@ arguments a block may hold:
 ``checkpoint_freq`` environment steps between checkpoints
 ``noise_type``     TD3 action noise (``normal`` | ``ornstein-uhlenbeck``), with ``noise_std``
 ``reward``         ``env`` (the environment's reward, default) or ``kpi`` (the KPI-aligned
-                   reward of :mod:`agents.reward`), with optional ``reward_kwargs``
+                   reward of :mod:`agents.learning.reward`), with optional ``reward_kwargs``
 ``residual``       a baseline controller name: the agent's action corrects that controller's
-                   (:mod:`agents.residual`; the saved policy applies it too)
+                   (:mod:`agents.control.residual`; the saved policy applies it too)
 ``residual_scale`` the residual's authority: env action = clip(base + scale * a, -1, 1)
                    (default 2: the agent can override the baseline anywhere)
 ``validation``     ``true``: keep as ``best/`` the model with the highest benchmark score on the
-                   validation suite (:class:`agents.benchmark.Validator`: frictions and unbalance
+                   validation suite (:class:`agents.benchmarking.benchmark.Validator`: frictions and unbalance
                    phases the benchmark does not use) instead of the highest evaluation reward
 ``action_log_std`` PPO: initial log std of named action entries, e.g. ``{gain: -1.0}``; the
-                   others keep ``log_std_init`` (:mod:`agents.exploration`)
+                   others keep ``log_std_init`` (:mod:`agents.learning.exploration`)
 ``frame_stack``    memory: the policy sees the last N (normalised) observations, newest last, as
                    rl-zoo3's ``frame_stack`` (``VecFrameStack``); the saved policy stacks them
                    itself (:class:`agents.sb3_policy.FrameStack`; default 1)
@@ -43,12 +43,12 @@ understands, and ``rotordrop train`` reads them as the keys above (:func:`projec
 =====================================================================  ===========================
 rl-zoo3 entry                                                          means
 =====================================================================  ===========================
-``vec_env_wrapper: [{agents.residual.ResidualAction: {base: B, scale: S}}]``  ``residual: B``,
+``vec_env_wrapper: [{agents.control.residual.ResidualAction: {base: B, scale: S}}]``  ``residual: B``,
                                                                        ``residual_scale: S``
-``vec_env_wrapper: [{agents.reward.KpiReward: {weights...}}]``         ``reward: kpi``,
+``vec_env_wrapper: [{agents.learning.reward.KpiReward: {weights...}}]``         ``reward: kpi``,
                                                                        ``reward_kwargs``
-``callback: [agents.validation.ValidationCallback]``                   ``validation: true``
-``callback: [{agents.exploration.ActionSpread: {log_std: {...}}}]``    ``action_log_std: {...}``
+``callback: [agents.training.validation.ValidationCallback]``                   ``validation: true``
+``callback: [{agents.learning.exploration.ActionSpread: {log_std: {...}}}]``    ``action_log_std: {...}``
 =====================================================================  ===========================
 
 (residual first: the list is applied inside out). ``eval_freq``, ``n_eval_episodes`` and
@@ -87,10 +87,10 @@ REWARDS = ("env", "kpi")
 #: when neither the command line nor the config sets them (rl-zoo3's eval_freq too)
 RUN_DEFAULTS = dict(eval_freq=25_000, n_eval_episodes=8, checkpoint_freq=100_000)
 #: rl-zoo3 entries (class path -> the project keys they set)
-RESIDUAL_WRAPPER = "agents.residual.ResidualAction"
-KPI_WRAPPER = "agents.reward.KpiReward"
-VALIDATION_CALLBACK = "agents.validation.ValidationCallback"
-SPREAD_CALLBACK = "agents.exploration.ActionSpread"
+RESIDUAL_WRAPPER = "agents.control.residual.ResidualAction"
+KPI_WRAPPER = "agents.learning.reward.KpiReward"
+VALIDATION_CALLBACK = "agents.training.validation.ValidationCallback"
+SPREAD_CALLBACK = "agents.learning.exploration.ActionSpread"
 #: project keys that rl-zoo3's ``callback:`` entries set
 CALLBACK_KEYS = ("validation", "action_log_std")
 WRAPPER_KEYS = ("residual", "residual_scale", "reward", "reward_kwargs")
@@ -441,12 +441,12 @@ def split(hp: dict) -> tuple[dict, dict]:
     if meta["reward"] not in REWARDS:
         raise ConfigError(f"reward must be one of {', '.join(REWARDS)}, got {meta['reward']!r}")
     if meta.get("residual") is not None:
-        from .controllers import BASELINES
+        from ..control.controllers import BASELINES
         if meta["residual"] not in BASELINES:
             raise ConfigError(f"residual must be a baseline controller ({', '.join(BASELINES)}), "
                               f"got {meta['residual']!r}")
     if meta.get("residual") is not None:
-        from .residual import RESIDUAL_SCALE
+        from ..control.residual import RESIDUAL_SCALE
         meta.setdefault("residual_scale", RESIDUAL_SCALE)
     if "residual_scale" in meta:
         try:

@@ -3,10 +3,10 @@ benchmark does not use.
 
 A control engineer's controller class (``package.module:Class`` or ``file.py:Class``, or a
 baseline) takes its gains as constructor keyword arguments (``Class(plant, kp=..., kd=...)``,
-like :class:`agents.controllers.WhirlBrake`). A cross-entropy search (:mod:`agents.search`)
+like :class:`agents.control.controllers.WhirlBrake`). A cross-entropy search (:mod:`agents.benchmarking.search`)
 over the given ranges maximises the controller's **validation score**: the benchmark score
-(:mod:`agents.score`) on the validation suite of the task (frictions 0.2/0.36/0.41/0.46/0.51 at
-unbalance phases 45°/225°, :class:`agents.benchmark.Validator`), which shares no scenario with
+(:mod:`agents.benchmarking.score`) on the validation suite of the task (frictions 0.2/0.36/0.41/0.46/0.51 at
+unbalance phases 45°/225°, :class:`agents.benchmarking.benchmark.Validator`), which shares no scenario with
 the benchmark, so that ``rotordrop benchmark`` afterwards still measures the tuned controller on
 unseen cases. The search starts from the class's ``GAINS`` defaults where it has them (clipped
 into the range; else the middle of each range).
@@ -27,7 +27,7 @@ import numpy as np
 from physics.runs.backend import Backend
 
 from .benchmark import TASKS, Validator, check_suite, controller_env_kwargs
-from .controllers import BASELINES, Controller, controller_class, make_controller
+from ..control.controllers import BASELINES, Controller, controller_class, make_controller
 from .rollout import check_actor
 from .score import write_json
 from .ray_search import minimise
@@ -59,7 +59,7 @@ def _controller(spec: str, env_id: str) -> type[Controller]:
 
 def _check_gains(cls: type[Controller], env_id: str, start: dict) -> dict:
     """Build the controller once with the start gains to fail early, naming what is wrong."""
-    from .plant import plant_of
+    from ..control.plant import plant_of
     kw = controller_env_kwargs(cls, env_id)
     plant = plant_of(env_id, **kw)
     if not cls.supports(plant):
@@ -117,9 +117,9 @@ def tune(spec: str, env_id: str, gains: list[str], out, iterations: int = 12,
          population: int = 24, elite: int = 6, seed: int = 0, progress: bool = True,
          plots: bool = True, backend: Backend = Backend(), suite: str = "nominal") -> dict:
     """Run the search (module doc) and write ``tune.json`` / ``tune.png`` into ``out``; on
-    ``--backend ray`` Ray Tune evaluates the candidates (:mod:`agents.ray_search`, its trials
+    ``--backend ray`` Ray Tune evaluates the candidates (:mod:`agents.benchmarking.ray_search`, its trials
     under ``out/ray_tune``), with the same result. ``suite="robust"``: on the robust
-    validation set (:func:`agents.robust.robust_validator`, Full task only) instead."""
+    validation set (:func:`agents.benchmarking.robust.robust_validator`, Full task only) instead."""
     check_suite(suite)
     if not gains:
         raise ValueError("--gain is required (NAME=LO:HI, repeatable)")

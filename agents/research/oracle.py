@@ -7,7 +7,7 @@ For each of ``--scenarios`` drops drawn where whirl is decided (``ORACLE_RANGES`
 0.38-0.6 unless ``--friction LO:HI`` says otherwise, power back 30-70 ms rounded up to the 5 ms control grid, any unbalance phase, the
 environments' default ranges for the rest; seeds from ``SCENARIO_SEED``, disjoint from training
 and evaluation seeds) a
-cross-entropy search (:mod:`agents.search`) optimises an open-loop command sequence of
+cross-entropy search (:mod:`agents.benchmarking.search`) optimises an open-loop command sequence of
 ``RotorDrop-Full-v1`` with ``command="supervisor"``: piecewise constant over the segments
 ``SEGMENT_EDGES_MS`` after the fault, per segment both damper commands, the PID gain scale and
 the four orbit-frame reference offsets, plus one delay after the power return before the
@@ -16,7 +16,7 @@ does, and starts from the ``inner-loop`` commands (C_max, switch on at once, zer
 it never ends worse than that row. Because the offsets act in the frame of the sensed orbit,
 inside the physics step, the "open-loop" sequence is still a feedback law of the inner loop.
 
-Cost of an episode: the benchmark's J (:func:`agents.score.row_cost`, against the passive drop
+Cost of an episode: the benchmark's J (:func:`agents.benchmarking.score.row_cost`, against the passive drop
 of the same scenario); the search adds ``SHAPING`` x min(peak backward revolutions / 3, 1) so
 that it sees progress towards a whirl-free drop before the whirl verdict flips; the oracle's
 sequence is the rollout of lowest J among all the search ran. Every row
@@ -39,9 +39,9 @@ reference offset, the law of the baseline ``inner-loop-lift`` with other constan
 those rows there.
 
 ``--suite robust`` runs the same search and rows on the robust suite's scenarios instead
-(:mod:`agents.robust`: the first ``--scenarios`` drops of ``rotordrop benchmark --suite robust``,
+(:mod:`agents.benchmarking.robust`: the first ``--scenarios`` drops of ``rotordrop benchmark --suite robust``,
 seeds from ``SUITE_SEED``, the robust plant spread, sensor noise and observation latency), each
-built by the benchmark's own :func:`agents.benchmark.episode_kwargs` from the robust
+built by the benchmark's own :func:`agents.benchmarking.benchmark.episode_kwargs` from the robust
 :class:`Scenario` and scored as that suite scores it. Noise and latency act on the
 observations only (:mod:`rotordrop_env.sensors`), so they change the rows that read the sensors
 and not the oracle's open-loop sequence over the built-in PID, which knows the plant in advance.
@@ -53,13 +53,13 @@ from pathlib import Path
 
 import numpy as np
 
-from .benchmark import (EPISODE_TIME, TASKS, Entry, Scenario, controller_entry, episode_kwargs,
+from ..benchmarking.benchmark import (EPISODE_TIME, TASKS, Entry, Scenario, controller_entry, episode_kwargs,
                         extras)
-from .controllers import BASELINES, Passive
-from .plant import plant_of
-from .policies import load_shipped, shipped_names
-from .rollout import final_kpis, run_episodes
-from .score import DEFAULT_SCORE, overall_score, row_cost, write_json
+from ..control.controllers import BASELINES, Passive
+from ..control.plant import plant_of
+from ..learning.policies import load_shipped, shipped_names
+from ..benchmarking.rollout import final_kpis, run_episodes
+from ..benchmarking.score import DEFAULT_SCORE, overall_score, row_cost, write_json
 
 ENV_ID = TASKS["full"]
 COMMAND = "supervisor"
@@ -101,10 +101,10 @@ def suite_scenarios(suite: str, n: int, seed: int,
                     friction: tuple[float, float] | None = None) -> list[tuple[Scenario, float, dict]]:
     """The first ``n`` scenarios of ``suite`` from ``seed``: (benchmark :class:`Scenario`,
     unbalance phase, the record written to oracle.json). ``robust``: the robust suite's own
-    scenarios (:func:`agents.robust.robust_scenarios`; their unbalance phase is in the scene
+    scenarios (:func:`agents.benchmarking.robust.robust_scenarios`; their unbalance phase is in the scene
     overrides, the phase argument is the benchmark's 0)."""
     if check_suite(suite) == "robust":
-        from .robust import robust_scenarios
+        from ..benchmarking.robust import robust_scenarios
         return [(sc, 0.0, robust_record(sc)) for sc in robust_scenarios(n, seed)]
     return [(*as_benchmark(v, f"#{i}"), v) for i, v in enumerate(draw_scenarios(n, seed, friction))]
 
@@ -122,7 +122,7 @@ def draw_scenarios(n: int, seed: int = SCENARIO_SEED,
     """``n`` scenario dicts (dotted scene keys and ``power_return_time``) drawn by the Full
     environment's own sampler from ``ORACLE_RANGES`` (friction from ``friction`` if given) and
     the default ranges."""
-    from .plant import make_env
+    from ..control.plant import make_env
     ranges = oracle_ranges(friction)
     env = make_env(ENV_ID, randomize=True, randomization=ranges, episode_time=0.01)
     try:
@@ -229,11 +229,11 @@ def constant_name(gain: float, offset_r: float) -> str:
 
 def constant_entry(gain: float, offset_r: float) -> Entry:
     """The ``--constant GAIN:OFFSET_R`` row: the designed law of ``inner-loop-lift``
-    (:class:`agents.controllers.InnerLoop` with these constants, a causal law that does not know
+    (:class:`agents.control.controllers.InnerLoop` with these constants, a causal law that does not know
     the scenario and reads no sensor) at ``inner-loop-lift``'s control step, run and scored as
     every other row; ``--constant 0.5:-0.5`` is ``inner-loop-lift`` itself."""
-    from .benchmark import controller_env_kwargs
-    from .controllers import InnerLoop, InnerLoopLift
+    from ..benchmarking.benchmark import controller_env_kwargs
+    from ..control.controllers import InnerLoop, InnerLoopLift
     return Entry(constant_name(gain, offset_r), "full",
                  lambda plant: InnerLoop(plant, gain, offset_r),
                  controller_env_kwargs(InnerLoopLift, ENV_ID))
@@ -308,7 +308,7 @@ def search_scenario(sc: Scenario, phase: float, passive: dict, population: int, 
     import warnings
     from rotordrop_env import BatchedRotorDropVecEnv
     from rotordrop_env.vec_env import TorchThreadsWarning
-    from .search import cross_entropy
+    from ..benchmarking.search import cross_entropy
     drops = [(sc, phase, passive), *copies]
     venvs: dict[tuple[int, int], object] = {}
     seen: dict[bytes, tuple[float, dict]] = {}
@@ -358,14 +358,14 @@ def search_currents(sc: Scenario, phase: float, passive: dict, population: int, 
                     seed: int, progress: bool) -> dict:
     """Cross-entropy search of an open-loop correction of ``CURRENT_BASELINE``'s coil currents
     on one drop (``--interface currents``; the correction of
-    :class:`agents.open_loop.OpenLoopCorrection`), for the benchmark's J with the
+    :class:`agents.control.open_loop.OpenLoopCorrection`), for the benchmark's J with the
     supervisor search's shaping; starts from no correction (the baseline itself), so its J is
     never above the baseline's on the drop. One episode per candidate (no batching)."""
     from rotordrop_env.layout import CURRENT_ACTIONS
-    from .benchmark import controller_entry
-    from .controllers import controller_class
-    from .open_loop import OpenLoopCorrection
-    from .search import cross_entropy
+    from ..benchmarking.benchmark import controller_entry
+    from ..control.controllers import controller_class
+    from ..control.open_loop import OpenLoopCorrection
+    from ..benchmarking.search import cross_entropy
     entry = controller_entry(controller_class(CURRENT_BASELINE), ENV_ID)
     kw = episode_kwargs(entry, sc, phase)
     seen: dict[bytes, tuple[float, dict]] = {}
@@ -396,8 +396,8 @@ def search_currents(sc: Scenario, phase: float, passive: dict, population: int, 
 def row_entries(policies: list[str] | None, suite: str = "full") -> list[Entry]:
     """Every baseline with channels in the Full task, the shipped Full policies and the
     ``--policy`` extras (paths or controller classes), as the benchmark builds them (with
-    ``suite`` robust: as the robust suite does, :func:`agents.benchmark.robust_entries`)."""
-    from .benchmark import _entries, check_unique_names, robust_entries
+    ``suite`` robust: as the robust suite does, :func:`agents.benchmarking.benchmark.robust_entries`)."""
+    from ..benchmarking.benchmark import _entries, check_unique_names, robust_entries
     if suite == "robust":
         return robust_entries(policies)[0]
     extra, custom = extras(policies or [])
@@ -442,7 +442,7 @@ def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iteration
     ``currents``: search open-loop corrections of whirl-brake's coil currents instead
     (:func:`search_currents`)."""
     from tqdm.auto import tqdm
-    from .score import fmt_or_dash
+    from ..benchmarking.score import fmt_or_dash
     if scenarios < 1 or population < 2 or iterations < 0:
         raise ValueError(f"need --scenarios >= 1, --population >= 2, --iterations >= 0 (got "
                          f"{scenarios}, {population}, {iterations})")
@@ -541,7 +541,7 @@ def suite_settings(suite: str, friction, scenario_seed: int | None) -> tuple[dic
                     control_dt=CONTROL_DT, shaping=SHAPING, episode_time_s=EPISODE_TIME,
                     score=DEFAULT_SCORE)
     if check_suite(suite) == "robust":
-        from .robust import LATENCY_MS, ROBUST_RANGES, SENSOR_NOISE, SUITE_SEED
+        from ..benchmarking.robust import LATENCY_MS, ROBUST_RANGES, SENSOR_NOISE, SUITE_SEED
         if friction is not None:
             raise ValueError("--friction does not apply to --suite robust (its scenarios are the "
                              "robust suite's, friction 0.3-0.6)")

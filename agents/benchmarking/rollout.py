@@ -15,8 +15,8 @@ import numpy as np
 
 from physics.model import P_Z_AMB1, axis_motion
 
-from .controllers import Controller, check_controller
-from .plant import POSITIONS, Plant, make_env
+from ..control.controllers import Controller, check_controller
+from ..control.plant import POSITIONS, Plant, make_env
 
 
 @dataclass
@@ -72,7 +72,7 @@ def run_episodes(env_id: str, make_actor: Callable[[Plant], object], seeds, env_
 
 def check_actor(env_id: str, make_actor: Callable[[Plant], object], env_kwargs=None) -> None:
     """Build the actor for ``gym.make(env_id, **env_kwargs)`` and run
-    :func:`~agents.controllers.check_controller` on its first observation (seed 0): raises
+    :func:`~agents.control.controllers.check_controller` on its first observation (seed 0): raises
     ``ControllerError`` (a ValueError) naming the actor if it cannot act."""
     env = make_env(env_id, **(env_kwargs or {}))
     try:

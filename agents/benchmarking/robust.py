@@ -11,7 +11,7 @@ the agent's observation gets its own latency of 0 or 1 ms (:data:`LATENCY_MS`, d
 scenario: 0 for a law running in the AMB controller, 1 ms for one transfer to a supervisory
 computer). The latency is physical time: a controller with control step Δt sees the newest
 measurement that has arrived, ⌈latency / Δt⌉ steps old (0-1 steps at 1 ms and at 5 ms), see
-:func:`agents.benchmark.latency_steps`.
+:func:`agents.benchmarking.benchmark.latency_steps`.
 
 Sensing ranges from AMB practice: eddy-current and inductive position sensors resolve 0.1-1 µm
 RMS over the controller's bandwidth (the suite takes the upper end); a digital AMB controller
@@ -120,11 +120,11 @@ def run_suite(suite: str, out, quick: bool = False, policies: list[str] | None =
               progress: bool = True, plots: bool = True, power_return: float | None = None,
               backend=None, env_id: str | None = None, names: list[str] | None = None,
               score: str | None = None) -> dict:
-    """``rotordrop benchmark --suite SUITE``: the nominal suite (:func:`agents.benchmark.benchmark`)
+    """``rotordrop benchmark --suite SUITE``: the nominal suite (:func:`agents.benchmarking.benchmark.benchmark`)
     or the robust one (:func:`robust_benchmark`, where ``episodes`` and ``power_return`` do not
     apply: its scenarios draw the power return, one episode each); ``robust-legacy``: the
     robust suite on its earlier test drops (``LEGACY_SUITE_SEED``). ``score``:
-    :data:`agents.score.SCORES` (default the first)."""
+    :data:`agents.benchmarking.score.SCORES` (default the first)."""
     from .benchmark import benchmark, check_suite
     from .score import DEFAULT_SCORE, check_score
     score = check_score(score if score is not None else DEFAULT_SCORE)

@@ -1,6 +1,6 @@
 """Baseline controllers with the interface of a trained SB3 policy.
 
-Every controller is built from a :class:`~agents.plant.Plant` (what the environment tells about
+Every controller is built from a :class:`~agents.control.plant.Plant` (what the environment tells about
 its observations and actions) and answers ``predict(obs, state, episode_start, deterministic)``
 with ``(actions, state)`` exactly like ``model.predict`` of Stable-Baselines3, for a single
 observation or a batch. Controllers read observations by *name* (``env.unwrapped.obs_names``)
@@ -50,7 +50,7 @@ class Controller:
     """Base class: ``act(obs)`` maps a batch of raw observations to a batch of actions.
 
     Subclasses set ``name`` and ``needs`` and return channel values from ``commands(obs)``
-    (:mod:`agents.plant`). One controller drives many episodes, so ``__init__`` is for
+    (:mod:`agents.control.plant`). One controller drives many episodes, so ``__init__`` is for
     constants (gains); **per-episode state** (integrators, filters, timers, flags) is (re)set in
     ``reset(n, which)``, which ``predict`` calls at episode starts: for all ``n`` environments
     when ``which`` is None, else where ``which`` is True. Override it, call
@@ -59,13 +59,13 @@ class Controller:
     going back), so one controller drives episode after episode without the caller's help.
     ``self.t`` (n,) is the time since each episode's start [s]. Errors in a controller, and
     commands of an unknown channel, shape or range, raise
-    :class:`~agents.plant.ControllerError` naming it.
+    :class:`~agents.control.plant.ControllerError` naming it.
     """
 
     name = "controller"
     #: channels the controller sets (a subset of Plant.channels); the rest stay passive
     needs: tuple[str, ...] = ()
-    #: reads the sensor observations (``agents.plant.SENSORS``), absent with full_state=True
+    #: reads the sensor observations (``agents.control.plant.SENSORS``), absent with full_state=True
     sensors: bool = True
     #: the action is a function of the present observation alone (no per-episode state, every
     #: damper channel set): a residual policy on it runs under plain SB3 (agents.sb3_policy)
@@ -101,7 +101,7 @@ class Controller:
             self.fresh[which] = True
 
     def commands(self, obs: np.ndarray) -> dict[str, np.ndarray]:
-        """Channel name -> value per environment (see :mod:`agents.plant`)."""
+        """Channel name -> value per environment (see :mod:`agents.control.plant`)."""
         return {}
 
     def act(self, obs: np.ndarray) -> np.ndarray:
@@ -373,7 +373,7 @@ class InnerLoop(Controller):
     law reads no sensor. The class defaults ``GAINS`` (both 0) are ``inner-loop``, the
     "inner loop only" row (the same trajectory as ``builtin-relevitate`` with C_max); other
     values are ``inner-loop-lift`` (:class:`InnerLoopLift`) and the oracle's ``--constant``
-    rows (:func:`agents.oracle.constant_entry`)."""
+    rows (:func:`agents.research.oracle.constant_entry`)."""
 
     name = "inner-loop"
     needs = ("levitate", "offsets")
@@ -524,7 +524,7 @@ def load_controller(spec: str) -> type[Controller]:
     cls = getattr(module, attr)
     if not (isinstance(cls, type) and issubclass(cls, Controller)):
         raise ValueError(f"controller {spec!r}: {attr!r} in {target} is not a subclass of "
-                         f"agents.controllers.Controller")
+                         f"agents.control.controllers.Controller")
     if cls.name in BASELINES:
         raise ValueError(f"controller {spec!r}: its name {cls.name!r} is a baseline's; give it its own")
     return cls

@@ -1,7 +1,7 @@
 """Cross-entropy search (CEM): the derivative-free optimiser behind the gain tuning of
 ``whirl-brake`` (:mod:`agents.research.tune_whirl_brake`) and the open-loop whirl bound
 (:mod:`agents.research.whirl_bound`) and of ``rotordrop tune`` (there on Ray Tune with
-``--backend ray``, :mod:`agents.ray_search`). Deterministic for a given ``rng``."""
+``--backend ray``, :mod:`agents.benchmarking.ray_search`). Deterministic for a given ``rng``."""
 from __future__ import annotations
 
 from typing import Callable
@@ -17,7 +17,7 @@ class CrossEntropy:
     refits mean and std to the ``elite`` best, and adds ``min_std`` to the refitted std (so the
     search never collapses below it). ``history[i]`` holds the best cost so far, the generation's
     best cost and the best candidate after generation i (i = 0: ``mean``). Whoever evaluates
-    the candidates (a loop here, Ray Tune in :mod:`agents.ray_search`), the same costs give the
+    the candidates (a loop here, Ray Tune in :mod:`agents.benchmarking.ray_search`), the same costs give the
     same search."""
 
     def __init__(self, mean, std, low, high, population: int, elite: int,

@@ -13,11 +13,11 @@ In a config (``rotordrop train``)::
 
     action_log_std: {gain: -1.0, offset_r1: -1.0, offset_r2: -1.0}
 
-and as rl-zoo3 writes it (``python -m rl_zoo3.train``; :mod:`agents.hyperparams` reads either
+and as rl-zoo3 writes it (``python -m rl_zoo3.train``; :mod:`agents.learning.hyperparams` reads either
 form)::
 
     callback:
-      - agents.exploration.ActionSpread: {log_std: {gain: -1.0, offset_r1: -1.0, offset_r2: -1.0}}
+      - agents.learning.exploration.ActionSpread: {log_std: {gain: -1.0, offset_r1: -1.0, offset_r2: -1.0}}
 
 Only policies with a state-independent log std take it (PPO's ``MlpPolicy`` without gSDE).
 A resumed run keeps the spread it learned.
@@ -65,7 +65,7 @@ def set_action_log_std(policy, action_names, log_std: dict) -> None:
 
 class ActionSpread(BaseCallback):
     """Sets the initial log std of the named action entries when training starts from scratch
-    (rl-zoo3: ``callback: - agents.exploration.ActionSpread: {log_std: {...}}``; in
+    (rl-zoo3: ``callback: - agents.learning.exploration.ActionSpread: {log_std: {...}}``; in
     ``rotordrop train`` the key ``action_log_std``). A resumed model is left as it is."""
 
     def __init__(self, log_std: dict, verbose: int = 0):

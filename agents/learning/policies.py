@@ -21,12 +21,11 @@ from pathlib import Path
 
 import numpy as np
 
-from .controllers import BASELINES, controller_class, make_baseline, make_controller
-from .plant import Plant
+from ..control.controllers import BASELINES, controller_class, make_baseline, make_controller
+from ..control.plant import Plant
 from .hyperparams import ALGOS as ALGO_NAMES, algo_class, parse_literal
-from .residual import RESIDUAL_SCALE, residual_action
-from .sb3_policy import FrameStack, current_env_id, frame_stack_of, export_self_contained, is_self_contained
-from .score import write_json
+from ..control.residual import RESIDUAL_SCALE, residual_action
+from ..sb3_policy import FrameStack, current_env_id, frame_stack_of, export_self_contained, is_self_contained
 
 
 #: the training schedules a zip pickles with the Python it was saved under; acting needs none of
@@ -219,7 +218,7 @@ def _read_meta(path: Path) -> dict:
 
 def _algo_from_zip(path: Path) -> str:
     """The algorithm from the zip's policy class, else from its name (``<algo>-...``)."""
-    from .sb3_policy import zip_algo
+    from ..sb3_policy import zip_algo
     found = zip_algo(path)
     if found is not None:
         return found
@@ -290,41 +289,3 @@ def export_learned(pol: LearnedPolicy, out: str | Path) -> Path:
     return export_self_contained(pol.model, pol.vecnormalize, out, env_id=pol.env_id,
                                  env_kwargs=pol.env_kwargs, residual=pol.residual,
                                  residual_scale=pol.residual_scale)
-
-
-def ship_policy(run_dir: str | Path, name: str, which: str = "final", dest: Path | None = None,
-                notes: str = "", command: str | None = None) -> Path:
-    """Export a training run's model (self-contained, :func:`export_policy`) and copy its
-    statistics into ``agents/policies/<name>.*``.
-
-    ``which`` = ``final`` (``model.zip``) or ``best`` (``best/best_model.zip``). The JSON records
-    the command and seed that reproduce the run (``command`` overrides the recorded one, e.g.
-    when the run's ``--config`` has become the shipped default), its training time and a
-    learning-curve summary.
-    """
-    import shutil
-    run = Path(run_dir)
-    dest = Path(dest) if dest is not None else shipped_dir()
-    algo = name.split("-")[0]
-    if algo not in ALGO_NAMES:
-        raise ValueError(f"a shipped policy's name starts with its algorithm ({', '.join(ALGO_NAMES)}), "
-                         f"got {name!r}")
-    model, vn = ((run / "model.zip", run / "vecnormalize.pkl") if which == "final"
-                 else (run / "best" / "best_model.zip", run / "best" / "vecnormalize.pkl"))
-    info = json.loads((run / "training.json").read_text())
-    export_policy(model, dest / f"{name}.zip")            # runs under plain SB3 as it is
-    shutil.copyfile(vn, dest / f"{name}.pkl")
-    curve = info.get("learning_curve", [])
-    summary = [{k: (round(v, 4) if isinstance(v, float) else v) for k, v in h.items()
-                if k in ("timesteps", "mean_reward", "mean_failure", "mean_backward_whirl",
-                         "mean_peak_contact_force_N", "mean_relevitated")} for h in curve]
-    command = command or re.sub(r"--out \S+", f"--out runs/{name}", info["command"])
-    meta = dict(name=name, algo=info["algo"], env_id=info["env_id"],
-                env_kwargs=info["hyperparams"].get("env_kwargs", {}), model=which,
-                command=command, seed=info["seed"], timesteps=info["timesteps"],
-                training_wall_time_s=round(info["wall_time_s"], 1),
-                steps_per_s=round(info["steps_per_s"], 1) if info.get("steps_per_s") else None,
-                threads=info.get("threads"), versions=info.get("versions"),
-                hyperparams=info["hyperparams"], learning_curve=summary, notes=notes)
-    write_json(dest / f"{name}.json", meta, indent=1)
-    return dest / f"{name}.zip"

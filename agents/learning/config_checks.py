@@ -1,5 +1,5 @@
-"""The error of a bad hyperparameter and the checks every config key shares (:mod:`agents.hyperparams`
-validates the files, :mod:`agents.reward` its ``reward_kwargs`` with them)."""
+"""The error of a bad hyperparameter and the checks every config key shares (:mod:`agents.learning.hyperparams`
+validates the files, :mod:`agents.learning.reward` its ``reward_kwargs`` with them)."""
 from __future__ import annotations
 
 import difflib

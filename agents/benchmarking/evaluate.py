@@ -12,8 +12,8 @@ from pathlib import Path
 
 from .benchmark import (EPISODE_TIME, RELEVITATION_ENVS, check_power_return, controller_env_kwargs,
                         monitor_kwargs, policy_label)
-from .controllers import Passive, controller_class, is_controller_spec, make_controller
-from .policies import resolve
+from ..control.controllers import Passive, controller_class, is_controller_spec, make_controller
+from ..learning.policies import resolve
 from .rollout import check_actor, run_episodes
 from .score import fmt_or_dash, summarize, write_json
 

@@ -3,7 +3,7 @@
 The environment receives ``clip(base(obs) + s a, -1, 1)`` with ``a`` the agent's action and
 ``s`` the config's ``residual_scale`` (default ``RESIDUAL_SCALE`` = 2), so a freshly initialised
 policy (a ≈ 0) is the baseline controller and learning changes it only where that pays
-(Johannink et al. 2019). :class:`agents.policies.LearnedPolicy` applies the same correction
+(Johannink et al. 2019). :class:`agents.learning.policies.LearnedPolicy` applies the same correction
 (:func:`residual_action`) when a saved residual policy is loaded.
 """
 from __future__ import annotations
@@ -24,7 +24,7 @@ def residual_action(base, raw_obs: np.ndarray, a: np.ndarray, scale: float,
 
 class ResidualAction(VecEnvWrapper):
     """Residual actions on an SB3 VecEnv (config key ``residual: <baseline>``; in an rl-zoo3
-    config ``vec_env_wrapper: [{agents.residual.ResidualAction: {base: NAME, scale: S}}]``):
+    config ``vec_env_wrapper: [{agents.control.residual.ResidualAction: {base: NAME, scale: S}}]``):
     see :func:`residual_action`. A freshly initialised policy (a ≈ 0) reproduces the baseline;
     learning changes it only where that pays (residual policy learning, Johannink et al.
     2019). Box action spaces only. Works on the batched VecEnv and on SB3's DummyVecEnv (rl-zoo3's

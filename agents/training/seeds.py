@@ -1,7 +1,7 @@
 """``rotordrop train --seeds 0,1,2``: one training run per seed, side by side.
 
 Each seed trains into ``<out>/seed_<k>`` exactly as ``rotordrop train --seed k --out
-<out>/seed_<k>`` would (:func:`agents.train.train`). On ``--backend local`` the seeds run one
+<out>/seed_<k>`` would (:func:`agents.training.train.train`). On ``--backend local`` the seeds run one
 after the other in this process; on ``--backend ray`` each seed is one Ray task holding
 ``--threads`` CPUs (``num_cpus``), so a cluster trains them at once. A task carries only the
 training's arguments (env id, algorithm, paths, numbers); it writes its run on the node that ran
@@ -37,7 +37,7 @@ def train_seeds(seeds: list[int], env_id: str, algo: str, outs: list[str | Path]
                 **kwargs) -> list[TrainResult]:
     """Train seed ``seeds[i]`` into ``outs[i]`` on ``backend`` (module doc); results in the
     order of ``seeds``."""
-    from .hyperparams import check_sb3, split
+    from ..learning.hyperparams import check_sb3, split
     meta, algo_kwargs = split(resolve_config(env_id, algo, kwargs.get("config"),
                                              kwargs.get("timesteps"), kwargs.get("n_envs")))
     check_sb3(algo, env_id, meta, algo_kwargs)                # fail before any task starts

@@ -25,7 +25,7 @@ hold no run unless ``overwrite`` (``--overwrite``) removes the run in it.
 The final model is always evaluated (and checkpointed, with ``checkpoint_freq`` > 0) unless the
 last step already was an evaluation (a checkpoint), so a run shorter than ``eval_freq`` still
 writes ``best/`` and its learning curve. Every input is checked before anything is written: a
-bad key or value raises :class:`~agents.hyperparams.ConfigError` naming it.
+bad key or value raises :class:`~agents.learning.hyperparams.ConfigError` naming it.
 """
 from __future__ import annotations
 
@@ -40,7 +40,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .hyperparams import (ALGOS, ConfigError, algo_class, check_sb3, dump_yaml, load_hyperparams,
+from ..learning.hyperparams import (ALGOS, ConfigError, algo_class, check_sb3, dump_yaml, load_hyperparams,
                           read_yaml, split)
 
 OFF_POLICY = ("sac", "td3", "tqc")
@@ -72,8 +72,8 @@ def _callbacks():
     """SB3 callback classes, defined lazily so that importing this module stays light."""
     from stable_baselines3.common.callbacks import BaseCallback, CheckpointCallback, EvalCallback
 
-    from .rollout import final_kpis
-    from .score import mean_finite, write_json
+    from ..benchmarking.rollout import final_kpis
+    from ..benchmarking.score import mean_finite, write_json
 
     class SaveBest(BaseCallback):
         """On a new best evaluation: the model in ``best/`` as a self-contained zip (over the
@@ -158,45 +158,6 @@ def _callbacks():
         def _on_training_end(self):
             self.bar.close()
 
-    class ValidationCallback(BaseCallback):
-        """At every evaluation, the benchmark score of the deterministic policy on the validation
-        suite (:class:`agents.benchmark.Validator`); the best-scoring model goes to ``best/``
-        with its VecNormalize statistics, and the score into the learning curve."""
-
-        def __init__(self, env_id, algo, env_kwargs, meta, best_dir: Path, eval_cb,
-                     best: float = -np.inf):
-            super().__init__()
-            from .robust import validator_for
-            self.validator = validator_for(env_id, env_kwargs)
-            self.env_id, self.algo, self.env_kwargs, self.meta = env_id, algo, env_kwargs, meta
-            self.best_dir, self.eval_cb = best_dir, eval_cb
-            self.best = best                        # a continued run's best score so far
-            self.seen = len(eval_cb.kpi_history)
-
-        def _init_callback(self) -> None:
-            self.best_dir.mkdir(parents=True, exist_ok=True)
-
-        def _on_step(self) -> bool:
-            if len(self.eval_cb.kpi_history) == self.seen:
-                return True
-            self.seen = len(self.eval_cb.kpi_history)
-            from .validation import validation_score
-            vn = self.model.get_vec_normalize_env()
-            score = validation_score(self.validator, self.model, self.algo, self.env_id,
-                                     self.env_kwargs, vn, self.meta.get("residual"),
-                                     self.meta.get("residual_scale"),
-                                     self.meta.get("frame_stack", 1))
-            self.eval_cb.kpi_history[-1]["validation_score"] = score
-            self.logger.record("eval/validation_score", score)
-            if score > self.best:
-                self.best = score
-                save_policy(self.model, self.best_dir / "best_model.zip", self.env_id, self.meta)
-            return True
-
-        def _on_training_end(self):
-            self._on_step()                         # scores the final evaluation, if any
-            self.logger.dump(self.num_timesteps)
-
     class FinalCheckpoint(CheckpointCallback):
         """CheckpointCallback that also saves the final model, so that a run shorter than
         ``checkpoint_freq`` or between two checkpoints can be resumed where it ended."""
@@ -251,15 +212,15 @@ def _callbacks():
             self.record["stopped_by_time_limit"] = True
             return False
 
-    return (SaveBest, KpiEvalCallback, TqdmCallback, ValidationCallback, FinalCheckpoint,
-            RecordCallback, WallClockLimit)
+    return (SaveBest, KpiEvalCallback, TqdmCallback, FinalCheckpoint, RecordCallback,
+            WallClockLimit)
 
 
 def save_policy(model, path: Path, env_id: str, meta: dict) -> None:
     """``model`` at ``path`` as a self-contained zip that plain SB3 runs like ``rotordrop
     evaluate`` (:func:`agents.sb3_policy.export_self_contained`), and its VecNormalize statistics
     as ``vecnormalize.pkl`` next to it (for rl-zoo3 and to continue training)."""
-    from .sb3_policy import export_self_contained
+    from ..sb3_policy import export_self_contained
     vn = model.get_vec_normalize_env()
     export_self_contained(model, vn, path, env_id=env_id, env_kwargs=meta["env_kwargs"],
                           residual=meta.get("residual"), residual_scale=meta.get("residual_scale"),
@@ -374,7 +335,7 @@ def train(env_id: str, algo: str, out: str | Path, timesteps: int | None = None,
     vn_path = out / "vecnormalize.pkl"
     save_policy(model, model_path, env_id, meta)
     wall = record_cb.write(finished=True)
-    from .plots import plot_learning_curve
+    from ..benchmarking.plots import plot_learning_curve
     plot_learning_curve(sorted(eval_cb.kpi_history, key=lambda h: h["timesteps"]),
                         out / "learning_curve.png", f"{algo} {env_id}")
     model.get_env().close()
@@ -410,8 +371,9 @@ def _training_callbacks(env_id: str, algo: str, meta: dict, seed: int, out: Path
     """(evaluation, record, all callbacks): evaluation with KPIs continuing ``curve`` and
     ``eval_log`` from their best score, validation, checkpoints, progress bar, training.json,
     the wall-clock limit."""
-    SaveBest, KpiEvalCallback, TqdmCallback, ValidationCallback, FinalCheckpoint, \
-        RecordCallback, WallClockLimit = _callbacks()
+    SaveBest, KpiEvalCallback, TqdmCallback, FinalCheckpoint, RecordCallback, WallClockLimit \
+        = _callbacks()
+    from .validation import ValidationCallback
     n = meta.get("n_envs", 1)
     eval_freq = max(meta.get("eval_freq", 10_000) // n, 1) if meta.get("eval_freq", 1) else -1
     keep_best = eval_freq > 0 and not meta["validation"]      # else ValidationCallback keeps it
@@ -427,11 +389,15 @@ def _training_callbacks(env_id: str, algo: str, meta: dict, seed: int, out: Path
     eval_cb.best_mean_reward = _best(curve, "mean_reward")
     cbs = [eval_cb]
     if "action_log_std" in meta:
-        from .exploration import ActionSpread
+        from ..learning.exploration import ActionSpread
         cbs.insert(0, ActionSpread(meta["action_log_std"]))
     if meta["validation"]:
-        cbs.append(ValidationCallback(env_id, algo, meta["env_kwargs"], meta, out / "best", eval_cb,
-                                      best=_best(curve, "validation_score")))
+        policy = dict(env_id=env_id, algo=algo, env_kwargs=meta["env_kwargs"],
+                      residual=meta.get("residual"), residual_scale=meta.get("residual_scale"),
+                      frame_stack=meta.get("frame_stack", 1))
+        cbs.append(ValidationCallback(save_path=out / "best", verbose=0, evaluations=eval_cb,
+                                      policy=policy, best=_best(curve, "validation_score"),
+                                      save=lambda model, path: save_policy(model, path, env_id, meta)))
     if meta.get("checkpoint_freq", 0):
         cbs.append(FinalCheckpoint(save_freq=max(meta["checkpoint_freq"] // n, 1),
                                    save_path=str(out / "checkpoints"), name_prefix="rl_model",
@@ -509,8 +475,8 @@ def check_env(env_id: str, algo: str, meta: dict) -> None:
     commands, an ``action_log_std`` naming entries the environment lacks are ConfigErrors."""
     from gymnasium.spaces import Box
 
-    from .controllers import make_baseline
-    from .plant import Plant, make_env
+    from ..control.controllers import make_baseline
+    from ..control.plant import Plant, make_env
     try:
         env = make_env(env_id, **meta["env_kwargs"])
     except (TypeError, ValueError, KeyError) as exc:
@@ -529,7 +495,7 @@ def check_env(env_id: str, algo: str, meta: dict) -> None:
             except ValueError as exc:
                 raise ConfigError(f"residual: {exc}") from exc
         if "action_log_std" in meta:
-            from .exploration import check_action_log_std
+            from ..learning.exploration import check_action_log_std
             if not isinstance(space, Box):
                 raise ConfigError(f"action_log_std needs continuous actions: {fix}")
             check_action_log_std(meta["action_log_std"], env.unwrapped.action_names)
@@ -556,7 +522,7 @@ def _check_resumed_run(checkpoint: Path, algo: str, env_id: str) -> None:
 
 def _checkpoint_algo(path: Path) -> str | None:
     """The algorithm of an SB3 model zip, from its policy class (None: unknown)."""
-    from .sb3_policy import zip_algo
+    from ..sb3_policy import zip_algo
     try:
         return zip_algo(path)
     except ValueError as exc:

@@ -19,7 +19,7 @@
    they were trained with.
    Episodes last ``EPISODE_TIME`` and are not cut short at the stator (``terminate_on_failure =
    False``) so that whirl is measured as ``rotordrop drop`` measures it.
-4. **Score** (:mod:`agents.score`): per task, 100 (1 − Σ J / Σ J_passive) over the suite;
+4. **Score** (:mod:`agents.benchmarking.score`): per task, 100 (1 − Σ J / Σ J_passive) over the suite;
    ``score`` picks J (``severity``, the default, or ``legacy``). Every leaderboard row carries
    a paired bootstrap over the drops (scenario × phase episodes, the same for every row) of its
    score and of its difference to the best designed row of its task (:func:`add_uncertainty`).
@@ -37,8 +37,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .controllers import BASELINES, Passive, command_for, controller_class, make_controller
-from .policies import LearnedPolicy, load_shipped, shipped_names
+from ..control.controllers import BASELINES, Passive, command_for, controller_class, make_controller
+from ..learning.policies import LearnedPolicy, load_shipped, shipped_names
 from .rollout import check_actor, run_episodes
 from .score import (BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, DEFAULT_SCORE, bootstrap_scores,
                     check_score, drop_costs, fmt_or_dash, overall_score, row_cost, summarize,
@@ -54,7 +54,7 @@ WHIRL_MARGINS = (0.05, 0.10, 0.15)
 TASKS = {"damping": "RotorDrop-Damping-v1", "relevitate": "RotorDrop-Relevitate-v1",
          "full": "RotorDrop-Full-v1"}
 RELEVITATION_ENVS = (TASKS["relevitate"], TASKS["full"])
-#: ``--suite``: the fixed nominal suite, or the robust one (:mod:`agents.robust`)
+#: ``--suite``: the fixed nominal suite, or the robust one (:mod:`agents.benchmarking.robust`)
 SUITES = ("nominal", "robust", "robust-legacy")
 
 
@@ -193,7 +193,7 @@ class Entry:
 def _entries(policies: list[LearnedPolicy], controllers=()) -> list[Entry]:
     """Every controller class (the baselines, then ``controllers``) in each task that has its
     channels, and every policy in the task it was trained for."""
-    from .plant import plant_of
+    from ..control.plant import plant_of
     out = []
     for task, env_id in TASKS.items():
         plants = {}                                  # per re-levitation command
@@ -333,10 +333,10 @@ def benchmark(out: str | Path, quick: bool = False, policies: list[str] | None =
               backend=None, env_id: str | None = None, names: list[str] | None = None,
               score: str = DEFAULT_SCORE) -> dict:
     """Run the suite and write benchmark.json, leaderboard.md and the plots into ``out``;
-    ``power_return`` [s]: see :func:`scenario_suite`; ``score``: :data:`agents.score.SCORES`.
+    ``power_return`` [s]: see :func:`scenario_suite`; ``score``: :data:`agents.benchmarking.score.SCORES`.
     On ``backend`` ray every friction of the threshold sweep and every controller is one Ray
     task (learned policies travel as their paths and are loaded again on the node). The robust
-    suite: :mod:`agents.robust`."""
+    suite: :mod:`agents.benchmarking.robust`."""
     from physics.runs.backend import Backend
     backend = backend if backend is not None else Backend()
     check_score(score)
@@ -432,7 +432,7 @@ VALIDATION_PHASES = (45.0, 225.0)
 class Validator:
     """The benchmark score of one policy on the validation suite (``VALIDATION_*``) of a task,
     against the passive drop on the same suite (computed once); or on given ``scenarios``
-    and ``phases`` (the robust validation set, :func:`agents.robust.robust_validator`)."""
+    and ``phases`` (the robust validation set, :func:`agents.benchmarking.robust.robust_validator`)."""
 
     def __init__(self, env_id: str, scenarios: list[Scenario] | None = None,
                  phases=VALIDATION_PHASES):
@@ -469,7 +469,7 @@ def _row(entry: Entry, sc: Scenario, eps) -> dict:
                 drops={key: [_plain(d.get(key)) for d in k] for key in DROP_KEYS})
 
 
-#: the per-episode KPIs a row keeps (``drops``) for :func:`agents.score.drop_costs`
+#: the per-episode KPIs a row keeps (``drops``) for :func:`agents.benchmarking.score.drop_costs`
 DROP_KEYS = ("backward_whirl", "peak_whirl_revolutions", "peak_contact_force_N",
              "max_displacement_um", "relevitated", "relevitation_time_s")
 
@@ -492,8 +492,8 @@ def bootstrap_record() -> dict:
 
 def leaderboard(rows: list[dict], scenarios: list[Scenario], threshold,
                 any_friction: bool = False, score: str = DEFAULT_SCORE) -> list[dict]:
-    """Per task and controller: overall score (``score``: :data:`agents.score.SCORES`) with its
-    bootstrap uncertainty (:func:`add_uncertainty`), whirl and force criteria (see agents.score).
+    """Per task and controller: overall score (``score``: :data:`agents.benchmarking.score.SCORES`) with its
+    bootstrap uncertainty (:func:`add_uncertainty`), whirl and force criteria (see agents.benchmarking.score).
     The whirl rate "where passive whirls" counts the scenarios where the passive drop whirls
     at μ* + 0.05 or above (``threshold`` = μ*), or at any friction with ``any_friction``
     (the robust suite's drawn scenarios)."""
@@ -542,8 +542,8 @@ def leaderboard(rows: list[dict], scenarios: list[Scenario], threshold,
 def add_uncertainty(entries: list[dict], rows: list[dict], passive: dict, relev: bool,
                     score: str = DEFAULT_SCORE) -> None:
     """Add to the leaderboard entries of one task the paired bootstrap over its drops
-    (:func:`agents.score.bootstrap_scores`): ``score_se``, ``reference`` (the best designed
-    row: a baseline of agents.controllers other than passive, by point score),
+    (:func:`agents.benchmarking.score.bootstrap_scores`): ``score_se``, ``reference`` (the best designed
+    row: a baseline of agents.control.controllers other than passive, by point score),
     ``diff_vs_reference``, ``diff_se`` and ``diff_ci95``. Rows without per-episode KPIs, or
     that did not run the passive row's drops, get none."""
     names = [e["controller"] for e in entries]
