@@ -204,7 +204,7 @@ def constant_theta(gain: float, offset_r: float) -> np.ndarray:
     """The law of :func:`constant_entry` (``InnerLoop(plant, gain, offset_r)``: C_max, the PID
     on at the power return, a constant gain action ``gain`` and radial reference offset
     ``offset_r`` on both planes) as a command sequence of the search: its start with
-    ``--start-from-constants`` (tests/test_oracle.py checks that both run the same drop)."""
+    ``--start-from-constants`` (tests/agents/research/test_oracle.py checks that both run the same drop)."""
     seg = inner_loop_theta()[:-1].reshape(len(SEGMENT_EDGES_MS) - 1, len(SEGMENT_ACTIONS))
     for name, value in (("gain", gain), ("offset_r1", offset_r), ("offset_r2", offset_r)):
         seg[:, SEGMENT_ACTIONS.index(name)] = value

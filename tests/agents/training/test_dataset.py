@@ -206,7 +206,7 @@ def test_dataset_without_minari_names_the_offline_extra(tmp_path):
     from pathlib import Path
     proc = subprocess.run([sys.executable, "-c", BLOCK_MINARI, "dataset", "--policy", "max-damping",
                            "--env", DAMPING, "--episodes", "1", "--out", str(tmp_path)],
-                          cwd=Path(__file__).resolve().parents[1], capture_output=True, text=True)
+                          cwd=Path(__file__).resolve().parents[3], capture_output=True, text=True)
     assert proc.returncode == 2
     assert proc.stderr.count("\n") == 1 and "offline extra" in proc.stderr, proc.stderr
 

@@ -1,5 +1,5 @@
 """The policies shipped in agents/policies/: loadable by name, documented, acting in their env
-(what ppo-full does physically: tests/test_agents_controllers.py)."""
+(what ppo-full does physically: tests/agents/control/test_agents_controllers.py)."""
 import numpy as np
 import pytest
 

@@ -229,7 +229,7 @@ def test_the_spin_down_example_runs_and_orders_the_three_laws(tmp_path):
     import subprocess
     import sys
     from pathlib import Path
-    root = Path(__file__).resolve().parent.parent
+    root = Path(__file__).resolve().parents[2]
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(root), os.environ.get("PYTHONPATH", "")]))
     subprocess.run([sys.executable, str(root / "docs/examples/thermal_spin_down.py"), "--out",
                     str(tmp_path), "--t-end", "3"], check=True, capture_output=True, cwd=root,

@@ -19,7 +19,7 @@ from physics.flexible import assembly as asm
 from physics.flexible import modal
 from physics.flexible import ross_io
 
-DATA = Path(__file__).resolve().parent / "data"
+DATA = Path(__file__).resolve().parents[2] / "data"
 TOML = DATA / "ross_sample_rotor.toml"
 REF = json.loads((DATA / "ross_reference.json").read_text())
 
@@ -104,7 +104,7 @@ def test_reduced_model_matches_ross_reference(name):
 def test_ross_live():
     """ROSS itself (only where it is installed): the committed numbers are what it computes."""
     pytest.importorskip("ross")
-    path = Path(__file__).resolve().parents[1] / "benchmarks" / "ross_reference.py"
+    path = Path(__file__).resolve().parents[3] / "benchmarks" / "ross_reference.py"
     spec = importlib.util.spec_from_file_location("ross_reference", path)
     ref_mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(ref_mod)

@@ -1,7 +1,7 @@
 """Execution backends and the on-disk drop store (issue 14): every finished drop is kept, a
 resumed batch runs only the missing drops and returns what an uninterrupted one returns, and
 bad input (unknown backend, unreachable address, missing Ray, a store of another batch) is a
-one-line error that changes nothing on disk. Ray itself is tested in tests/test_cluster.py."""
+one-line error that changes nothing on disk. Ray itself is tested in tests/physics/runs/test_cluster.py."""
 import json
 import os
 import signal

@@ -171,7 +171,7 @@ def test_the_legacy_score_reproduces_a_benchmark_run_before_the_severity_score()
     legacy leaderboard gives the very same floats (JSON keeps them exactly)."""
     import json
     from pathlib import Path
-    d = json.loads((Path(__file__).parent / "data" / "benchmark-quick-legacy.json").read_text())
+    d = json.loads((Path(__file__).resolve().parents[2] / "data" / "benchmark-quick-legacy.json").read_text())
     board = leaderboard(d["rows"], [], d["passive_threshold"], score="legacy")
     new = {(e["task"], e["controller"]): e["score"] for e in board}
     assert {(e["task"], e["controller"]): e["score"] for e in d["scores"]} == new

@@ -26,7 +26,7 @@ def test_shipped_configs_parse(algo):
             assert isinstance(env.action_space, Box), (algo, env_id)
 
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[3]
 #: the experiment variants: deltas on a shipped entry or on each other (docs/experiments/configs)
 DELTAS = sorted((ROOT / "docs/experiments/configs").glob("*.yaml"))
 #: the named entries of the shipped files (one per shipped policy that shares an env id)
@@ -474,3 +474,23 @@ def test_resume_into_the_same_directory_continues_the_record(tmp_path):
     assert sum(line.startswith("r,l,t") for line in lines) == 1
     assert {p.name for p in (run / "checkpoints").glob("*_steps.zip")} == {
         "rl_model_256_steps.zip", "rl_model_512_steps.zip"}
+
+
+def test_a_run_ships_as_a_policy_of_agents_policies(trained, tmp_path, capsys):
+    """``python -m agents.training.ship RUN NAME``: how the shipped policies are made (a
+    self-contained zip, the statistics, the JSON that reproduces the run)."""
+    from stable_baselines3 import PPO
+
+    from agents.sb3_policy import is_self_contained
+    from agents.training.ship import main as ship
+    res, _ = trained
+    assert ship([str(res.out), "ppo-tiny", "--dest", str(tmp_path), "--notes", "a test"]) == 0
+    assert "wrote" in capsys.readouterr().out
+    assert {p.name for p in tmp_path.iterdir()} == {"ppo-tiny.zip", "ppo-tiny.pkl", "ppo-tiny.json"}
+    meta = json.loads((tmp_path / "ppo-tiny.json").read_text())
+    assert (meta["name"], meta["algo"], meta["env_id"], meta["seed"]) == \
+        ("ppo-tiny", "ppo", "RotorDrop-Damping-v1", 3)
+    assert meta["command"].startswith("rotordrop train --env RotorDrop-Damping-v1") and meta["notes"] == "a test"
+    assert is_self_contained(PPO.load(tmp_path / "ppo-tiny.zip", device="cpu"))   # plain SB3 runs it
+    assert ship([str(res.out), "tiny", "--dest", str(tmp_path)]) == 2      # no algorithm prefix
+    assert "starts with its algorithm" in capsys.readouterr().err

@@ -19,7 +19,7 @@ from agents.control.residual import ResidualAction
 from agents.learning.reward import KpiReward
 from rotordrop_env import make_batched
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[3]
 #: what the shipped PPO blocks meant before they were written as rl-zoo3 entries
 SHIPPED = {"RotorDrop-Damping-v1": ("max-damping", 0.5), "RotorDrop-Relevitate-v1": ("whirl-brake", 0.5),
            "RotorDrop-Full-v1": ("whirl-brake", 1.0)}

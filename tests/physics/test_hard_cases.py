@@ -9,7 +9,7 @@ ranges must raise the clear SceneError and never run.
 CI runs the grid with 0.2 s of drop after the fault (the first impacts, the bounces and the
 whirl onset, where the stiffness is); the full 5 s grid is opt-in:
 
-    python3 -m pytest -m slow tests/test_hard_cases.py -n 2
+    python3 -m pytest -m slow tests/physics/test_hard_cases.py -n 2
 """
 from __future__ import annotations
 

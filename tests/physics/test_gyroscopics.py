@@ -67,7 +67,7 @@ def test_the_campbell_example_writes_simulated_and_linearised_frequencies(tmp_pa
     import subprocess
     import sys
     from pathlib import Path
-    root = Path(__file__).resolve().parent.parent
+    root = Path(__file__).resolve().parents[2]
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(root), os.environ.get("PYTHONPATH", "")]))
     subprocess.run([sys.executable, str(root / "docs/examples/campbell.py"), "--out", str(tmp_path),
                     "--max-rpm", "20000", "--points", "2"], check=True, capture_output=True,

@@ -8,7 +8,7 @@ import pytest
 from physics import SceneError, load_scene, parameter_table, preset_names
 from physics.scene import scene_from_toml
 
-SPEC_VALUES = Path(__file__).parent / "data" / "spec_values.json"
+SPEC_VALUES = Path(__file__).resolve().parents[1] / "data" / "spec_values.json"
 
 PUBLIC_KEYS = ["contact.friction", "contact.stiffness", "support.stiffness", "support.damping",
                "unbalance.mass", "rotor.speed_rpm", "amb.off_time", "solver.rtol",

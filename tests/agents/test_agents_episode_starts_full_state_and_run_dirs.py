@@ -1,4 +1,4 @@
-"""Second review round of the agents: a controller finds episode starts without the caller,
+"""Agents across episodes and observations: a controller finds episode starts without the caller,
 policies trained on the full state evaluate, rl-zoo3's ``train_freq: [1, episode]`` and a run's
 ``best/`` directory as ``--policy``."""
 import numpy as np

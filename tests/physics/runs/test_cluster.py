@@ -25,7 +25,7 @@ from agents.cli import main as cli_main
 pytestmark = pytest.mark.cluster
 
 HEAD, WORKER = "127.0.0.2", "127.0.0.3"
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[3]
 # the done-when command
 SWEEP = ["study", "sweep", "--vary", "contact.friction=0.3:0.5:0.1",
          "--vary", "support.damping=2790,27900", "--quiet", "--no-plots"]

@@ -123,7 +123,7 @@ def test_a_cleanrl_style_ppo_loop_trains_on_the_vector_env():
     import importlib.util
     from pathlib import Path
     import numpy as np
-    path = Path(__file__).resolve().parents[1] / "docs" / "examples" / "cleanrl_ppo.py"
+    path = Path(__file__).resolve().parents[2] / "docs" / "examples" / "cleanrl_ppo.py"
     spec = importlib.util.spec_from_file_location("cleanrl_ppo", path)
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)

@@ -85,7 +85,7 @@ def test_the_flexible_campbell_example_writes_its_diagram(tmp_path):
     import subprocess
     import sys
     from pathlib import Path
-    root = Path(__file__).resolve().parent.parent
+    root = Path(__file__).resolve().parents[3]
     env = dict(os.environ,
                PYTHONPATH=os.pathsep.join([str(root), os.environ.get("PYTHONPATH", "")]))
     subprocess.run([sys.executable, str(root / "docs/examples/flexible_campbell.py"), "--out",
