@@ -30,38 +30,67 @@ leaderboard), ``leaderboard.md``, ``score.png``, ``whirl_map.png``, ``peak_force
 from __future__ import annotations
 
 import math
-import os
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from ..control.controllers import BASELINES, Passive, command_for, controller_class, make_controller
-from ..learning.policies import LearnedPolicy, load_shipped, shipped_names
-from .rollout import check_actor, run_episodes
+from ..control.controllers import BASELINES, Passive, controller_class, controller_env_kwargs, make_controller
+from ..control.plant import task_flags
+from ..learning.policies import LearnedPolicy, load_shipped, policy_label, shipped_names
+from .rollout import check_actor, monitor_kwargs, run_episodes
 from .score import (BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, DEFAULT_SCORE, bootstrap_scores,
                     check_score, drop_costs, fmt_or_dash, overall_score, row_cost, summarize,
                     write_json)
 
 EPISODE_TIME = 0.3
 EVAL_KWARGS = dict(episode_time=EPISODE_TIME, terminate_on_failure=False, randomize=False)
-MONITOR_DT = 2e-4            # KPI sampling interval of every benchmark episode [s]
 PHASES = (0.0, 90.0, 180.0, 270.0)
 QUICK_PHASES = (0.0, 180.0)
 THRESHOLD_GRID = tuple(round(0.10 + 0.02 * i, 2) for i in range(21))     # 0.10 ... 0.50
 WHIRL_MARGINS = (0.05, 0.10, 0.15)
-TASKS = {"damping": "RotorDrop-Damping-v1", "relevitate": "RotorDrop-Relevitate-v1",
-         "full": "RotorDrop-Full-v1"}
-RELEVITATION_ENVS = (TASKS["relevitate"], TASKS["full"])
-#: ``--suite``: the fixed nominal suite, or the robust one (:mod:`agents.benchmarking.robust`)
-SUITES = ("nominal", "robust", "robust-legacy")
 
 
-def check_suite(suite: str) -> str:
-    if suite not in SUITES:
-        raise ValueError(f"--suite = {suite!r} must be one of {', '.join(SUITES)}")
-    return suite
+def _env_tasks() -> tuple[dict[str, str], tuple[str, ...]]:
+    """The benchmark tasks as the environments declare them (:func:`agents.control.plant.task_flags`):
+    every registered id whose env controls something, keyed by the task in the id
+    (``RotorDrop-Full-v1``: ``full``), and the ids whose env re-levitates."""
+    from rotordrop_env import ENV_IDS
+    flags = {env_id: task_flags(env_id) for env_id in ENV_IDS}
+    return ({env_id.split("-")[1].lower(): env_id for env_id, f in flags.items() if any(f)},
+            tuple(env_id for env_id, (_, relevitate) in flags.items() if relevitate))
+
+
+#: task -> env id (``damping``, ``relevitate``, ``full``) and the re-levitation env ids
+TASKS, RELEVITATION_ENVS = _env_tasks()
+
+
+@dataclass(frozen=True)
+class Suite:
+    """A named set of scenarios, the ``--suite`` of ``rotordrop benchmark``, ``tune`` and
+    ``oracle``: the fixed nominal suite, or drops drawn one per seed from ``seed`` on."""
+    name: str
+    about: str
+    seed: int | None = None         # the first drawn scenario's seed (None: the fixed suite)
+
+
+#: every suite; each command accepts those it can run (:func:`check_suite`)
+SUITES = {s.name: s for s in (
+    Suite("nominal", "the fixed scenario suite around the passive threshold (module doc)"),
+    Suite("robust", "the robust suite's test drops of the Full task (agents.benchmarking.robust)",
+          50_000),                  # fresh: no choice was made on them
+    Suite("robust-legacy", "the robust suite's earlier test drops", 30_000),
+    Suite("full", "drops of the Full task drawn by its own sampler from the oracle's ranges "
+                  "(agents.research.oracle)", 10_000),
+)}
+
+
+def check_suite(suite: str, accepted: tuple[str, ...] = ("nominal", "robust", "robust-legacy")) -> Suite:
+    """The :class:`Suite` named ``suite``; a ValueError unless a command ``accepted`` it."""
+    if suite not in accepted:
+        raise ValueError(f"--suite = {suite!r} must be one of {', '.join(accepted)}")
+    return SUITES[suite]
 
 
 def task_of(env_id: str) -> str:
@@ -71,17 +100,6 @@ def task_of(env_id: str) -> str:
             return task
     raise ValueError(f"{env_id!r} is not the environment of a benchmark task "
                      f"({', '.join(TASKS.values())})")
-
-
-def controller_env_kwargs(cls, env_id: str) -> dict:
-    """The env kwargs a controller class needs in ``env_id``: the re-levitation command of its
-    channels (``controllers.command_for``) in the re-levitation environments (the passive
-    reference keeps the AMBs off), and its ``control_dt`` where it sets one."""
-    command = command_for(cls)
-    kw = {"command": command} if command and env_id in RELEVITATION_ENVS else {}
-    if getattr(cls, "control_dt", None) is not None:
-        kw["control_dt"] = cls.control_dt
-    return kw
 
 
 @dataclass(frozen=True)
@@ -228,24 +246,6 @@ def controller_entry(cls, env_id: str) -> Entry:
                  controller_env_kwargs(cls, env_id))
 
 
-def run_label(spec: str) -> str:
-    """A short label of a policy path that tells runs apart: the run directory, with ``/best``
-    for its best model (``runs/a/best/best_model.zip`` -> ``a/best``, ``runs/a/model.zip`` and
-    ``runs/a`` -> ``a``, ``x/ppo-7.zip`` -> ``ppo-7``; a relative ``model.zip`` names the
-    current directory)."""
-    path = Path(os.path.abspath(spec))
-    if path.suffix != ".zip":
-        return path.name
-    if path.name == "best_model.zip" and path.parent.name == "best":
-        return f"{path.parent.parent.name}/best"
-    return path.parent.name if path.name == "model.zip" else path.stem
-
-
-def policy_label(spec: str, policy: LearnedPolicy) -> str:
-    """The display name of a learned policy: a shipped one's name, else ``name@run`` (:func:`run_label`)."""
-    return policy.name if spec in shipped_names() else f"{policy.name}@{run_label(spec)}"
-
-
 def extras(specs: list[str], env_id: str | None = None,
            names: list[str] | None = None) -> tuple[list[LearnedPolicy], list]:
     """The ``--policy`` extras: learned policies given by path, named ``name@run``
@@ -290,15 +290,6 @@ def check_unique_names(entries: list[Entry]) -> list[Entry]:
         raise ValueError(f"--policy: two controllers are named {', '.join(twice)}; give each "
                          f"its own name")
     return entries
-
-
-def monitor_kwargs(kw: dict) -> dict:
-    """``samples_per_step`` so that the KPI monitor samples every 0.2 ms whatever the control
-    step (the environments' default: 5 samples per 1 ms step). Peak forces of impacts lasting
-    about a millisecond are under-read at coarser sampling, which would favour controllers
-    with longer control steps."""
-    dt = float(kw.get("control_dt", 1e-3))
-    return {"samples_per_step": max(5, int(round(dt / MONITOR_DT)))}
 
 
 def episode_kwargs(entry: Entry, scenario: Scenario, phase: float) -> dict:

@@ -10,46 +10,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .benchmark import (EPISODE_TIME, RELEVITATION_ENVS, check_power_return, controller_env_kwargs,
-                        monitor_kwargs, policy_label)
-from ..control.controllers import Passive, controller_class, is_controller_spec, make_controller
-from ..learning.policies import resolve
-from .rollout import check_actor, run_episodes
+from .benchmark import EPISODE_TIME, RELEVITATION_ENVS, check_power_return
+from ..control.controllers import Passive
+from ..learning.policies import actor_for
+from .rollout import check_actor, merge_env_kwargs, run_episodes
 from .score import fmt_or_dash, summarize, write_json
-
-
-def _merge_kwargs(base: dict, user: dict, randomize: bool) -> dict:
-    """Env kwargs: the policy's training kwargs, then the user's; scene keys (and the power
-    return) the user sets are taken out of the randomisation so that they stay at the given
-    value."""
-    kw = dict(base)
-    for k, v in user.items():
-        if k == "overrides":
-            kw["overrides"] = {**(kw.get("overrides") or {}), **v}
-        else:
-            kw[k] = v
-    kw["randomize"] = randomize
-    kw.setdefault("terminate_on_failure", False)
-    kw.update(monitor_kwargs(kw))              # KPI sampling every 0.2 ms at any control step
-    if not randomize:
-        kw.pop("randomization", None)          # the env refuses ranges it would not draw from
-        return kw
-    fixed = [*(kw.get("overrides") or {}), *(["power_return_time"] if "power_return_time" in user else [])]
-    if fixed:
-        kw["randomization"] = {**(kw.get("randomization") or {}), **{k: None for k in fixed}}
-    return kw
-
-
-def _actor(spec: str, env_id: str | None):
-    """(make_actor(plant), env id, env kwargs of the policy, display name)."""
-    cls = controller_class(spec)
-    if cls is not None:
-        if env_id is None:
-            raise ValueError(f"--env is required for the controller {spec!r}")
-        return ((lambda plant: make_controller(cls, plant)), env_id, controller_env_kwargs(cls, env_id),
-                cls.name)
-    policy, trained_on = resolve(spec, env_id=env_id)
-    return policy.bound, env_id or trained_on, dict(policy.env_kwargs), policy_label(spec, policy)
 
 
 def _episode_rows(eps) -> list[dict]:
@@ -69,18 +34,18 @@ def evaluate(policy: str, env_id: str | None, episodes: int, out: str | Path,
     length (``terminate_on_failure=False``) unless ``env_kwargs`` says otherwise."""
     if episodes < 1:
         raise ValueError(f"--episodes must be >= 1, got {episodes}")
-    make_actor, env_id, base_kwargs, name = _actor(policy, env_id)
+    make_actor, env_id, base_kwargs, name, designed = actor_for(policy, env_id)
     from rotordrop_env import ENV_IDS
     if env_id not in ENV_IDS:
         raise ValueError(f"--env {env_id!r} is not a rotor-drop environment; known: {', '.join(ENV_IDS)}")
     if "power_return_time" in (env_kwargs or {}) and env_id not in RELEVITATION_ENVS:
         raise ValueError(f"--power-return-ms (power_return_time) applies to the re-levitation "
                          f"environments ({', '.join(RELEVITATION_ENVS)}) only, not {env_id}")
-    kwargs = _merge_kwargs(base_kwargs, env_kwargs or {}, randomize)
+    kwargs = merge_env_kwargs(base_kwargs, env_kwargs or {}, randomize)
     if "power_return_time" in (env_kwargs or {}):
         check_power_return(kwargs["power_return_time"], "--power-return-ms",
                            kwargs.get("episode_time", EPISODE_TIME))     # the envs' default
-    if is_controller_spec(policy):
+    if designed:
         check_actor(env_id, make_actor, kwargs)                  # fail fast: a user's class
     seeds = list(range(seed, seed + episodes))
     eps = run_episodes(env_id, make_actor, seeds, kwargs, record=True)

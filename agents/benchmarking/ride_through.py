@@ -27,9 +27,9 @@ from pathlib import Path
 import numpy as np
 
 from .benchmark import (EPISODE_TIME, PHASES, RELEVITATION_ENVS, Entry, Scenario, check_unique_names,
-                        controller_entry, episode_kwargs, policy_label, task_of)
+                        controller_entry, episode_kwargs, task_of)
 from ..control.controllers import BASELINES, Passive, command_for, controller_class, is_controller_spec
-from ..learning.policies import load_shipped, resolve, shipped_names
+from ..learning.policies import load_shipped, policy_label, resolve, shipped_names
 from .rollout import check_actor, run_episodes
 from .score import write_json
 

@@ -33,7 +33,7 @@ import math
 
 import numpy as np
 
-from .benchmark import TASKS, Scenario, Validator
+from .benchmark import SUITES, TASKS, Scenario, Validator
 
 ENV_ID = TASKS["full"]
 #: the robust distribution: key -> (low, high), uniform (the training config copies it)
@@ -52,8 +52,8 @@ SENSOR_DELAY_S = (5e-5, 2e-4)       # sensor delay [s] (sensor.delay), uniform p
 LATENCY_MS = (0, 1)                 # the agent's own observation latency [ms], an integer
                                     # drawn per scenario
 POWER_GRID = 0.005                  # the power return is rounded up to this grid [s]
-SUITE_SEED = 50_000                 # the test set (fresh: no choice was made on it)
-LEGACY_SUITE_SEED = 30_000          # the earlier test set (--suite robust-legacy)
+SUITE_SEED = SUITES["robust"].seed                  # the test set
+LEGACY_SUITE_SEED = SUITES["robust-legacy"].seed    # the earlier test set (--suite robust-legacy)
 SUITE_SCENARIOS = 200
 QUICK_SCENARIOS = 40
 VALIDATION_SEED = 40_000
@@ -70,10 +70,8 @@ def is_robust(env_kwargs: dict) -> bool:
 
 def draw_scenario(seed: int, name: str | None = None) -> Scenario:
     """One scenario of the robust distribution, drawn from ``seed`` (module doc)."""
-    from rotordrop_env.scenario import resolve_ranges, sample
-    ranges, _ = resolve_ranges(ROBUST_RANGES, True, "FullEnv")
-    rng = np.random.default_rng(seed)
-    values = sample(ranges, rng)
+    from rotordrop_env.scenario import draw
+    values, rng = draw(ROBUST_RANGES, seed)
     latency_ms = int(rng.integers(LATENCY_MS[0], LATENCY_MS[1] + 1))
     values["sensor.delay"] = float(rng.uniform(*SENSOR_DELAY_S))   # last: the rest as before
     pr = math.ceil(values.pop("power_return_time") / POWER_GRID - 1e-9) * POWER_GRID
@@ -128,14 +126,15 @@ def run_suite(suite: str, out, quick: bool = False, policies: list[str] | None =
     from .benchmark import benchmark, check_suite
     from .score import DEFAULT_SCORE, check_score
     score = check_score(score if score is not None else DEFAULT_SCORE)
-    if check_suite(suite) == "nominal":
+    chosen = check_suite(suite)
+    if chosen.seed is None:
         return benchmark(out, quick, policies, max_scenarios, episodes, progress, plots,
                          power_return, backend, env_id, names, score=score)
     for flag, value in (("--episodes", episodes), ("--power-return-ms", power_return)):
         if value is not None:
             raise ValueError(f"{flag} does not apply to --suite {suite} (its scenarios draw the "
                              "power return; one episode each)")
-    seed = LEGACY_SUITE_SEED if suite == "robust-legacy" else SUITE_SEED
+    seed = chosen.seed
     return robust_benchmark(out, quick, policies, max_scenarios, progress, plots, backend,
                             env_id, names, score=score, seed=seed)
 

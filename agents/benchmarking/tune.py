@@ -26,8 +26,9 @@ import numpy as np
 
 from physics.runs.backend import Backend
 
-from .benchmark import TASKS, Validator, check_suite, controller_env_kwargs
-from ..control.controllers import BASELINES, Controller, controller_class, make_controller
+from .benchmark import TASKS, Validator, check_suite
+from ..control.controllers import (BASELINES, Controller, controller_class, controller_env_kwargs,
+                                   make_controller)
 from .rollout import check_actor
 from .score import write_json
 from .ray_search import minimise
@@ -120,7 +121,7 @@ def tune(spec: str, env_id: str, gains: list[str], out, iterations: int = 12,
     ``--backend ray`` Ray Tune evaluates the candidates (:mod:`agents.benchmarking.ray_search`, its trials
     under ``out/ray_tune``), with the same result. ``suite="robust"``: on the robust
     validation set (:func:`agents.benchmarking.robust.robust_validator`, Full task only) instead."""
-    check_suite(suite)
+    check_suite(suite, ("nominal", "robust"))
     if not gains:
         raise ValueError("--gain is required (NAME=LO:HI, repeatable)")
     ranges = [parse_gain(g) for g in gains]

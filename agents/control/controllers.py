@@ -43,7 +43,7 @@ from contextlib import contextmanager
 
 import numpy as np
 
-from .plant import ControllerError, Plant
+from .plant import ControllerError, Plant, task_flags
 
 
 class Controller:
@@ -471,6 +471,17 @@ def command_for(cls: type[Controller]) -> str | None:
     if {"gain", "offsets"} & set(cls.needs):
         return "supervisor"
     return "discrete" if "levitate" in cls.needs else None
+
+
+def controller_env_kwargs(cls, env_id: str) -> dict:
+    """The env kwargs a controller class needs in ``env_id``: the re-levitation command of its
+    channels (``controllers.command_for``) in the re-levitation environments (the passive
+    reference keeps the AMBs off), and its ``control_dt`` where it sets one."""
+    command = command_for(cls)
+    kw = {"command": command} if command and task_flags(env_id)[1] else {}
+    if getattr(cls, "control_dt", None) is not None:
+        kw["control_dt"] = cls.control_dt
+    return kw
 
 
 def is_controller_spec(spec: str) -> bool:

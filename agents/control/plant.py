@@ -58,6 +58,20 @@ class ControllerError(ValueError):
     """A controller's bug or bad command, named with the controller (one line in the CLIs)."""
 
 
+def task_flags(env_id: str) -> tuple[bool, bool]:
+    """(damping, relevitate): what the environment of ``env_id`` lets a controller command, as
+    its class declares it (``_damping``, ``_relevitate``; read through the id's registered entry
+    point). (False, False) for an id that is not a rotor-drop environment."""
+    from importlib import import_module
+
+    from rotordrop_env import ENV_IDS
+    if env_id not in ENV_IDS:
+        return False, False
+    module, name = ENV_IDS[env_id].split(":")
+    cls = getattr(import_module(module), name)
+    return bool(cls._damping), bool(cls._relevitate)
+
+
 def make_env(env_id: str, **kwargs):
     """``gym.make`` of a rotor-drop environment (registers the ids first)."""
     import gymnasium as gym

@@ -13,15 +13,18 @@ is run as it is, and the statistics next to it are not applied a second time.
 from __future__ import annotations
 
 import json
+import os
 import pickle
 import re
 from dataclasses import dataclass, field
+from functools import cached_property
 from importlib import resources
 from pathlib import Path
 
 import numpy as np
 
-from ..control.controllers import BASELINES, controller_class, make_baseline, make_controller
+from ..control.controllers import (BASELINES, controller_class, controller_env_kwargs, make_baseline,
+                                   make_controller)
 from ..control.plant import Plant
 from .hyperparams import ALGOS as ALGO_NAMES, algo_class, parse_literal
 from ..control.residual import RESIDUAL_SCALE, residual_action
@@ -59,13 +62,20 @@ class LearnedPolicy:
     source: str | None = None            # the path it was loaded from
     given_env_id: str | None = None      # the env id given at load (a plain SB3 zip records none)
     frame_stack: int | None = None       # observations the network sees at once (None: inferred)
+    self_contained: bool | None = None   # normalisation and residual inside the zip (None: look)
 
     def __post_init__(self):
+        if self.self_contained is None:
+            self.self_contained = is_self_contained(self.model)
         if self.self_contained:
             self.frame_stack = self.model.policy.stack.n
         elif self.frame_stack is None:                  # a model still on its training env
             self.frame_stack = frame_stack_of(self.model.get_env())
-        self.stack = FrameStack(self.frame_stack)
+
+    @cached_property
+    def stack(self) -> FrameStack:
+        """The observations the network sees at once, stacked as in training."""
+        return FrameStack(self.frame_stack)
 
     def __reduce__(self):
         """Pickled as where it was loaded from (SB3 models and their statistics do not pickle):
@@ -81,10 +91,6 @@ class LearnedPolicy:
         if self.residual is not None:
             self.base = make_baseline(self.residual, plant)
         return self
-
-    @property
-    def self_contained(self) -> bool:
-        return is_self_contained(self.model)
 
     def predict(self, observation, state=None, episode_start=None, deterministic: bool = True):
         if self.residual is not None and self.base is None:
@@ -149,7 +155,8 @@ class LearnedPolicy:
                 " (nor best_model.zip: a run's best/)" if path.is_dir() else ""))
         algo = meta.get("algo") or _algo_from_zip(model_path)
         model = algo_class(algo).load(str(model_path), device="cpu", custom_objects=ACTING_ONLY)
-        inside = model.policy.rotordrop if is_self_contained(model) else {}
+        contained = is_self_contained(model)
+        inside = model.policy.rotordrop if contained else {}
         given, env_id = env_id, meta.get("env_id") or inside.get("env_id")
         env_id = current_env_id(env_id) if env_id is not None else None
         if check_env and env_id is not None and given is not None and given != env_id:
@@ -164,7 +171,7 @@ class LearnedPolicy:
         env_kwargs = dict(meta.get("env_kwargs") or hp.get("env_kwargs")
                           or inside.get("env_kwargs") or {})
         task = env_id.split("-")[1].lower() if env_id.count("-") >= 2 else "policy"
-        if is_self_contained(model):        # normalisation and residual are inside the zip
+        if contained:                       # normalisation and residual are inside the zip
             vn, settings = None, model.policy.rotordrop
         else:
             vn, settings = _load_stats(model_path, vn_paths, hp.get("normalize", False)), hp
@@ -172,7 +179,7 @@ class LearnedPolicy:
                    vn, meta, settings.get("residual"),
                    float(settings.get("residual_scale") or RESIDUAL_SCALE),
                    source=str(path.resolve()), given_env_id=given,
-                   frame_stack=settings.get("frame_stack"))
+                   frame_stack=settings.get("frame_stack"), self_contained=contained)
 
 
 def _reload(source: str, name: str, env_id: str | None = None) -> LearnedPolicy:
@@ -246,15 +253,55 @@ def resolve(spec: str, plant: Plant | None = None, env_id: str | None = None):
     cls = controller_class(spec)
     if cls is not None:
         return (make_controller(cls, plant) if plant is not None else None), None
+    pol = _learned(spec, env_id)
+    return (pol.bound(plant) if plant is not None else pol), pol.env_id
+
+
+def _learned(spec: str, env_id: str | None) -> LearnedPolicy:
+    """The learned policy ``spec`` names, a shipped one or a path (not a controller: the callers
+    asked :func:`controller_class` first); KeyError for anything else."""
     if spec in shipped_names():
-        pol = load_shipped(spec)
-        return (pol.bound(plant) if plant is not None else pol), pol.env_id
+        return load_shipped(spec)
     if Path(spec).exists():
-        pol = LearnedPolicy.load(spec, env_id=env_id, check_env=False)
-        return (pol.bound(plant) if plant is not None else pol), pol.env_id
+        return LearnedPolicy.load(spec, env_id=env_id, check_env=False)
     raise KeyError(f"--policy {spec!r} is not a baseline ({', '.join(BASELINES)}), a shipped "
                    f"policy ({', '.join(shipped_names()) or 'none shipped'}), an existing path or "
                    f"a controller class (package.module:Class, file.py:Class)")
+
+
+def run_label(spec: str) -> str:
+    """A short label of a policy path that tells runs apart: the run directory, with ``/best``
+    for its best model (``runs/a/best/best_model.zip`` -> ``a/best``, ``runs/a/model.zip`` and
+    ``runs/a`` -> ``a``, ``x/ppo-7.zip`` -> ``ppo-7``; a relative ``model.zip`` names the
+    current directory)."""
+    path = Path(os.path.abspath(spec))
+    if path.suffix != ".zip":
+        return path.name
+    if path.name == "best_model.zip" and path.parent.name == "best":
+        return f"{path.parent.parent.name}/best"
+    return path.parent.name if path.name == "model.zip" else path.stem
+
+
+def policy_label(spec: str, policy: LearnedPolicy) -> str:
+    """The display name of a learned policy: a shipped one's name, else ``name@run`` (:func:`run_label`)."""
+    return policy.name if spec in shipped_names() else f"{policy.name}@{run_label(spec)}"
+
+
+def actor_for(spec: str, env_id: str | None = None):
+    """What ``rotordrop evaluate`` runs for ``--policy spec`` (``--env env_id``): (make_actor(plant),
+    env id, env kwargs, display name, designed). A shipped policy's name, a baseline or a
+    controller class (``designed``: True; ``--env`` is required) or a path; the env id and
+    kwargs are the policy's own unless ``env_id`` is given."""
+    if spec not in shipped_names():          # (a shipped name is never a controller's)
+        cls = controller_class(spec)
+        if cls is not None:
+            if env_id is None:
+                raise ValueError(f"--env is required for the controller {spec!r}")
+            return ((lambda plant: make_controller(cls, plant)), env_id,
+                    controller_env_kwargs(cls, env_id), cls.name, True)
+    policy = _learned(spec, env_id)
+    return (policy.bound, env_id or policy.env_id, dict(policy.env_kwargs),
+            policy_label(spec, policy), False)
 
 
 def export_policy(source: str | Path, out: str | Path, env_id: str | None = None) -> Path:

@@ -53,8 +53,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..benchmarking.benchmark import (EPISODE_TIME, TASKS, Entry, Scenario, controller_entry, episode_kwargs,
-                        extras)
+from ..benchmarking.benchmark import (EPISODE_TIME, SUITES, TASKS, Entry, Scenario, check_suite,
+                                      controller_entry, episode_kwargs, extras)
 from ..control.controllers import BASELINES, Passive
 from ..control.plant import plant_of
 from ..learning.policies import load_shipped, shipped_names
@@ -65,7 +65,7 @@ ENV_ID = TASKS["full"]
 COMMAND = "supervisor"
 ORACLE_RANGES = {"contact.friction": (0.38, 0.6), "power_return_time": (0.03, 0.07),
                  "unbalance.angle_deg": (0.0, 360.0)}
-SCENARIO_SEED = 10_000
+SCENARIO_SEED = SUITES["full"].seed
 SEGMENT_EDGES_MS = (0, 10, 20, 30, 45, 60, 90, 300)
 SEGMENT_ACTIONS = ("damping1", "damping2", "gain", "offset_r1", "offset_t1", "offset_r2",
                    "offset_t2")
@@ -73,8 +73,9 @@ MAX_DELAY = 0.04            # switch-on delay after the power return: (theta + 1
 CONTROL_DT = 0.005          # the commands are piecewise constant over >= 10 ms segments
 SHAPING = 0.25
 WHIRL_REVOLUTIONS = 3.0
-#: ``--suite``: drops drawn from ``ORACLE_RANGES`` (full) or the robust suite's (robust)
-SUITES = ("full", "robust")
+#: ``--suite`` (:data:`agents.benchmarking.benchmark.SUITES`): drops drawn from ``ORACLE_RANGES``
+#: (full) or the robust suite's (robust)
+ORACLE_SUITES = ("full", "robust")
 #: ``--interface``: what the search commands (supervisor sequences, or raw-current corrections)
 INTERFACES = ("supervisor", "currents")
 #: the raw-current search: open-loop corrections of ``CURRENT_BASELINE``'s coil currents,
@@ -91,19 +92,13 @@ def check_interface(interface: str) -> str:
     return interface
 
 
-def check_suite(suite: str) -> str:
-    if suite not in SUITES:
-        raise ValueError(f"--suite = {suite!r} must be one of {', '.join(SUITES)}")
-    return suite
-
-
 def suite_scenarios(suite: str, n: int, seed: int,
                     friction: tuple[float, float] | None = None) -> list[tuple[Scenario, float, dict]]:
     """The first ``n`` scenarios of ``suite`` from ``seed``: (benchmark :class:`Scenario`,
     unbalance phase, the record written to oracle.json). ``robust``: the robust suite's own
     scenarios (:func:`agents.benchmarking.robust.robust_scenarios`; their unbalance phase is in the scene
     overrides, the phase argument is the benchmark's 0)."""
-    if check_suite(suite) == "robust":
+    if check_suite(suite, ORACLE_SUITES).name == "robust":
         from ..benchmarking.robust import robust_scenarios
         return [(sc, 0.0, robust_record(sc)) for sc in robust_scenarios(n, seed)]
     return [(*as_benchmark(v, f"#{i}"), v) for i, v in enumerate(draw_scenarios(n, seed, friction))]
@@ -119,20 +114,17 @@ def robust_record(sc: Scenario) -> dict:
 
 def draw_scenarios(n: int, seed: int = SCENARIO_SEED,
                    friction: tuple[float, float] | None = None) -> list[dict]:
-    """``n`` scenario dicts (dotted scene keys and ``power_return_time``) drawn by the Full
-    environment's own sampler from ``ORACLE_RANGES`` (friction from ``friction`` if given) and
-    the default ranges."""
-    from ..control.plant import make_env
+    """``n`` scenario dicts (dotted scene keys and ``power_return_time``): what the Full
+    environment draws from ``ORACLE_RANGES`` (friction from ``friction`` if given) and the default
+    ranges at ``reset(seed=seed + i)`` (:func:`rotordrop_env.scenario.draw`)."""
+    from rotordrop_env.scenario import draw
     ranges = oracle_ranges(friction)
-    env = make_env(ENV_ID, randomize=True, randomization=ranges, episode_time=0.01)
-    try:
-        scenarios = []
-        for i in range(n):
-            env.reset(seed=seed + i)
-            scenarios.append(on_grid(env.unwrapped.scenario))
-        return scenarios
-    finally:
-        env.close()
+    scenarios = []
+    for i in range(n):
+        values = draw(ranges, seed + i)[0]
+        pr = values.pop("power_return_time")            # last, as the environment lists it
+        scenarios.append(on_grid({**values, "power_return_time": pr}))
+    return scenarios
 
 
 def oracle_ranges(friction: tuple[float, float] | None = None) -> dict:
@@ -232,8 +224,7 @@ def constant_entry(gain: float, offset_r: float) -> Entry:
     (:class:`agents.control.controllers.InnerLoop` with these constants, a causal law that does not know
     the scenario and reads no sensor) at ``inner-loop-lift``'s control step, run and scored as
     every other row; ``--constant 0.5:-0.5`` is ``inner-loop-lift`` itself."""
-    from ..benchmarking.benchmark import controller_env_kwargs
-    from ..control.controllers import InnerLoop, InnerLoopLift
+    from ..control.controllers import InnerLoop, InnerLoopLift, controller_env_kwargs
     return Entry(constant_name(gain, offset_r), "full",
                  lambda plant: InnerLoop(plant, gain, offset_r),
                  controller_env_kwargs(InnerLoopLift, ENV_ID))
@@ -540,17 +531,17 @@ def suite_settings(suite: str, friction, scenario_seed: int | None) -> tuple[dic
                     segment_actions=list(SEGMENT_ACTIONS), max_delay_s=MAX_DELAY,
                     control_dt=CONTROL_DT, shaping=SHAPING, episode_time_s=EPISODE_TIME,
                     score=DEFAULT_SCORE)
-    if check_suite(suite) == "robust":
-        from ..benchmarking.robust import LATENCY_MS, ROBUST_RANGES, SENSOR_NOISE, SUITE_SEED
+    chosen = check_suite(suite, ORACLE_SUITES)
+    if chosen.name == "robust":
+        from ..benchmarking.robust import LATENCY_MS, ROBUST_RANGES, SENSOR_NOISE
         if friction is not None:
             raise ValueError("--friction does not apply to --suite robust (its scenarios are the "
                              "robust suite's, friction 0.3-0.6)")
         ranges = dict(ROBUST_RANGES)
         settings.update(suite=suite, sensor_noise_m=SENSOR_NOISE, latency_ms=list(LATENCY_MS))
-        default_seed = SUITE_SEED
     else:
         ranges = oracle_ranges(friction)
-        default_seed = SCENARIO_SEED
+    default_seed = chosen.seed
     settings.update(ranges={k: list(v) for k, v in ranges.items()},
                     scenario_seed=default_seed if scenario_seed is None else scenario_seed)
     return settings, ranges

@@ -21,8 +21,8 @@ from functools import partial
 from pathlib import Path
 
 import numpy as np
-from agents.benchmarking.benchmark import EVAL_KWARGS, Entry, Scenario, controller_env_kwargs, episode_kwargs, task_of
-from agents.control.controllers import WhirlBrake
+from agents.benchmarking.benchmark import EVAL_KWARGS, Entry, Scenario, episode_kwargs, task_of
+from agents.control.controllers import WhirlBrake, controller_env_kwargs
 from agents.benchmarking.rollout import run_episodes
 from agents.benchmarking.ray_search import minimise
 from physics.runs.backend import Backend

@@ -26,9 +26,9 @@ from pathlib import Path
 
 import numpy as np
 
-from agents.benchmarking.benchmark import (RELEVITATION_ENVS, Entry, Scenario, controller_env_kwargs,
+from agents.benchmarking.benchmark import (RELEVITATION_ENVS, Entry, Scenario,
                               episode_kwargs, task_of)
-from agents.control.controllers import _rot90, command_for, controller_class
+from agents.control.controllers import _rot90, command_for, controller_class, controller_env_kwargs
 from agents.control.open_loop import CurrentOverride, OpenLoopCorrection
 from agents.control.plant import Plant
 from agents.benchmarking.rollout import run_episodes

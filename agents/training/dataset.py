@@ -2,8 +2,8 @@
 
 Any ``--policy`` that ``rotordrop evaluate`` runs (a baseline or designed controller name, a
 shipped policy, a training directory or model zip, a ``module:Class`` controller) is resolved
-exactly as evaluate resolves it (:func:`agents.benchmarking.evaluate._actor`) and run on the environment
-built as evaluate builds it (:func:`agents.benchmarking.evaluate._merge_kwargs`: the policy's env kwargs,
+exactly as evaluate resolves it (:func:`agents.learning.policies.actor_for`) and run on the environment
+built as evaluate builds it (:func:`agents.benchmarking.rollout.merge_env_kwargs`: the policy's env kwargs,
 then the user's, scenario randomisation on unless ``randomize=False``, episodes run their
 full length, the KPI monitor at 0.2 ms). Episode ``i`` is ``env.reset(seed=seed + i)``; a
 controller is built afresh for every episode, as in evaluate and the benchmark.
@@ -156,15 +156,16 @@ def resolve_actor(policy: str, env_id: str | None, env_kwargs: dict | None = Non
     """(make_actor(plant), env id, env kwargs, display name) as ``rotordrop evaluate`` resolves
     and builds them; ValueError / KeyError naming the parameter on bad input."""
     from rotordrop_env import ENV_IDS
-    from ..benchmarking.evaluate import _actor, _merge_kwargs
+    from ..benchmarking.rollout import merge_env_kwargs
+    from ..learning.policies import actor_for
     if env_id is not None and env_id not in ENV_IDS:
         raise ValueError(f"--env {env_id!r} is not a rotor-drop environment; known: "
                          f"{', '.join(ENV_IDS)}")
-    make_actor, env_id, base_kwargs, name = _actor(policy, env_id)
+    make_actor, env_id, base_kwargs, name, _ = actor_for(policy, env_id)
     if env_id not in ENV_IDS:
         raise ValueError(f"--env {env_id!r} is not a rotor-drop environment; known: "
                          f"{', '.join(ENV_IDS)}")
-    return make_actor, env_id, _merge_kwargs(base_kwargs, env_kwargs or {}, randomize), name
+    return make_actor, env_id, merge_env_kwargs(base_kwargs, env_kwargs or {}, randomize), name
 
 
 def run_episode(env, plant, actor, seed: int) -> Collected:

@@ -212,7 +212,7 @@ def test_benchmark_power_return_applies_to_every_scenario_without_its_own():
 
 
 def test_runs_of_one_policy_get_labels_that_tell_them_apart(tmp_path, monkeypatch):
-    from agents.benchmarking.benchmark import run_label
+    from agents.learning.policies import run_label
     assert run_label("runs/s1/best/best_model.zip") == "s1/best"
     assert run_label("runs/s2/best/best_model.zip") == "s2/best"
     assert run_label("runs/s1/model.zip") == run_label("runs/s1") == run_label("runs/s1/") == "s1"

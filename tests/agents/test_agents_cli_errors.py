@@ -283,7 +283,8 @@ class _Stop(Exception):
 def test_the_benchmark_names_every_run_name_at_run_as_evaluate_does(tmp_path, monkeypatch):
     """Two runs of a policy no shipped one is named like: both are name@run (the first was
     bare, the second got @run only because of the clash); evaluate's label is the same."""
-    from agents.benchmarking.benchmark import benchmark, policy_label
+    from agents.benchmarking.benchmark import benchmark
+    from agents.learning.policies import policy_label
     from agents.learning.policies import LearnedPolicy
     run_a, run_b = _named_run(tmp_path, "runA", "ppo-mine"), _named_run(tmp_path, "runB", "ppo-mine")
     seen = []

@@ -221,7 +221,7 @@ def test_a_scene_delay_reaches_the_env_and_is_fixed():
 def test_a_raw_current_law_runs_at_a_realistic_control_rate_with_sensing(dt):
     """A digital AMB controller's rate (5-10 kHz): the env steps at control_dt 0.1-0.2 ms
     with the sensors' delay and noise, and whirl-brake (tuned at 1 ms) still re-levitates."""
-    from agents.benchmarking.benchmark import controller_env_kwargs
+    from agents.control.controllers import controller_env_kwargs
     from agents.control.controllers import BASELINES
     from agents.benchmarking.rollout import run_episodes
     cls = BASELINES["whirl-brake"]

@@ -111,7 +111,7 @@ def test_latency_breaks_a_fast_current_loop_but_not_the_builtin_pid():
     """With 3 ms of observation latency (the agent's own, obs_latency_steps) a 1 kHz PID on the
     raw currents no longer re-levitates; the built-in PID inside the physics step does not get
     that latency (only the sensors' sensor_delay, which both see)."""
-    from agents.benchmarking.benchmark import controller_env_kwargs
+    from agents.control.controllers import controller_env_kwargs
     from agents.control.controllers import BASELINES
     from agents.benchmarking.rollout import run_episodes
     relev = {}

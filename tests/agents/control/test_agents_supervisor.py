@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from agents.benchmarking.benchmark import controller_env_kwargs
+from agents.control.controllers import controller_env_kwargs
 from agents.control.controllers import BASELINES, InnerLoop, WhirlBrake, WhirlBrakeSupervisor, command_for
 from agents.control.plant import Plant, make_env
 from agents.benchmarking.rollout import run_episodes

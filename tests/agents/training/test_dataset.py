@@ -10,7 +10,8 @@ minari = pytest.importorskip("minari")
 
 from agents.cli import main
 from agents.training.dataset import info_arrays, info_columns, write_dataset
-from agents.benchmarking.evaluate import _actor, _merge_kwargs
+from agents.benchmarking.rollout import merge_env_kwargs
+from agents.learning.policies import actor_for
 from agents.control.plant import Plant, make_env
 
 FULL = "RotorDrop-Full-v1"
@@ -20,8 +21,8 @@ DAMPING = "RotorDrop-Damping-v1"
 def _replay(policy, env_id, user_kwargs, seeds, randomize=True):
     """The episodes as evaluate would run them, written out here step by step (not through
     agents.training.dataset): [(observations, actions, rewards, terminated, truncated, infos)]."""
-    make_actor, env_id, base, _ = _actor(policy, env_id)
-    env = make_env(env_id, **_merge_kwargs(base, user_kwargs, randomize))
+    make_actor, env_id, base, _, _ = actor_for(policy, env_id)
+    env = make_env(env_id, **merge_env_kwargs(base, user_kwargs, randomize))
     plant = Plant.from_env(env)
     out = []
     for s in seeds:
