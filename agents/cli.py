@@ -12,13 +12,13 @@ import argparse
 import sys
 from pathlib import Path
 
-from physics import accuracy, study
 from physics import cli as physics_cli
-from physics.backend import add_backend_args
+from physics.runs.backend import add_backend_args
 from physics.cli import at_least
 
-from . import imitation, research
-from .hyperparams import ALGOS
+from . import research
+from .training import imitation
+from .learning.hyperparams import ALGOS
 
 OPTIONAL_RL_MODULES = ("gymnasium", "stable_baselines3", "torch", "tensorboard", "yaml")
 
@@ -73,9 +73,9 @@ def _number(text: str):
 
 
 def cmd_train(args) -> int:
-    from physics.backend import Backend
-    from .hyperparams import ConfigError
-    from .train import command_line, train
+    from physics.runs.backend import Backend
+    from .learning.hyperparams import ConfigError
+    from .training.train import command_line, train
     try:
         backend = Backend.from_args(args)
         common = dict(timesteps=args.timesteps, n_envs=args.n_envs, config=args.config,
@@ -86,7 +86,7 @@ def cmd_train(args) -> int:
             print(train(args.env, args.algo, args.out, seed=args.seed, resume=args.resume,
                         threads=args.threads, progress=not args.quiet, **common).summary())
             return 0
-        from .seeds import parse_seeds, seed_dir, train_seeds
+        from .training.seeds import parse_seeds, seed_dir, train_seeds
         if args.resume is not None:
             raise ValueError("--resume continues one run on --backend local; leave out --seeds "
                              "and --backend ray")
@@ -102,7 +102,7 @@ def cmd_train(args) -> int:
 
 
 def cmd_evaluate(args) -> int:
-    from .evaluate import evaluate, print_summary
+    from .benchmarking.evaluate import evaluate, print_summary
     try:
         report = evaluate(args.policy, args.env, args.episodes, args.out, env_kwargs=_env_kwargs(args),
                           seed=args.seed, plots=not args.no_plots, compare_passive=not args.no_passive,
@@ -114,7 +114,7 @@ def cmd_evaluate(args) -> int:
 
 
 def cmd_export_policy(args) -> int:
-    from .policies import export_policy, export_zoo
+    from .learning.policies import export_policy, export_zoo
     try:
         path = (export_zoo(args.source, args.zoo, args.env) if args.zoo
                 else export_policy(args.source, args.out, args.env))
@@ -127,8 +127,8 @@ def cmd_export_policy(args) -> int:
 
 
 def cmd_benchmark(args) -> int:
-    from physics.backend import Backend
-    from .robust import run_suite
+    from physics.runs.backend import Backend
+    from .benchmarking.robust import run_suite
     try:
         run_suite(args.suite, args.out, quick=args.quick, policies=args.policy,
                   max_scenarios=args.scenarios, episodes=args.episodes, progress=not args.quiet,
@@ -141,8 +141,8 @@ def cmd_benchmark(args) -> int:
 
 
 def cmd_ride_through(args) -> int:
-    from .ride_through import DELAYS, FRICTIONS, QUICK, ride_through, summary_table
-    from .benchmark import PHASES
+    from .benchmarking.ride_through import DELAYS, FRICTIONS, QUICK, ride_through, summary_table
+    from .benchmarking.benchmark import PHASES
     grid = QUICK if args.quick else dict(frictions=FRICTIONS, delays=DELAYS, phases=PHASES)
     try:
         report = ride_through(args.out, args.env, args.policy,
@@ -160,8 +160,8 @@ def cmd_ride_through(args) -> int:
 
 
 def cmd_tune(args) -> int:
-    from physics.backend import Backend
-    from .tune import tune
+    from physics.runs.backend import Backend
+    from .benchmarking.tune import tune
     try:
         r = tune(args.policy, args.env, args.gain, args.out, iterations=args.iterations,
                  population=args.population, elite=args.elite, seed=args.seed,
@@ -191,7 +191,7 @@ def _number_list(sep: str, count: int | None):
 
 
 def cmd_oracle(args) -> int:
-    from .oracle import oracle
+    from .research.oracle import oracle
     try:
         report = oracle(args.out, scenarios=args.scenarios, population=args.population,
                         iterations=args.iterations, seed=args.seed, policies=args.policy,
@@ -208,7 +208,7 @@ def cmd_oracle(args) -> int:
 
 
 def cmd_dataset(args) -> int:
-    from .dataset import load_snippet, parse_env_kwargs, write_dataset
+    from .training.dataset import load_snippet, parse_env_kwargs, write_dataset
     try:
         r = write_dataset(args.policy, args.env, args.episodes, args.out, seed=args.seed,
                           env_kwargs=parse_env_kwargs(args.env_kwarg), dataset_id=args.name,
@@ -440,12 +440,12 @@ def register(sub) -> None:
 
 
 def cmd_results(args) -> int:
-    from . import results
+    from .benchmarking import results
     return results.run(args)
 
 
 def register_results(sub) -> None:
-    from . import results
+    from .benchmarking import results
     p = sub.add_parser("results", help="docs/results.md and the README leaderboard from the "
                                        "benchmark output committed in docs/data")
     results.add_arguments(p)
@@ -456,7 +456,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="rotordrop", description="AMB rotor drop onto retainer "
                                      "bearings: simulation, studies, Gymnasium environments and agents")
     sub = parser.add_subparsers(dest="command", required=True)
-    for register_commands in (physics_cli.register, study.register, accuracy.register, register,
+    for register_commands in (physics_cli.register, register,
                               register_results, research.register):
         register_commands(sub)
     return parser

@@ -9,7 +9,7 @@ whose policy class (one of :data:`POLICY_CLASSES`, subclasses of SB3's own) carr
 * the statistics as buffers of the policy's ``state_dict`` (``obs_mean``, ``obs_var``), applied
   in ``predict`` exactly as ``VecNormalize.normalize_obs`` does (float64, clipped, to float32);
 * the residual's baseline by name and scale, applied in ``predict`` as
-  :func:`agents.residual.residual_action` does, on a :class:`~agents.plant.Plant` of the
+  :func:`agents.control.residual.residual_action` does, on a :class:`~agents.control.plant.Plant` of the
   training environment (``env_id`` and ``env_kwargs`` in the zip).
 
 SB3 saves the policy class by reference, so loading the zip imports this module (the
@@ -119,7 +119,7 @@ class SelfContained:
         action, state = self.network_predict(self.normalize_obs(self.stack(raw, episode_start)),
                                              state, episode_start, deterministic)
         if base is not None:
-            from .residual import residual_action
+            from .control.residual import residual_action
             action = residual_action(base, raw, action, float(self.rotordrop["residual_scale"]),
                                      episode_start)
         return action, state
@@ -132,7 +132,7 @@ class SelfContained:
             raise RuntimeError(
                 f"this policy corrects the {residual!r} controller, which keeps per-episode state "
                 "that single observations do not carry, so plain SB3 cannot run it; load it with "
-                "agents.policies.LearnedPolicy.load(path).bound(Plant.from_env(env)), or run "
+                "agents.learning.policies.LearnedPolicy.load(path).bound(Plant.from_env(env)), or run "
                 "`rotordrop evaluate --policy path`")
         return self.act(observation, state, episode_start, deterministic,
                         self.training_base() if residual else None)
@@ -140,8 +140,8 @@ class SelfContained:
     def training_base(self):
         """The residual's baseline on the training environment (``env_id``, ``env_kwargs``)."""
         if self._base is None:
-            from .controllers import make_baseline
-            from .plant import plant_of
+            from .control.controllers import make_baseline
+            from .control.plant import plant_of
             self._base = make_baseline(self.rotordrop["residual"],
                                        plant_of(current_env_id(self.rotordrop["env_id"]),
                                                 **self.rotordrop.get("env_kwargs", {})))
@@ -241,11 +241,11 @@ def export_self_contained(model, vecnormalize, out_path: str | Path, *, env_id: 
     ``residual`` baseline (name, ``residual_scale``) go inside the policy. ``env_id`` and
     ``env_kwargs`` name the training environment (the residual's plant); without ``env_id``
     all four are read from the model's own training env (its spec and its
-    :class:`~agents.residual.ResidualAction` wrapper, if any). ``frame_stack``: the number of
+    :class:`~agents.control.residual.ResidualAction` wrapper, if any). ``frame_stack``: the number of
     observations the network sees at once (the run's ``frame_stack``). The model passed in is
     left as it was."""
-    from .controllers import BASELINES
-    from .residual import RESIDUAL_SCALE, residual_of
+    from .control.controllers import BASELINES
+    from .control.residual import RESIDUAL_SCALE, residual_of
     cls = _exported_class(model.policy)
     if env_id is None:
         venv = model.get_env()

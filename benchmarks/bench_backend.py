@@ -3,8 +3,8 @@
     python benchmarks/bench_backend.py [--repeats 3] [--quick-only] [--json out.json]
 
 The swept drops of the quick paper study (with the study's observables) run through
-:func:`physics.backend.run_drops`, interleaved per repeat: the local backend on 1 thread (and on
-2 threads when ``physics.sweep.run_chunk`` is there), then Ray on this machine with 1 and with 2 CPUs
+:func:`physics.runs.backend.run_drops`, interleaved per repeat: the local backend on 1 thread (and on
+2 threads when ``physics.runs.sweep.run_chunk`` is there), then Ray on this machine with 1 and with 2 CPUs
 (``ray.init(num_cpus=N)`` by this script; its start-up is timed apart, the batch time includes
 the start of Ray's worker processes and their loading of the compiled kernels, as a user's run
 does). Prints medians over the repeats: the Ray overhead against local on the same cores, the
@@ -22,13 +22,13 @@ os.environ.setdefault("RAY_USAGE_STATS_ENABLED", "0")
 
 
 def quick_study_runs():
-    from physics.study.paper import Plan, StudyInput, plan_runs
+    from physics.runs.study.paper import Plan, StudyInput, plan_runs
     return [r for r in plan_runs(Plan.make(quick=True), StudyInput()) if r.label["member"] != -1]
 
 
 def local(runs, threads: int) -> dict:
-    from physics.backend import Backend, run_drops
-    from physics.study.observables import drop_observables
+    from physics.runs.backend import Backend, run_drops
+    from physics.runs.study.observables import drop_observables
     t0 = time.perf_counter()
     outcomes, _ = run_drops(runs, drop_observables, Backend("local"), jobs=threads, progress=False)
     return dict(batch_s=time.perf_counter() - t0, outcomes=outcomes)
@@ -36,8 +36,8 @@ def local(runs, threads: int) -> dict:
 
 def on_ray(runs, cpus: int) -> dict:
     import ray
-    from physics.backend import Backend, run_drops
-    from physics.study.observables import drop_observables
+    from physics.runs.backend import Backend, run_drops
+    from physics.runs.study.observables import drop_observables
     t0 = time.perf_counter()
     ray.init(num_cpus=cpus, include_dashboard=False, logging_level="ERROR")
     start = time.perf_counter() - t0
@@ -62,8 +62,8 @@ def main() -> None:
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--json", default=None)
     args = ap.parse_args()
-    import physics.sweep
-    if hasattr(physics.sweep, "run_chunk"):                # threads in one process
+    import physics.runs.sweep
+    if hasattr(physics.runs.sweep, "run_chunk"):                # threads in one process
         configs = [("local", 1), ("local", 2), ("ray", 1), ("ray", 2)]
     else:
         configs = [("local", 1), ("ray", 1), ("ray", 2)]

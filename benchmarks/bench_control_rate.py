@@ -24,10 +24,10 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from agents.benchmark import controller_env_kwargs  # noqa: E402
-from agents.controllers import BASELINES  # noqa: E402
-from agents.plant import Plant  # noqa: E402
-from agents.rollout import _episode, make_env  # noqa: E402
+from agents.control.controllers import controller_env_kwargs  # noqa: E402
+from agents.control.controllers import BASELINES  # noqa: E402
+from agents.control.plant import Plant  # noqa: E402
+from agents.benchmarking.rollout import _episode, make_env  # noqa: E402
 
 ENV = "RotorDrop-Full-v1"
 LAW = "whirl-brake"

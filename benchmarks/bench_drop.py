@@ -22,7 +22,7 @@ import time
 import numpy as np
 
 from physics import load_scene, simulate
-from physics.accuracy import REDUCED
+from physics.runs.accuracy import REDUCED
 from physics.model import N_AUX, build_model, rhs
 from physics.simulate import warm_up
 

@@ -41,10 +41,10 @@ import time
 from physics import load_scene, simulate
 from physics.model import build_model
 from physics.simulate import run_model, warm_up
-from physics.study.observables import drop_observables
-from physics.study.paper import Plan, StudyInput, plan_runs
-from physics.study.run import run_paper_study
-from physics.sweep import available_cores, outcome_of
+from physics.runs.study.observables import drop_observables
+from physics.runs.study.paper import Plan, StudyInput, plan_runs
+from physics.runs.study.run import run_paper_study
+from physics.runs.sweep import available_cores, outcome_of
 
 
 def drop_rate(scene, repeats: int) -> list[float]:

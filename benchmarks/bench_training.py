@@ -4,7 +4,7 @@
                                         [--threads 1 2] [--json out.json]
 
 For each algorithm and thread count (torch and numba threads, ``rotordrop train --threads``)
-a short ``agents.train.train`` run on ``RotorDrop-Damping-v1`` with the shipped
+a short ``agents.training.train.train`` run on ``RotorDrop-Damping-v1`` with the shipped
 hyperparameters (evaluation and checkpoints off) is timed; figures are medians of
 ``--repeats`` runs after a warm-up. Also the raw batched env with random actions
 (``bench_env.batched_rate``, timed by the wall clock like the training runs), to separate the
@@ -37,7 +37,7 @@ def env_steps_per_s(threads: int, repeats: int) -> float:
 
 
 def train_steps_per_s(algo: str, steps: int, threads: int) -> float:
-    from agents.train import train
+    from agents.training.train import train
     with tempfile.TemporaryDirectory() as d:
         cfg = f"{d}/bench.yaml"
         with open(cfg, "w") as fh:

@@ -1,4 +1,4 @@
-"""Reference natural frequencies from ROSS 2.3.0 for tests/test_flexible_ross.py.
+"""Reference natural frequencies from ROSS 2.3.0 for tests/physics/flexible/test_flexible_ross.py.
 
     python3 -m venv /tmp/rossenv
     /tmp/rossenv/bin/pip install "ross-rotordynamics==2.3.0" "plotly<6"

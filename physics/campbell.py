@@ -9,7 +9,7 @@ z_1, z_2 (measured from the centre of mass), undamped. With Z = x + iy, psi = a 
 and Z, psi ~ e^{i w t} give (k11 - m w^2)(k22 - I_d w^2 + I_p Omega w) - k12^2 = 0: four real
 whirl frequencies, w > 0 forward (with the spin), w < 0 backward. :func:`identified_frequencies`
 reads the same frequencies from a simulated free response, so the two can be compared
-(tests/test_gyroscopics.py, docs/examples/campbell.py).
+(tests/physics/test_gyroscopics.py, docs/examples/campbell.py).
 """
 from __future__ import annotations
 

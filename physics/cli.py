@@ -1,9 +1,9 @@
-"""physics' part of the ``rotordrop`` command line: ``drop``, ``params`` and the argparse helpers
-every layer's commands share.
+"""physics' part of the ``rotordrop`` command line: ``drop``, ``params``, ``study`` and
+``accuracy``, and the argparse helpers every layer's commands share. It sits above the model and
+the run tools (:mod:`physics.runs`), and imports them inside the handlers.
 
 The ``rotordrop`` entry point is ``agents.cli:main`` (the top layer): it calls each layer's
-``register(subparsers)`` (this module's, :mod:`physics.study`'s, :mod:`physics.accuracy`'s and
-agents') and runs the chosen command through :func:`run`. Registration must stay light: heavy
+``register(subparsers)`` (this module's and agents') and runs the chosen command through :func:`run`. Registration must stay light: heavy
 imports happen inside the handlers (docs/architecture.md).
 """
 from __future__ import annotations
@@ -14,9 +14,7 @@ import os
 import sys
 from pathlib import Path
 
-
-class UsageError(ValueError):
-    """A bad command-line argument that is not a scene parameter (one-line error, exit 2)."""
+from .runs import UsageError
 
 
 def at_least(low: int):
@@ -60,7 +58,7 @@ def overrides_from_args(args) -> dict:
 
 def cmd_drop(args) -> int:
     from .metrics import compute_metrics
-    from .plots import plot_drop
+    from .runs.plots import plot_drop
     from .simulate import simulate
 
     scene = scene_from_args(args)
@@ -201,7 +199,7 @@ def scene_parameter_rows(scene) -> list[dict]:
 
 
 def register(sub) -> None:
-    """``drop`` and ``params``."""
+    """``drop``, ``params``, ``study`` and ``accuracy``."""
     p = sub.add_parser("drop", help="simulate a drop: summary table, metrics.json, time series, plots")
     add_scene_args(p)
     p.add_argument("--t-end", type=float, default=None, help="simulated time [s] (solver.t_end)")
@@ -216,6 +214,89 @@ def register(sub) -> None:
     p.add_argument("--json", action="store_true", help="machine-readable output")
     p.add_argument("--presets", action="store_true", help="list the preset scene names")
     p.set_defaults(func=cmd_params)
+    _register_study(sub)
+    _register_accuracy(sub)
+
+
+# ------------------------------------------------------------------ study and accuracy --
+def _register_study(subparsers) -> None:
+    from .runs.backend import add_backend_args
+    p = subparsers.add_parser("study", help="re-run a published study: report.md, figures, study.json")
+    sub = p.add_subparsers(dest="study", required=True)
+    q = sub.add_parser("paper", help="the paper's friction, stiffness and damping studies (§V)")
+    add_scene_args(q)
+    q.add_argument("--out", default="out/study", help="output directory")
+    q.add_argument("--quick", action="store_true",
+                   help="coarse grid and small ensembles (same outputs, minutes -> seconds)")
+    q.add_argument("--jobs", type=at_least(1), default=None,
+                   help="threads (default: all cores; at most one per CPU and per drop)")
+    q.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_backend_args(q, jobs=True)
+    q.set_defaults(func=cmd_study_paper)
+
+    q = sub.add_parser("sweep", help="a parameter study of the passive drop over 1 to 3 scene keys, "
+                                     "an ensemble of drops per cell")
+    add_scene_args(q)
+    q.add_argument("--vary", action="append", default=[], metavar="KEY=VALUES", required=True,
+                   help="a scene key and its values: KEY=V1,V2,... or KEY=LO:HI:STEP (1 to 3 times; a third key gives one map per value), "
+                        "e.g. --vary support.damping=2790,27900,1e5 --vary contact.friction=0.3:0.6:0.05")
+    q.add_argument("--members", type=at_least(1), default=8,
+                   help="drops per cell, unbalance angle and fault time perturbed (default 8)")
+    q.add_argument("--seed", type=at_least(0), default=0, help="seed of the ensemble perturbations")
+    q.add_argument("--out", default="out/sweep", help="output directory")
+    q.add_argument("--jobs", type=at_least(1), default=None,
+                   help="threads (default: all cores; at most one per CPU and per drop)")
+    q.add_argument("--no-plots", action="store_true", help="no sweep.png")
+    q.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_backend_args(q, jobs=True)
+    q.set_defaults(func=cmd_study_sweep)
+
+
+def cmd_study_paper(args) -> int:
+    from .runs.backend import Backend
+    from .runs.study.run import run_paper_study
+    summary = run_paper_study(args.scene, overrides_from_args(args), args.out, quick=args.quick,
+                              jobs=args.jobs, progress=not args.quiet,
+                              backend=Backend.from_args(args), resume=args.resume)
+    print(summary)
+    return 0
+
+
+def cmd_study_sweep(args) -> int:
+    from .runs.backend import Backend
+    from .runs.study.parametric import notes, run_parametric, summary_table
+    report = run_parametric(args.scene, overrides_from_args(args), args.vary, args.out,
+                            members=args.members, seed=args.seed, jobs=args.jobs,
+                            progress=not args.quiet, plots=not args.no_plots,
+                            backend=Backend.from_args(args), resume=args.resume)
+    print(summary_table(report))
+    for line in notes(report, args.members):
+        print(line)
+    print("wrote " + ", ".join(f"{args.out}/{f}" for f in report["files"])
+          + f" in {report['wall_time_s']:.0f} s")
+    return 0
+
+
+def _register_accuracy(subparsers) -> None:
+    p = subparsers.add_parser("accuracy", help="what accuracy costs in time: solver settings and "
+                              "reduced models against a tight reference (Markdown, JSON, Pareto plot)")
+    add_scene_args(p)
+    p.add_argument("--out", default="out/accuracy", help="output directory")
+    p.add_argument("--quick", action="store_true", help="2 drops of 0.3 s, fewer settings")
+    p.add_argument("--jobs", type=at_least(1), default=None, help="threads (default: all cores)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=cmd_accuracy)
+
+
+def cmd_accuracy(args) -> int:
+    from .runs.accuracy import run_accuracy, scene_setting_text
+    a, paths = run_accuracy(args.scene, overrides_from_args(args), args.out, quick=args.quick,
+                            jobs=args.jobs, progress=not args.quiet)
+    print(Path(paths[1]).read_text().split("\n\n![")[0])
+    print(f"\nrecommended: {a['recommended']} ({a['recommended_reason']}); "
+          f"scene's setting: {scene_setting_text(a)}")
+    print("wrote " + ", ".join(str(p) for p in paths))
+    return 0
 
 
 def run(args) -> int:

@@ -190,7 +190,7 @@ def simulate(scene: Scene, t_end: float | None = None, progress: bool = False) -
 def run_model(model: Model, compile_s: float = 0.0, progress: bool = False) -> Result:
     """The drop of a built ``model`` whose kernels are loaded (:func:`warm_up`; ``compile_s``:
     the seconds that took, reported apart from the integration's ``wall_time_s``). The single
-    drop and the batches of :func:`physics.sweep.run_chunk` both run this, so their numbers are identical."""
+    drop and the batches of :func:`physics.runs.sweep.run_chunk` both run this, so their numbers are identical."""
     if model.scene.sensor.noise > 0.0:
         raise SceneError(f"sensor.noise = {model.scene.sensor.noise:g} m: the drop driver has no "
                          "noise source (the environments draw it per control step); set it to 0")

@@ -77,7 +77,7 @@ class ThreadChoice:
 def auto_threads(n_envs: int) -> int:
     """The most threads worth trying for ``n_envs`` environments: the cores this process may
     use and numba's threads, at most one per ``ENVS_PER_THREAD`` environments."""
-    from physics.sweep import available_cores
+    from physics.runs.sweep import available_cores
     return max(1, min(available_cores(), numba.config.NUMBA_NUM_THREADS,
                       n_envs // ENVS_PER_THREAD))
 

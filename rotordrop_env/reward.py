@@ -21,7 +21,7 @@ the step of re-levitation, and ``−w_time · control_dt / episode_time`` in eve
 (re-levitating sooner pays).
 
 The environments compute it from their kernel arrays (:func:`kpi_step`); the SB3 wrapper
-``agents.reward.KpiReward`` computes the same from the ``info`` entries with
+``agents.learning.reward.KpiReward`` computes the same from the ``info`` entries with
 :func:`kpi_potential` and :func:`kpi_reward`.
 """
 from __future__ import annotations

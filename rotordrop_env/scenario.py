@@ -109,6 +109,16 @@ def sample(ranges: Mapping[str, tuple[str, float, float]], rng: np.random.Genera
     return out
 
 
+def draw(randomization: Mapping[str, Any] | None, seed: int, relevitate: bool = True,
+         env_name: str = "FullEnv") -> tuple[dict, np.random.Generator]:
+    """The scenario an environment (class ``env_name``, re-levitating or not) made with
+    ``randomization`` draws at ``reset(seed=seed)``, without making one; and the generator after
+    the draw, for what a caller draws beyond the scene (sensing, latency)."""
+    ranges, fixed = resolve_ranges(randomization, relevitate, env_name)
+    rng = np.random.default_rng(seed)
+    return sample(ranges, rng, fixed), rng
+
+
 class FaultState:
     """A scene compiled, its state at the instant of the fault, and the integrator (its
     settings and its step size there) that the episode continues with."""

@@ -30,8 +30,8 @@ def energy_residual(result):
 
 def phys(env, obs, name: str) -> float:
     """Physical (SI) value of observation ``name`` of one observation of a rotor-drop env, read
-    the way the controllers read it (``agents.plant.Plant.get``)."""
-    from agents.plant import Plant
+    the way the controllers read it (``agents.control.plant.Plant.get``)."""
+    from agents.control.plant import Plant
     return Plant.from_env(env).get(np.atleast_2d(obs), name)[0]
 
 

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-TESTS = ("tests/test_dissipation.py", "tests/test_energy.py")
+TESTS = ("tests/physics/test_dissipation.py", "tests/physics/test_energy.py")
 
 
 @dataclass(frozen=True)

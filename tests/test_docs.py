@@ -5,7 +5,7 @@ import json
 import re
 from pathlib import Path
 
-from agents import results
+from agents.benchmarking import results
 
 ROOT = Path(__file__).resolve().parents[1]
 USER_PAGES = [ROOT / "README.md"] + [p for p in (ROOT / "docs").rglob("*.md")
@@ -14,7 +14,7 @@ USER_PAGES = [ROOT / "README.md"] + [p for p in (ROOT / "docs").rglob("*.md")
 
 def test_results_page_and_readme_leaderboard_match_the_committed_data():
     for path, text in results.generated(ROOT).items():
-        assert path.read_text() == text, f"{path.name} is stale: run `python -m agents.results`"
+        assert path.read_text() == text, f"{path.name} is stale: run `python -m agents.benchmarking.results`"
     assert results.main(["--check"]) == 0
 
 

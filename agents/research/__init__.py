@@ -9,8 +9,9 @@ environments are imported by the handlers.
 """
 from __future__ import annotations
 
-from physics.backend import add_backend_args
-from physics.cli import UsageError, at_least
+from physics.runs.backend import add_backend_args
+from physics.cli import at_least
+from physics.runs import UsageError
 
 
 def register(subparsers) -> None:

@@ -4,7 +4,7 @@
 its friction included. :mod:`agents.research.oracle_sensitivity` found that its gain shrinks
 most when the friction is changed by 0.001, far below what any sensor or estimator resolves
 over the robust range 0.3-0.6. This probe asks the fairer question: the *blind oracle* runs the
-same cross-entropy search (:func:`agents.oracle.search_scenario`, same population and
+same cross-entropy search (:func:`agents.research.oracle.search_scenario`, same population and
 iterations) but scores every candidate sequence by its mean J over three copies of the
 scenario, friction mu - delta, mu and mu + delta, so it must find one sequence that suits all
 three, as a controller that knows everything but the friction to within delta must. It starts
@@ -29,10 +29,10 @@ from pathlib import Path
 
 import numpy as np
 
-from agents.oracle import check_constants, constant_theta, search_scenario, suite_scenarios
+from agents.research.oracle import check_constants, constant_theta, search_scenario, suite_scenarios
 from agents.research.oracle_sensitivity import (largest_gains, passive_row, perturbed, replay, row_J,
                                                 searches)
-from agents.score import write_json
+from agents.benchmarking.score import write_json
 
 COPIES = (0.0, -1.0, 1.0)          # friction of each copy: mu + k delta (the scenario first)
 

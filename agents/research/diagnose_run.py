@@ -24,12 +24,12 @@ from pathlib import Path
 
 import numpy as np
 
-from agents.benchmark import EPISODE_TIME
-from agents.controllers import InnerLoop
-from agents.policies import LearnedPolicy
-from agents.reward import WEIGHTS, kpi_potential
-from agents.robust import robust_validator
-from agents.score import write_json
+from agents.benchmarking.benchmark import EPISODE_TIME
+from agents.control.controllers import InnerLoop
+from agents.learning.policies import LearnedPolicy
+from agents.learning.reward import WEIGHTS, kpi_potential
+from agents.benchmarking.robust import robust_validator
+from agents.benchmarking.score import write_json
 from rotordrop_env.env import DAMPING_ACTIONS
 from rotordrop_env.kernels import damper_fraction
 
@@ -50,7 +50,7 @@ class Recorder:
 
 
 def kpi_return(row: dict) -> float:
-    """The KPI reward's episode return from a validation row's KPIs (agents/reward.py)."""
+    """The KPI reward's episode return from a validation row's KPIs (agents/learning/reward.py)."""
     w = {k: v for k, v in WEIGHTS.items() if k not in ("w_relevitate", "w_time")}
     phi = kpi_potential(min(row["peak_whirl_revolutions"], 3.0), row["peak_contact_force_N"],
                         row["max_displacement_um"], **w)
@@ -135,8 +135,8 @@ def main(argv=None) -> None:
         ckpts.append(args.run / "best" / "best_model.zip")
     first = LearnedPolicy.load(ckpts[0])
     env_kwargs = first.env_kwargs
-    from agents.plant import Plant
-    from agents.rollout import make_env
+    from agents.control.plant import Plant
+    from agents.benchmarking.rollout import make_env
     env = make_env(first.env_id, command="supervisor", control_dt=env_kwargs["control_dt"])
     names = list(Plant.from_env(env).obs_names)
     env.close()

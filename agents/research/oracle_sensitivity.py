@@ -30,12 +30,12 @@ from pathlib import Path
 
 import numpy as np
 
-from agents.benchmark import controller_entry, episode_kwargs
-from agents.controllers import Passive
-from agents.oracle import (ENV_ID, check_constants, constant_name, constant_theta, episode_cost, kpi_row,
+from agents.benchmarking.benchmark import controller_entry, episode_kwargs
+from agents.control.controllers import Passive
+from agents.research.oracle import (ENV_ID, check_constants, constant_name, constant_theta, episode_cost, kpi_row,
                            rollout, search_kwargs, suite_scenarios)
-from agents.rollout import run_episodes
-from agents.score import write_json
+from agents.benchmarking.rollout import run_episodes
+from agents.benchmarking.score import write_json
 
 #: name -> (scene key, change, relative): copies of a scenario no sensor tells apart
 PERTURBATIONS = {"none": None,

@@ -9,8 +9,8 @@ Random: every entry tanh(N(0, std²)) each step (SAC's initial actor: std 1), th
 with 0. Constant: the 8 Full-supervisor entries (damping1, damping2, levitate, gain, offset_r1,
 offset_t1, offset_r2, offset_t2), every step. Both at the 5 ms step; with ``--suite robust``
 (the default) on the robust validation set with the sensing of the robust training runs
-(:func:`agents.robust.training_env_kwargs`), with ``--suite nominal`` on the nominal validation
-suite of the Full task (:class:`agents.benchmark.Validator`: the one ``rotordrop train`` selects
+(:func:`agents.benchmarking.robust.training_env_kwargs`), with ``--suite nominal`` on the nominal validation
+suite of the Full task (:class:`agents.benchmarking.benchmark.Validator`: the one ``rotordrop train`` selects
 on and ``rotordrop tune`` tunes on).
 """
 from __future__ import annotations
@@ -20,8 +20,8 @@ import json
 
 import numpy as np
 
-from agents.benchmark import Validator
-from agents.robust import ENV_ID, robust_validator, training_env_kwargs
+from agents.benchmarking.benchmark import Validator
+from agents.benchmarking.robust import ENV_ID, robust_validator, training_env_kwargs
 
 #: the probes' control step [s]
 CONTROL_DT = 0.005

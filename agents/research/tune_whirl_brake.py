@@ -1,4 +1,4 @@
-"""Tune the gains of the ``whirl-brake`` baseline (agents/controllers.py) by cross-entropy search.
+"""Tune the gains of the ``whirl-brake`` baseline (agents/control/controllers.py) by cross-entropy search.
 
 The tuning set deliberately avoids the benchmark's scenarios: frictions 0.45, 0.50, 0.55 (the
 benchmark uses mu* + 0.05/0.10/0.15 = 0.43/0.48/0.53 and 0.6) at unbalance phases 45° and 225°
@@ -21,11 +21,11 @@ from functools import partial
 from pathlib import Path
 
 import numpy as np
-from agents.benchmark import EVAL_KWARGS, Entry, Scenario, controller_env_kwargs, episode_kwargs, task_of
-from agents.controllers import WhirlBrake
-from agents.rollout import run_episodes
-from agents.ray_search import minimise
-from physics.backend import Backend
+from agents.benchmarking.benchmark import EVAL_KWARGS, Entry, Scenario, episode_kwargs, task_of
+from agents.control.controllers import WhirlBrake, controller_env_kwargs
+from agents.benchmarking.rollout import run_episodes
+from agents.benchmarking.ray_search import minimise
+from physics.runs.backend import Backend
 
 NAMES = ("kp", "kd", "kc", "kt", "kr", "ff")
 LOW = np.array([0.0, 0.0, -3.0, -0.5, -1.0, 0.0])

@@ -1,7 +1,7 @@
 """How few backward-whirl revolutions can *any* AMB current sequence reach once the power is back?
 
 An oracle probe of the re-levitation task: for one fixed scenario (friction, unbalance phase,
-power-return delay) a cross-entropy search (agents/search.py) optimises an open-loop correction
+power-return delay) a cross-entropy search (agents/benchmarking/search.py) optimises an open-loop correction
 of the AMB currents, piecewise constant over ``--segments`` × ``--steps`` control steps from the
 moment the power returns, added to a baseline controller's currents (default ``whirl-brake``)
 and clipped to the current limit. The correction is allowed the full range [-2, 2], so it can
@@ -26,13 +26,13 @@ from pathlib import Path
 
 import numpy as np
 
-from agents.benchmark import (RELEVITATION_ENVS, Entry, Scenario, controller_env_kwargs,
+from agents.benchmarking.benchmark import (RELEVITATION_ENVS, Entry, Scenario,
                               episode_kwargs, task_of)
-from agents.controllers import _rot90, command_for, controller_class
-from agents.open_loop import CurrentOverride, OpenLoopCorrection
-from agents.plant import Plant
-from agents.rollout import run_episodes
-from agents.search import cross_entropy
+from agents.control.controllers import _rot90, command_for, controller_class, controller_env_kwargs
+from agents.control.open_loop import CurrentOverride, OpenLoopCorrection
+from agents.control.plant import Plant
+from agents.benchmarking.rollout import run_episodes
+from agents.benchmarking.search import cross_entropy
 from physics.metrics import WHIRL_MIN_REVOLUTIONS
 from rotordrop_env.layout import CURRENT_ACTIONS
 

@@ -12,7 +12,7 @@ Each is a symmetric steel shaft 0.9 m long (journals, a thicker core) plus one r
   399.2 Hz; on the same AMBs at 10 000 rpm forward 402.2 Hz = 2.41 x running speed (between
   1.5 and 3 x, as in many high-speed AMB machines), backward 399.6 Hz.
 
-(Figures from tests/test_flexible_examples.py, which recomputes them.)
+(Figures from tests/physics/flexible/test_flexible_examples.py, which recomputes them.)
 """
 from __future__ import annotations
 

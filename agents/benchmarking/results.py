@@ -1,0 +1,511 @@
+"""The results page from committed data: ``python -m agents.benchmarking.results`` (or ``rotordrop results``).
+
+Reads the benchmark output committed under ``docs/data/`` and the learning-curve CSVs under
+``docs/img/`` and writes
+
+* ``docs/results.md``: the leaderboards of the nominal suite, the robust suite and the hard
+  benchmark (where their data exist) and the list of learning-curve figures, and
+* the leaderboard block of ``README.md`` between ``<!-- leaderboard:start -->`` and
+  ``<!-- leaderboard:end -->`` (the Full task of the nominal suite).
+
+Data files (each written by the project's own commands; only what the tables need is kept):
+
+=====================================  =======================================================
+``docs/data/leaderboard-nominal.json``  ``rotordrop benchmark --out DIR``: ``DIR/benchmark.json``
+``docs/data/leaderboard-robust.json``   ``rotordrop benchmark --suite robust --out DIR``: ``DIR/benchmark.json``
+``docs/data/oracle-nominal.json``       ``rotordrop oracle --out DIR``: ``DIR/oracle.json``
+``docs/data/oracle-robust.json``        ``rotordrop oracle --suite robust --out DIR``: ``DIR/oracle.json``
+``docs/data/hard-<name>.json``          ``rotordrop evaluate ... --episodes 200 --seed 900000 --out DIR``: ``DIR/kpis.json``
+=====================================  =======================================================
+
+After re-running a benchmark, hand its output to the command, which stores it and regenerates
+the pages in one go::
+
+    python -m agents.benchmarking.results --nominal out/bench/benchmark.json --robust out/robust/benchmark.json \\
+        --oracle-nominal out/oracle/oracle.json --oracle-robust out/oracle-robust/oracle.json \\
+        --hard out/hard-tqc/kpis.json
+
+``--check`` writes nothing and exits 1 when the committed pages differ from what the committed
+data give (the test suite runs it). The module needs only the standard library.
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import re
+import statistics
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+DATA = Path("docs/data")
+IMG = Path("docs/img")
+RESULTS = Path("docs/results.md")
+README = Path("README.md")
+START, END = "<!-- leaderboard:start -->", "<!-- leaderboard:end -->"
+#: the benchmark.json keys kept in docs/data (the per-episode ``rows`` are left out)
+DROPPED_KEYS = ("rows",)
+#: the kpis.json keys kept for the hard benchmark (the passive comparison is left out)
+HARD_KEYS = ("policy", "env_id", "env_kwargs", "seeds", "summary", "episodes")
+TASK_TITLES = {"damping": "Damping (`RotorDrop-Damping-v1`)",
+               "relevitate": "Re-levitation (`RotorDrop-Relevitate-v1`)",
+               "full": "Damping and re-levitation (`RotorDrop-Full-v1`)"}
+
+
+# -- formatting --------------------------------------------------------------------------------
+def _f(x, spec: str = ".2f") -> str:
+    return "–" if x is None else format(x, spec)
+
+
+def leaderboard_table(entries: list[dict], kind: bool = False, in_out: bool = True) -> list[str]:
+    """One markdown leaderboard (the columns of ``rotordrop benchmark``'s leaderboard.md); the
+    bootstrap columns (SE of the score, difference to the best designed row ± SE and its 95 %
+    interval) where the data have them."""
+    se = any(e.get("score_se") is not None for e in entries)
+    ref = next((e["reference"] for e in entries if e.get("reference")), None)
+    head = ["rank", "controller"] + (["kind"] if kind else []) + ["score"]
+    head += ["SE", f"Δ vs `{ref}` ± SE [95 %]"] if se else []
+    head += (["in-dist.", "out-of-dist."] if in_out else [])
+    head += ["whirl rate", "whirl where passive whirls", "peak F / passive (mean, max)",
+             "disp. / passive", "relevitated", "stator contact"]
+    align = ["---:", "---"] + (["---"] if kind else []) + ["---:"] * (len(head) - 2 - kind)
+    lines = ["| " + " | ".join(head) + " |", "|" + "|".join(align) + "|"]
+    for i, e in enumerate(entries, 1):
+        cells = [str(i), f"`{e['controller']}`"] + ([e.get("kind", "")] if kind else [])
+        cells.append(_f(e["score"]))
+        if se:
+            ci = e.get("diff_ci95") or [None, None]
+            cells += [_f(e.get("score_se")),
+                      "–" if e.get("diff_se") is None else
+                      f"{e['diff_vs_reference']:+.2f} ± {e['diff_se']:.2f} "
+                      f"[{ci[0]:+.2f}, {ci[1]:+.2f}]"]
+        if in_out:
+            cells += [_f(e.get("in_distribution_score")), _f(e.get("out_of_distribution_score"))]
+        cells += [_f(e["whirl_rate"]), _f(e.get("whirl_rate_where_passive_whirls")),
+                  f"{_f(e['force_ratio'])}, {_f(e['max_force_ratio'])}", _f(e["displacement_ratio"]),
+                  _f(e.get("relevitation_rate")), _f(e["stator_contact_rate"])]
+        lines.append("| " + " | ".join(cells) + " |")
+    return lines
+
+
+def _tasks(report: dict) -> list[str]:
+    return list(dict.fromkeys(e["task"] for e in report["leaderboard"]))
+
+
+def nominal_section(report: dict, source: str) -> list[str]:
+    thr = report.get("passive_threshold")
+    out = ["## Nominal suite", "",
+           f"`rotordrop benchmark{' --quick' if report.get('quick') else ''}` "
+           f"(data: `{source}`). Passive whirl threshold μ\\* = {_f(thr, 'g')}; "
+           f"{len(report['scenarios'])} scenarios at {len(report['phases_deg'])} unbalance "
+           f"phases, {report['episode_time_s']:g} s after the fault; re-levitation tasks with "
+           f"the power back {1e3 * report['power_return_s']:g} ms after the fault unless the "
+           f"scenario says otherwise. {score_words(report)}", ""]
+    for task in _tasks(report):
+        out += [f"### {TASK_TITLES.get(task, task)}", ""]
+        out += leaderboard_table([e for e in report["leaderboard"] if e["task"] == task]) + [""]
+        out += seed_table([g for g in report.get("seed_groups") or []
+                           if any(e["task"] == task and e["controller"] in g["members"]
+                                  for e in report["leaderboard"])])
+    return out
+
+
+def score_words(report: dict) -> str:
+    """What the score and its uncertainty columns are."""
+    name = report.get("score")
+    text = (f"Score{f' ({name})' if name else ''}: 100 (1 − Σ J / Σ J_passive); passive scores 0 "
+            "([how it is scored](agents.md#benchmark-rotordrop-benchmark)).")
+    b = report.get("bootstrap")
+    if b:
+        text += (f" SE: paired bootstrap over the drops ({b['resamples']} resamples, seed "
+                 f"{b['seed']}); Δ: the score minus the best designed row's, with its SE and 95 % "
+                 "interval.")
+    return text
+
+
+def seed_table(groups: list[dict]) -> list[str]:
+    """Learned configurations trained with several seeds: their scores, mean ± std."""
+    if not groups:
+        return []
+    out = ["Learned configurations trained with several seeds:", "",
+           "| configuration (seeds) | scores | mean ± std | mean − std |", "|---|---|---:|---:|"]
+    for g in groups:
+        out.append(f"| {', '.join(f'`{m}`' for m in g['members'])} | "
+                   f"{', '.join(_f(s) for s in g['scores'])} | {_f(g['mean'])} ± {_f(g['std'])} | "
+                   f"{_f(g['mean_minus_std'])} |")
+    return out + [""]
+
+
+def robust_section(report: dict, source: str) -> list[str]:
+    d = report.get("distribution", {})
+    seeds = d.get("scenario_seeds", [None, None])
+    out = ["## Robust suite", "",
+           f"`rotordrop benchmark --suite robust{' --quick' if report.get('quick') else ''}` "
+           f"(data: `{source}`): {len(report['scenarios'])} drops of `RotorDrop-Full-v1` "
+           f"(scenario seeds {seeds[0]}–{seeds[1]}) with {_f(1e6 * d.get('sensor_noise_m', 0), 'g')} µm "
+           f"sensor noise, "
+           + (f"{'–'.join(f'{1e3 * v:g}' for v in d['sensor_delay_s'])} ms sensor delay (every "
+              "controller), " if d.get("sensor_delay_s") else "")
+           + f"{'–'.join(str(x) for x in d.get('latency_ms', []))} ms observation "
+           "latency, actuator spread and plant variation "
+           "([what is perturbed](agents.md#robust-suite))."
+           + (f" {score_words(report)}" if report.get("score") else ""), ""]
+    out += leaderboard_table(report["leaderboard"], kind=True, in_out=False) + [""]
+    out += seed_table(report.get("seed_groups") or [])
+    return out
+
+
+ORACLE_KEYS = ("command", "settings", "summary")
+
+
+def _learned_names(root: Path) -> set[str]:
+    return {p.stem for p in (root / "agents" / "policies").glob("*.zip")}
+
+
+def oracle_section(reports: list[tuple[str, dict, str]], root: Path) -> list[str]:
+    """The per-drop searched plan of the supervisor interface (``rotordrop oracle``) against the
+    designed rows scored on the same drops. Learned rows are left out here (policies are replaced; their
+    standing is in the leaderboards above)."""
+    learned = _learned_names(root)
+    out = ["## Oracle (searched open-loop plans)", "",
+           "`rotordrop oracle` searches, per drop and knowing the drop in advance, an open-loop "
+           "command sequence of the supervisor interface (a local search over a few segments "
+           "from the best designed row's plan): its score is reachable on those drops, a lower "
+           "bound on what that interface can reach, not a ceiling; a policy may do better "
+           "([how](agents.md#the-supervisor-interface)). Designed rows scored on the same drops; a "
+           "row `constant g=G r=R` is `inner-loop` with the constant gain action G and radial "
+           "offset R clearance (`inner-loop-lift` is g=0.5 r=-0.5).", ""]
+    for title, r, src in reports:
+        s = r["settings"]
+        rows = [e for e in r["summary"] if e["controller"] == "oracle"
+                or (e["controller"] not in learned and "@" not in e["controller"])]
+        designed = [e for e in rows if e["controller"] != "oracle"]
+        oracle = next((e for e in rows if e["controller"] == "oracle"), None)
+        best = max(designed, key=lambda e: e["score"]) if designed else None
+        seed = s.get("scenario_seed")
+        from rotordrop_env import ENV_IDS
+        out += [f"### {title}", "",
+                f"{s.get('scenarios')} drops (scenario seeds {seed}–{seed + s.get('scenarios', 1) - 1}), "
+                f"search {s.get('population')} × {s.get('iterations')} per drop, "
+                f"{s.get('score', 'legacy')} score, on `{s.get('env_id', 'RotorDrop-Full-v0')}`"
+                + (" (an earlier environment version: its numbers are not comparable with the"
+                   " leaderboards above)" if s.get("env_id", "RotorDrop-Full-v0") not in ENV_IDS
+                   else "") + f" (data: `{src}`)."
+                + (f" Searched plan over the best designed row (`{best['controller']}`): "
+                   f"**{oracle['score'] - best['score']:+.2f}** points." if oracle and best else ""), "",
+                *_oracle_header(rows)]
+        for e in rows:
+            out.append(f"| `{e['controller']}` | {_f(e['score'])} | " + _oracle_se(e, rows)
+                       + f"{_f(e['whirl_rate'])} | {_f(e.get('whirl_rate_where_passive_whirls'))} | "
+                       f"{_f(e.get('relevitation_rate'))} | {_f(e.get('mean_J'), '.3f')} |")
+        out.append("")
+    return out
+
+
+def _oracle_header(rows: list[dict]) -> list[str]:
+    """The oracle table's header: with the SE and Δ columns when the report carries them."""
+    ref = next((e["reference"] for e in rows if e.get("reference")), None)
+    se = [f"SE | Δ vs `{ref}` ± SE [95 %] | "] if ref else [""]
+    return ["| row | score | " + se[0] + "whirl rate | whirl where passive whirls | re-levitated "
+            "| mean J |", "|---|---:|" + ("---:|---:|" if ref else "") + "---:|---:|---:|---:|"]
+
+
+def _oracle_se(e: dict, rows: list[dict]) -> str:
+    if not any(r.get("reference") for r in rows):
+        return ""
+    if e.get("score_se") is None:
+        return "– | – | "
+    lo, hi = e["diff_ci"]
+    return (f"{_f(e['score_se'])} | {e['diff_vs_reference']:+.2f} ± {e['diff_se']:.2f} "
+            f"[{lo:+.2f}, {hi:+.2f}] | ")
+
+
+def oracle_budget_section(report: dict, src: str) -> list[str]:
+    """The oracle's score against its search budget on the same drops (``--oracle-budget``)."""
+    runs = sorted(report["runs"], key=lambda r: r["rollouts_per_drop"])
+    first = runs[0]
+    out = ["### Search budget", "",
+           f"The same {first['scenarios']} drops ({first['suite']}, scenario seeds "
+           f"{first['scenario_seed']}–{first['scenario_seed'] + first['scenarios'] - 1}) searched "
+           f"with growing budgets (population × generations); Δ: the searched plan minus the best "
+           f"designed row on those drops, paired bootstrap over the drops (data: `{src}`).", "",
+           "| population × generations | rollouts per drop | oracle score | SE | best designed row "
+           "| Δ ± SE [95 %] | no gain over its start (drops) | wall time |",
+           "|---|---:|---:|---:|---|---:|---:|---:|"]
+    for r in runs:
+        lo, hi = r["diff_ci"]
+        out.append(f"| {r['population']} × {r['iterations']} | {r['rollouts_per_drop']} | "
+                   f"{_f(r['score'])} | {_f(r['score_se'])} | `{r['reference']}` "
+                   f"{_f(r['reference_score'])} | {r['diff']:+.2f} ± {r['diff_se']:.2f} "
+                   f"[{lo:+.2f}, {hi:+.2f}] | {r['unchanged']} / {r['scenarios']} | "
+                   f"{r['wall_time_s']:.0f} s |")
+    return out + [""]
+
+
+def headroom_section(result: dict, src: str) -> list[str]:
+    """Where the robust suite's points go (``python -m agents.benchmarking.headroom``)."""
+    from .headroom import table
+    return ["## Headroom on the robust suite", "",
+            f"Each column's score split into the points each term of J costs (score = 100 − the "
+            f"sum), on the {result['drops']} test drops of the robust leaderboard: the best "
+            f"designed row `{result['reference']}`, the best learned row, each drop scored by the "
+            f"best designed row on it and by the best row of all (knowing the drop), and every "
+            f"term at its best over all rows at once with the re-levitation time at the power "
+            f"return (optimistic: the terms trade against each other; not a bound). ± SE: paired "
+            f"bootstrap over the drops ([how](agents.md#robust-suite); data: `{src}`).", "",
+            table(result), ""]
+
+
+def budget_run(report: dict) -> dict:
+    """One row of the budget sweep from a ``rotordrop oracle`` oracle.json."""
+    s = report["settings"]
+    orc = next(e for e in report["summary"] if e["controller"] == "oracle")
+    ref = next(e for e in report["summary"] if e["controller"] == orc["reference"])
+    searched = [d["search"] for d in report["per_scenario"]]
+    return dict(population=s["population"], iterations=s["iterations"],
+                rollouts_per_drop=searched[0]["rollouts"],
+                scenarios=s["scenarios"], scenario_seed=s["scenario_seed"],
+                suite=s.get("suite", "nominal"), score=orc["score"], score_se=orc["score_se"],
+                reference=orc["reference"], reference_score=ref["score"],
+                diff=orc["diff_vs_reference"], diff_se=orc["diff_se"], diff_ci=orc["diff_ci"],
+                unchanged=sum(d["J"] >= d["start_J"] for d in searched),
+                wall_time_s=report["wall_time_s"])
+
+
+def _quantile(values: list[float], q: float) -> float:
+    v = sorted(values)
+    k = (len(v) - 1) * q
+    lo, hi = int(k), min(int(k) + 1, len(v) - 1)
+    return v[lo] + (v[hi] - v[lo]) * (k - lo)
+
+
+def hard_row(report: dict, source: str) -> str:
+    eps = report["episodes"]
+    s = report["summary"]
+    after = [1e3 * (e["relevitation_time_s"] - e["scenario"]["power_return_time"])
+             for e in eps if e.get("relevitated") and e.get("relevitation_time_s") is not None
+             and "power_return_time" in e.get("scenario", {})]
+    n_ok = sum(1 for e in eps if e.get("relevitated"))
+    stator = [bool(e.get("stator_contact")) for e in eps if "stator_contact" in e]
+    times = (f"{statistics.median(after):.1f} / {_quantile(after, 0.9):.1f} / {max(after):.1f} ms"
+             if after else "–")
+    seeds = report["seeds"]
+    return (f"| `{report['policy']}` | {s['episodes']} (seeds {seeds[0]}–{seeds[-1]}) | "
+            f"**{_f(s['relevitation_success_rate'])}** ({n_ok} / {len(eps)}) | {times} | "
+            f"{_f(s['backward_whirl_rate'])} | {_f(sum(stator) / len(stator) if stator else None)} | "
+            f"`{source}` |")
+
+
+def hard_section(reports: list[tuple[dict, str]]) -> list[str]:
+    out = ["## Hard benchmark", "",
+           "Re-levitation on raw coil currents, learned from scratch in 60 minutes on one core "
+           "([rules and commands](agents.md#hard-benchmark-raw-currents-from-scratch)); every "
+           "row is `rotordrop evaluate` on the 200 held-out drops. A baseline's row "
+           "(`pid-relevitate`: designed PD with gravity feed-forward on the currents) is the "
+           "reference a learned entry is compared with.", "",
+           "| policy | drops | re-levitation rate | after the power return (median / 90 % / max) | "
+           "whirl rate | stator contact | data |",
+           "|---|---|---:|---:|---:|---:|---|"]
+    out += [hard_row(r, src) for r, src in reports]
+    return out + [""]
+
+
+def learning_curves(root: Path) -> list[str]:
+    """One row per curve of each learning-curve figure under docs/img (``learning-*.png``, and
+    ``hard-*.png`` with a CSV): from the CSV beside the figure (``python -m
+    agents.training.learning_curves`` writes it), the runs, the last step and the best point; and the
+    pages that discuss the figure."""
+    img, docs = root / IMG, root / "docs"
+    pngs = sorted(img.glob("learning-*.png")) + sorted(
+        p for p in img.glob("hard-*.png") if p.with_suffix(".csv").exists())
+    pages = [docs / "agents.md"] + sorted((docs / "experiments").glob("*.md"))
+    pages = [p for p in pages if p.exists()]
+    out = ["## Learning curves", "",
+           "Each figure is drawn by `python -m agents.training.learning_curves` from the runs' "
+           "`training.json`, with a CSV beside it; the table gives, per curve, the best point of "
+           "the mean over its runs (± the std over runs at that step).", "",
+           "| figure | curve | runs | last step | best point | discussed in |",
+           "|---|---|---:|---:|---|---|"]
+    for png in pngs:
+        rel = png.relative_to(docs).as_posix()
+        seen = [p for p in pages if png.name in p.read_text()]
+        where = ", ".join(f"[{p.stem}]({p.relative_to(docs).as_posix()})" for p in seen) or "–"
+        c = png.with_suffix(".csv")
+        if not c.exists():
+            out.append(f"| [{png.name}]({rel}) | – | – | – | no CSV committed | {where} |")
+            continue
+        with c.open(newline="") as fh:
+            rows = list(csv.DictReader(fh))
+        qty = next(k[:-5] for k in rows[0] if k.endswith("_mean"))
+        for i, label in enumerate(dict.fromkeys(r["label"] for r in rows)):
+            mine = [r for r in rows if r["label"] == label]
+            best = max(mine, key=lambda r: float(r[f"{qty}_mean"]))
+            std = float(best.get(f"{qty}_std") or 0.0)
+            point = (f"{qty} {float(best[f'{qty}_mean']):.4g}"
+                     + (f" ± {std:.2g}" if int(best["runs"]) > 1 else "")
+                     + f" at step {int(best['timesteps'])}")
+            first = f"[{png.name}]({rel})" if i == 0 else ""
+            out.append(f"| {first} | {label} | {max(int(r['runs']) for r in mine)} | "
+                       f"{max(int(r['timesteps']) for r in mine)} | {point} | "
+                       f"{where if i == 0 else ''} |")
+    return out + [""]
+
+
+# -- pages -------------------------------------------------------------------------------------
+def _load(path: Path):
+    return json.loads(path.read_text()) if path.exists() else None
+
+
+def results_page(root: Path = ROOT) -> str:
+    data = root / DATA
+    lines = ["# Results", "",
+             "<!-- Generated by `python -m agents.benchmarking.results` from docs/data/ and docs/img/: "
+             "do not edit by hand. -->", "",
+             "Every table on this page is generated from committed benchmark output by "
+             "`python -m agents.benchmarking.results` (after re-running a benchmark: "
+             "`rotordrop results --nominal out/bench/benchmark.json`, likewise `--robust`, "
+             "`--oracle-nominal`, `--oracle-robust` and `--hard`; "
+             "[the commands](agents.md#benchmark-results)). How the rows came to be is in the "
+             "[experiment log](experiments/index.md).", ""]
+    nominal = _load(data / "leaderboard-nominal.json")
+    if nominal:
+        lines += nominal_section(nominal, (DATA / "leaderboard-nominal.json").as_posix())
+    robust = _load(data / "leaderboard-robust.json")
+    if robust:
+        lines += robust_section(robust, (DATA / "leaderboard-robust.json").as_posix())
+    oracles = [(title, json.loads((data / name).read_text()), (DATA / name).as_posix())
+               for title, name in (("Nominal drops", "oracle-nominal.json"),
+                                   ("Robust suite", "oracle-robust.json"))
+               if (data / name).exists()]
+    if oracles:
+        lines += oracle_section(oracles, root)
+    room = _load(data / "headroom-robust.json")
+    if room:
+        lines += headroom_section(room, (DATA / "headroom-robust.json").as_posix())
+    budget = _load(data / "oracle-budget.json")
+    if budget:
+        lines += oracle_budget_section(budget, (DATA / "oracle-budget.json").as_posix())
+    hard = [(json.loads(p.read_text()), (DATA / p.name).as_posix())
+            for p in sorted(data.glob("hard-*.json"))]
+    if hard:
+        lines += hard_section(hard)
+    lines += learning_curves(root)
+    return "\n".join(lines).rstrip() + "\n"
+
+
+def readme_block(root: Path = ROOT) -> str:
+    """The README's leaderboard: the Full task of the nominal suite."""
+    nominal = _load(root / DATA / "leaderboard-nominal.json")
+    if not nominal:
+        return "No benchmark data committed yet: see docs/results.md."
+    full = [e for e in nominal["leaderboard"] if e["task"] == "full"]
+    return "\n".join([f"`rotordrop benchmark`, damping and re-levitation together "
+                      f"(`RotorDrop-Full-v1`, passive threshold μ\\* = {_f(nominal['passive_threshold'], 'g')}"
+                      + (f", {nominal['score']} score; SE and Δ: paired bootstrap over the drops against "
+                         "the best designed row" if nominal.get("score") else "")
+                      + "); every table: [docs/results.md](docs/results.md).", ""]
+                     + leaderboard_table(full))
+
+
+def readme_text(root: Path = ROOT) -> str:
+    text = (root / README).read_text()
+    pattern = re.compile(re.escape(START) + r".*?" + re.escape(END), flags=re.S)
+    if not pattern.search(text):
+        raise ValueError(f"README.md has no {START} ... {END} block")
+    return pattern.sub(lambda _: f"{START}\n{readme_block(root)}\n{END}", text)
+
+
+def store(src: str | Path, dest: Path, keep=None, drop=()) -> Path:
+    """Copy a benchmark.json / kpis.json into docs/data, keeping what the tables need."""
+    report = json.loads(Path(src).read_text())
+    if keep is not None:
+        report = {k: report[k] for k in keep if k in report}
+    report = {k: v for k, v in report.items() if k not in drop}
+    dest.parent.mkdir(parents=True, exist_ok=True)
+    dest.write_text(json.dumps(report, indent=1, sort_keys=True) + "\n")
+    return dest
+
+
+def generated(root: Path = ROOT) -> dict[Path, str]:
+    return {root / RESULTS: results_page(root), root / README: readme_text(root)}
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """The options of ``python -m agents.benchmarking.results`` and ``rotordrop results``."""
+    p.add_argument("--nominal", help="a `rotordrop benchmark` benchmark.json to store as "
+                                     "docs/data/leaderboard-nominal.json")
+    p.add_argument("--robust", help="a `rotordrop benchmark --suite robust` benchmark.json to "
+                                    "store as docs/data/leaderboard-robust.json")
+    p.add_argument("--hard", action="append", default=[],
+                   help="a `rotordrop evaluate` kpis.json of the hard benchmark to store as "
+                        "docs/data/hard-<policy>.json (repeatable)")
+    p.add_argument("--oracle-nominal", help="a `rotordrop oracle` oracle.json (nominal drops) to "
+                                            "store as docs/data/oracle-nominal.json")
+    p.add_argument("--oracle-robust", help="a `rotordrop oracle --suite robust` oracle.json to "
+                                           "store as docs/data/oracle-robust.json")
+    p.add_argument("--headroom", help="a `python -m agents.benchmarking.headroom` headroom.json of "
+                                      "the robust leaderboard, stored as "
+                                      "docs/data/headroom-robust.json")
+    p.add_argument("--oracle-budget", nargs="+", default=[],
+                   help="`rotordrop oracle` oracle.json files of one suite's drops at several "
+                        "search budgets, stored together as docs/data/oracle-budget.json")
+    p.add_argument("--root", default=str(ROOT), help="the project folder (default: this checkout)")
+    p.add_argument("--check", action="store_true",
+                   help="write nothing; exit 1 if the committed pages differ from the data")
+
+
+def run(args) -> int:
+    """Store the given benchmark output in docs/data and regenerate the pages (or ``--check``)."""
+    root = Path(args.root)
+    given = (args.nominal, args.robust, args.hard, args.oracle_nominal, args.oracle_robust,
+             args.oracle_budget, args.headroom)
+    if args.check and any(given):
+        print("results: error: --check takes no data files", file=sys.stderr)
+        return 2
+    stored = []
+    if args.nominal:
+        stored.append(store(args.nominal, root / DATA / "leaderboard-nominal.json", drop=DROPPED_KEYS))
+    if args.robust:
+        stored.append(store(args.robust, root / DATA / "leaderboard-robust.json", drop=DROPPED_KEYS))
+    for src, name in ((args.oracle_nominal, "oracle-nominal.json"),
+                      (args.oracle_robust, "oracle-robust.json")):
+        if src:
+            stored.append(store(src, root / DATA / name, keep=ORACLE_KEYS))
+    if args.headroom:
+        stored.append(store(args.headroom, root / DATA / "headroom-robust.json"))
+    if args.oracle_budget:
+        runs = [budget_run(json.loads(Path(p).read_text())) for p in args.oracle_budget]
+        dest = root / DATA / "oracle-budget.json"
+        dest.write_text(json.dumps({"runs": runs}, indent=1, sort_keys=True) + "\n")
+        stored.append(dest)
+    for h in args.hard:
+        name = re.sub(r"[^A-Za-z0-9_.-]+", "-", json.loads(Path(h).read_text())["policy"]).strip("-")
+        stored.append(store(h, root / DATA / f"hard-{name}.json", keep=HARD_KEYS))
+    stale = []
+    for path, text in generated(root).items():
+        if path.exists() and path.read_text() == text:
+            continue
+        stale.append(path)
+        if not args.check:
+            path.write_text(text)
+    if args.check:
+        if stale:
+            print("out of date (run `python -m agents.benchmarking.results`): "
+                  + ", ".join(str(s.relative_to(root)) for s in stale), file=sys.stderr)
+            return 1
+        print("docs/results.md and the README leaderboard match docs/data")
+        return 0
+    print("wrote " + ", ".join(str(s.relative_to(root)) for s in stored + stale) if stored + stale
+          else "nothing to change")
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(prog="python -m agents.benchmarking.results", description=__doc__.split("\n")[0])
+    add_arguments(p)
+    return run(p.parse_args(argv))
+
+
+if __name__ == "__main__":
+    sys.exit(main())

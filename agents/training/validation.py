@@ -1,0 +1,123 @@
+"""Model selection on the validation suite, for ``rotordrop train`` and for rl-zoo3.
+
+:func:`validation_score` is the benchmark score (:class:`agents.benchmarking.benchmark.Validator`: frictions
+and unbalance phases the benchmark does not use) of a model being trained, run as the saved
+policy will run: its observation normalisation and, for a residual policy, its baseline.
+
+:class:`ValidationCallback` runs it as an SB3 callback, the one class for both: rl-zoo3 builds it
+from a config's ``callback:`` entry (``agents.training.validation.ValidationCallback``; in
+``rotordrop train`` that entry means ``validation: true``) and scores every ``eval_freq``
+environment steps; ``rotordrop train`` scores after each of its KPI evaluations. It logs
+``eval/validation_score`` and, with a ``save_path``, keeps the best-scoring model there as a
+self-contained zip (:mod:`agents.sb3_policy`) that plain SB3 loads.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from stable_baselines3.common.callbacks import BaseCallback
+
+#: rl-zoo3's default evaluation interval [environment steps]
+EVAL_FREQ = 25_000
+
+
+def validation_score(validator, model, algo: str, env_id: str, env_kwargs: dict, vecnormalize,
+                     residual: str | None = None, residual_scale: float | None = None,
+                     frame_stack: int | None = None) -> float:
+    """The benchmark score of ``model`` (with its ``vecnormalize``, ``residual`` and
+    ``frame_stack``; None: read from the model's training env) on the validation suite of
+    ``validator``."""
+    from ..learning.policies import LearnedPolicy
+    pol = LearnedPolicy("candidate", algo, env_id, env_kwargs, model, vecnormalize,
+                        frame_stack=frame_stack)
+    if residual is not None:
+        pol.residual, pol.residual_scale = residual, residual_scale
+    score, _ = validator.score(pol.bound, env_kwargs)
+    return score
+
+
+class ValidationCallback(BaseCallback):
+    """The validation score of the deterministic policy, logged as ``eval/validation_score``
+    (and printed with ``verbose``); the best model so far is saved to ``save_path/best_model.zip``
+    (self-contained) when ``save_path`` is given.
+
+    rl-zoo3 builds it from a config's ``callback:`` entry (``callback: -
+    agents.training.validation.ValidationCallback: {save_path: DIR}``): it scores every
+    ``eval_freq`` environment steps and reads the env id, its kwargs, the residual and the
+    algorithm from the training env and the model. ``rotordrop train`` (``validation: true``)
+    passes ``evaluations``, its KPI evaluation: the score follows each of its evaluations and is
+    written into that evaluation's learning-curve entry; ``policy`` (``env_id``, ``algo``,
+    ``env_kwargs``, ``residual``, ``residual_scale``, ``frame_stack``) says what the run trains,
+    ``best`` is a continued run's best score so far and ``save(model, path)`` saves the best model
+    (default: :func:`agents.sb3_policy.export_self_contained`).
+    """
+
+    def __init__(self, eval_freq: int = EVAL_FREQ, save_path: str | None = None, verbose: int = 1,
+                 *, evaluations=None, policy: dict | None = None, best: float = -np.inf,
+                 save=None):
+        super().__init__(verbose)
+        if int(eval_freq) != eval_freq or eval_freq < 1:
+            raise ValueError(f"ValidationCallback: eval_freq = {eval_freq!r} must be an integer >= 1")
+        self.eval_freq = int(eval_freq)
+        self.save_path = None if save_path is None else Path(save_path)
+        self.evaluations, self.policy, self.save = evaluations, policy, save
+        self.best = best
+        self.last = 0
+        self.seen = 0 if evaluations is None else len(evaluations.kpi_history)
+        self.validator = None
+
+    def _init_callback(self) -> None:
+        from ..benchmarking.robust import validator_for
+        if self.policy is not None:
+            self.env_id, self.env_kwargs = self.policy["env_id"], dict(self.policy["env_kwargs"])
+            self.algo = self.policy["algo"]
+        else:
+            spec = self.training_env.get_attr("spec", [0])[0]
+            self.env_id, self.env_kwargs = spec.id, dict(spec.kwargs)
+            self.algo = type(self.model).__name__.lower()
+        self.validator = validator_for(self.env_id, self.env_kwargs)
+        if self.save_path is not None:
+            self.save_path.mkdir(parents=True, exist_ok=True)
+
+    def _on_step(self) -> bool:
+        if self.evaluations is not None:
+            if len(self.evaluations.kpi_history) != self.seen:
+                self.seen = len(self.evaluations.kpi_history)
+                self.evaluations.kpi_history[-1]["validation_score"] = self.validate()
+        elif self.num_timesteps - self.last >= self.eval_freq:
+            self.last = self.num_timesteps
+            self.validate()
+        return True
+
+    def _on_training_end(self) -> None:
+        if self.evaluations is not None:
+            self._on_step()                         # scores the final evaluation, if any
+            self.logger.dump(self.num_timesteps)
+
+    def validate(self) -> float:
+        vn = self.model.get_vec_normalize_env()
+        if self.policy is not None:
+            residual, scale = self.policy.get("residual"), self.policy.get("residual_scale")
+            frame_stack = self.policy.get("frame_stack", 1)
+        else:
+            from ..control.residual import residual_of
+            residual, scale = residual_of(self.training_env)
+            frame_stack = None
+        score = validation_score(self.validator, self.model, self.algo, self.env_id,
+                                 self.env_kwargs, vn, residual, scale, frame_stack)
+        self.logger.record("eval/validation_score", score)
+        if self.verbose:
+            print(f"validation score {score:.2f} at {self.num_timesteps} steps (best {max(score, self.best):.2f})")
+        if score > self.best:
+            self.best = score
+            if self.save_path is not None:
+                path = self.save_path / "best_model.zip"
+                if self.save is not None:
+                    self.save(self.model, path)
+                else:
+                    from ..sb3_policy import export_self_contained
+                    export_self_contained(self.model, vn, path, env_id=self.env_id,
+                                          env_kwargs=self.env_kwargs, residual=residual,
+                                          residual_scale=scale)
+        return score
