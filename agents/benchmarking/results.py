@@ -301,9 +301,10 @@ def hard_section(reports: list[tuple[dict, str]]) -> list[str]:
     out = ["## Hard benchmark", "",
            "Re-levitation on raw coil currents, learned from scratch in 60 minutes on one core "
            "([rules and commands](agents.md#hard-benchmark-raw-currents-from-scratch)); every "
-           "row is `rotordrop evaluate` on the 200 held-out drops. A baseline's row "
-           "(`pid-relevitate`: designed PD with gravity feed-forward on the currents) is the "
-           "reference a learned entry is compared with.", "",
+           "row is `rotordrop evaluate` on the 200 held-out drops. The designed rows on the same "
+           "interface are the references a learned entry is compared with: `whirl-brake` (the "
+           "strongest designed raw-current law: PD centring with whirl-braking terms) and "
+           "`pid-relevitate` (PD with gravity feed-forward and a ramped reference).", "",
            "| policy | drops | re-levitation rate | after the power return (median / 90 % / max) | "
            "whirl rate | stator contact | data |",
            "|---|---|---:|---:|---:|---:|---|"]
