@@ -38,6 +38,8 @@ from .layout import Layout, StateSizes
 from .rotor import axis_at, rotor_energy, tilt_accelerations, unbalance_load
 from .scene import Scene
 from . import sensor as sensor_mod
+from . import seal
+from .seal import seal_load
 from .stator import mount_energy, mount_power, mount_rates, stator_force, stator_potential
 from .support import (body_energy, damper_rate, housing_rates, spin_energy, spring_energy,
                       support_power)
@@ -69,7 +71,8 @@ class EnergyAudit:
 
 
 #: the registered effects, in the order their states are laid out (adding an effect: one line)
-EFFECTS = (rotor, contact, ball_bearing, amb_mod, support, EnergyAudit, thermal, stator, sensor)
+EFFECTS = (rotor, contact, ball_bearing, amb_mod, support, EnergyAudit, thermal, stator, sensor,
+           seal)
 #: the packed arrays' named slots, from the effects' declarations
 LAYOUT = Layout.build(EFFECTS)
 _P, _I, _J, _U, _A, _AP = (LAYOUT.params, LAYOUT.index, LAYOUT.plane, LAYOUT.controls,
@@ -111,6 +114,8 @@ P_ST_GAP, P_ST_K, P_ST_C, P_ST_MU, P_ST_R, P_ST_VL, P_STM_K, P_STM_C, P_STM_M = 
 P_TH_C, P_TH_G, P_TH_A, P_TH_SLOPE, P_TH_RMIN, P_TH_RMAX, P_TH_B = _P.indices(*thermal.PARAM_NAMES)
 # position sensing (scene group sensor, physics/sensor.py): delay tau
 P_SENS_TAU = _P["sensor.delay"]
+# seal cross-coupling (physics/seal.py): station, direct and cross-coupled stiffness
+P_SEAL_Z, P_SEAL_K, P_SEAL_KC = _P.indices("seal.z", "seal.direct_stiffness", "seal.cross_stiffness")
 N_P = _P.size
 
 # ------------------------------------------------------------------- flags and indices I --
@@ -120,7 +125,8 @@ F_GRAV, F_UNB, F_GYRO, F_AMB, F_RB, F_FILM, F_BFRIC, F_HOUSING, F_SLEEVE_J, F_FR
                "flag.sleeve_inertia", "flag.friction", "flag.audit"))
 # flags: rotor-stator contact on/off, rotor-sleeve contact law (LAW_*), position sensing (on
 # when sensor.delay or sensor.noise > 0)
-F_STATOR, F_LAW, F_SENSOR = _I.indices("flag.stator", "flag.law", "flag.sensor")
+F_STATOR, F_LAW, F_SENSOR, F_SEAL = _I.indices("flag.stator", "flag.law", "flag.sensor",
+                                               "flag.seal")
 S_X, S_Y, S_A, S_B, S_VX, S_VY, S_VA, S_VB, S_W, S_PHI = _I.indices(
     *("state." + n for n in rotor.STATE_NAMES + ("phi",)))
 S_EDISS, S_WEXT = _I.indices("state.E_dissipated", "state.W_external")
@@ -412,6 +418,16 @@ def rhs(t, y, P, I, U, dy, aux):
         Mb += my
         p_ext += p
         dy[iphi] = W
+
+    # seal cross-coupling (physics/seal.py)
+    if dy is not None and I[F_SEAL]:
+        sx, sy, smx, smy, p = seal_load(P[P_SEAL_Z], P[P_SEAL_K], P[P_SEAL_KC], y[I[S_X]],
+                                        y[I[S_Y]], y[I[S_A]], y[I[S_B]], vx, vy, va, vb)
+        Fx += sx
+        Fy += sy
+        Ma += smx
+        Mb += smy
+        p_ext += p
 
     # AMBs (hold the rotor until the fault)
     amb = I[F_AMB]

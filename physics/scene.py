@@ -250,6 +250,16 @@ class Sensor:
 
 
 @dataclass(frozen=True)
+class Seal:
+    """Seal cross-coupling at one axial station (physics/seal.py; effects.seal): F = -[[K, k],
+    [-k, K]] r_s on the rotor axis displacement r_s at seal.z."""
+    z: float = param(0.0, "m", -5.0, 5.0, "axial station of the seal (rotor frame)", "A")
+    direct_stiffness: float = param(0.0, "N/m", -1e9, 1e9, "direct stiffness K", "A")
+    cross_stiffness: float = param(2e5, "N/m", -1e9, 1e9,
+                                   "cross-coupled stiffness k (> 0 drives a forward whirl)", "A")
+
+
+@dataclass(frozen=True)
 class Effects:
     """Switches: an effect that is off adds no state and no right-hand-side work (spec §8)."""
     gravity: bool = param(True, "-", doc="gravity on all bodies")
@@ -291,12 +301,15 @@ class Effects:
     semi_active_damper: bool = param(False, "-",
                                      doc="support damping C_s is a controlled state lagging its command"
                                          " (needs housing; adds one state per housing)")
+    seal: bool = param(False, "-",
+                       doc="seal cross-coupling: a direct and cross-coupled stiffness load at"
+                           " seal.z (seal.* parameters; no state)", tag="A")
 
 
 GROUPS: dict[str, type] = {
     "rotor": Rotor, "positions": Positions, "unbalance": Unbalance, "world": World, "amb": Amb,
     "contact": Contact, "stator": Stator, "sleeve": Sleeve, "thermal": Thermal, "bearing": Bearing,
-    "support": Support, "sensor": Sensor,
+    "support": Support, "sensor": Sensor, "seal": Seal,
     "solver": Solver, "effects": Effects,
 }
 
@@ -317,6 +330,7 @@ class Scene:
     bearing: Bearing = field(default_factory=Bearing)
     support: Support = field(default_factory=Support)
     sensor: Sensor = field(default_factory=Sensor)
+    seal: Seal = field(default_factory=Seal)
     solver: Solver = field(default_factory=Solver)
     effects: Effects = field(default_factory=Effects)
 
