@@ -40,7 +40,7 @@ from ..control.controllers import BASELINES, Passive, controller_class, controll
 from ..control.plant import task_flags
 from ..learning.policies import LearnedPolicy, load_shipped, policy_label, shipped_names
 from .rollout import check_actor, monitor_kwargs, run_episodes
-from .score import (BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, DEFAULT_SCORE, bootstrap_scores,
+from .score import (BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, DEFAULT_SCORE, attach_bootstrap,
                     check_score, drop_costs, fmt_or_dash, overall_score, row_cost, summarize,
                     write_json)
 
@@ -554,13 +554,7 @@ def add_uncertainty(entries: list[dict], rows: list[dict], passive: dict, relev:
     pool = designed if designed else ([names.index("passive")] if "passive" in names else [])
     if not pool:
         return
-    ref = max(pool, key=lambda i: entries[i]["score"])
-    b = bootstrap_scores(costs, p_cost, ref)
-    for i, e in enumerate(entries):
-        e.update(score_se=float(b["score_se"][i]), reference=names[ref],
-                 diff_vs_reference=float(b["diff"][i]), diff_se=float(b["diff_se"][i]),
-                 diff_ci95=[float(b["diff_ci_low"][i]), float(b["diff_ci_high"][i])],
-                 drops=int(p_cost.size))
+    attach_bootstrap(entries, costs, p_cost, max(pool, key=lambda i: entries[i]["score"]))
 
 
 def _group_score(mine, costs, p_costs, group):

@@ -86,9 +86,9 @@ def headroom(report: dict, task: str = "full", reference: str | None = None) -> 
         best = np.argmin(cost[idx], axis=0)
         envelope[label] = stack[idx][best, :, np.arange(cost.shape[1])].T   # (terms, drops)
     termwise = stack.min(axis=0)
-    if "relevitation_time" in TERMS and terms[reference][TERMS.index("relevitation_time")].any():
-        termwise[TERMS.index("relevitation_time")] = np.minimum(
-            termwise[TERMS.index("relevitation_time")], floor)
+    t_r = TERMS.index("relevitation_time")
+    if terms[reference][t_r].any():                 # a task that re-levitates
+        termwise[t_r] = np.minimum(termwise[t_r], floor)
     estimates = dict(envelope, **{"term-wise best (optimistic)": termwise})
     columns = {reference: terms[reference]}
     if learned:
@@ -104,9 +104,7 @@ def headroom(report: dict, task: str = "full", reference: str | None = None) -> 
                         diff_vs_reference=float(boot["diff"][i]), diff_se=float(boot["diff_se"][i]),
                         points=dict(zip(TERMS, (100.0 * t.sum(axis=1) / total).tolist()))))
     return dict(task=task, reference=reference, drops=int(p_cost.size), score=report.get("score"),
-                columns=out, estimate_rows=list(estimates),
-                points_of_passive=dict(zip(TERMS, (100.0 * terms["passive"].sum(axis=1)
-                                                   / total).tolist())))
+                columns=out, estimate_rows=list(estimates))
 
 
 def table(result: dict) -> str:

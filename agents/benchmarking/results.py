@@ -75,11 +75,7 @@ def leaderboard_table(entries: list[dict], kind: bool = False, in_out: bool = Tr
         cells = [str(i), f"`{e['controller']}`"] + ([e.get("kind", "")] if kind else [])
         cells.append(_f(e["score"]))
         if se:
-            ci = e.get("diff_ci95") or [None, None]
-            cells += [_f(e.get("score_se")),
-                      "–" if e.get("diff_se") is None else
-                      f"{e['diff_vs_reference']:+.2f} ± {e['diff_se']:.2f} "
-                      f"[{ci[0]:+.2f}, {ci[1]:+.2f}]"]
+            cells += se_cells(e)
         if in_out:
             cells += [_f(e.get("in_distribution_score")), _f(e.get("out_of_distribution_score"))]
         cells += [_f(e["whirl_rate"]), _f(e.get("whirl_rate_where_passive_whirls")),
@@ -87,6 +83,15 @@ def leaderboard_table(entries: list[dict], kind: bool = False, in_out: bool = Tr
                   _f(e.get("relevitation_rate")), _f(e["stator_contact_rate"])]
         lines.append("| " + " | ".join(cells) + " |")
     return lines
+
+
+def se_cells(e: dict) -> list[str]:
+    """The SE of a row's score and its difference to the reference row (± SE, [95 %])."""
+    if e.get("diff_se") is None:
+        return [_f(e.get("score_se")), "–"]
+    lo, hi = e["diff_ci95"]
+    return [_f(e.get("score_se")),
+            f"{e['diff_vs_reference']:+.2f} ± {e['diff_se']:.2f} [{lo:+.2f}, {hi:+.2f}]"]
 
 
 def _tasks(report: dict) -> list[str]:
@@ -212,13 +217,10 @@ def _oracle_header(rows: list[dict]) -> list[str]:
 
 
 def _oracle_se(e: dict, rows: list[dict]) -> str:
+    """The SE and Δ cells of an oracle row, as the leaderboards' (:func:`se_cells`)."""
     if not any(r.get("reference") for r in rows):
         return ""
-    if e.get("score_se") is None:
-        return "– | – | "
-    lo, hi = e["diff_ci"]
-    return (f"{_f(e['score_se'])} | {e['diff_vs_reference']:+.2f} ± {e['diff_se']:.2f} "
-            f"[{lo:+.2f}, {hi:+.2f}] | ")
+    return " | ".join(se_cells(e)) + " | "
 
 
 def oracle_budget_section(report: dict, src: str) -> list[str]:
@@ -234,7 +236,7 @@ def oracle_budget_section(report: dict, src: str) -> list[str]:
            "| Δ ± SE [95 %] | no gain over its start (drops) | wall time |",
            "|---|---:|---:|---:|---|---:|---:|---:|"]
     for r in runs:
-        lo, hi = r["diff_ci"]
+        lo, hi = r["diff_ci95"]
         out.append(f"| {r['population']} × {r['iterations']} | {r['rollouts_per_drop']} | "
                    f"{_f(r['score'])} | {_f(r['score_se'])} | `{r['reference']}` "
                    f"{_f(r['reference_score'])} | {r['diff']:+.2f} ± {r['diff_se']:.2f} "
@@ -268,7 +270,7 @@ def budget_run(report: dict) -> dict:
                 scenarios=s["scenarios"], scenario_seed=s["scenario_seed"],
                 suite=s.get("suite", "nominal"), score=orc["score"], score_se=orc["score_se"],
                 reference=orc["reference"], reference_score=ref["score"],
-                diff=orc["diff_vs_reference"], diff_se=orc["diff_se"], diff_ci=orc["diff_ci"],
+                diff=orc["diff_vs_reference"], diff_se=orc["diff_se"], diff_ci95=orc["diff_ci95"],
                 unchanged=sum(d["J"] >= d["start_J"] for d in searched),
                 wall_time_s=report["wall_time_s"])
 

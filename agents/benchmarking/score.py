@@ -214,6 +214,19 @@ def bootstrap_scores(costs: np.ndarray, passive: np.ndarray, reference: int,
                 diff_ci_low=lo, diff_ci_high=hi)
 
 
+def attach_bootstrap(entries: list[dict], costs, passive, reference: int) -> None:
+    """Add to each entry (the rows of ``costs``, in order) its paired-bootstrap uncertainty
+    against the entry ``reference`` (:func:`bootstrap_scores`): ``score_se``, ``reference``
+    (its name), ``diff_vs_reference``, ``diff_se``, ``diff_ci95`` and ``drops``."""
+    b = bootstrap_scores(costs, passive, reference)
+    name = entries[reference]["controller"]
+    for i, e in enumerate(entries):
+        e.update(score_se=float(b["score_se"][i]), reference=name,
+                 diff_vs_reference=float(b["diff"][i]), diff_se=float(b["diff_se"][i]),
+                 diff_ci95=[float(b["diff_ci_low"][i]), float(b["diff_ci_high"][i])],
+                 drops=int(np.asarray(passive).size))
+
+
 def seed_groups(board: list[dict], learned: dict) -> list[dict]:
     """Learned rows trained with the same algorithm and hyperparameters (the seeds of one
     configuration): mean, standard deviation (over seeds, ddof = 1) and mean − std of their
@@ -226,11 +239,11 @@ def seed_groups(board: list[dict], learned: dict) -> list[dict]:
     for name, pol in learned.items():
         key = json.dumps([pol.algo, pol.env_id, pol.meta.get("hyperparams") or pol.env_kwargs],
                          sort_keys=True, default=str)
-        seed = pol.meta.get("seed")
-        if seed is not None and seed in seeds.setdefault(key, set()):
+        seed, seen = pol.meta.get("seed"), seeds.setdefault(key, set())
+        if seed is not None and seed in seen:
             repeats.setdefault(key, []).append(name)
             continue
-        seeds.setdefault(key, set()).add(seed)
+        seen.add(seed)
         keys.setdefault(key, []).append(name)
     score = {e["controller"]: e["score"] for e in board}
     out = []

@@ -59,7 +59,7 @@ from ..control.controllers import BASELINES, Passive
 from ..control.plant import plant_of
 from ..learning.policies import load_shipped, shipped_names
 from ..benchmarking.rollout import final_kpis, run_episodes
-from ..benchmarking.score import DEFAULT_SCORE, bootstrap_scores, overall_score, row_cost, write_json
+from ..benchmarking.score import DEFAULT_SCORE, attach_bootstrap, overall_score, row_cost, write_json
 
 ENV_ID = TASKS["full"]
 COMMAND = "supervisor"
@@ -416,17 +416,12 @@ def score_rows(per_scenario: list[dict], names: list[str]) -> list[dict]:
 
 def add_bootstrap(summary: list[dict], per_scenario: list[dict], reference: str) -> None:
     """Each summary row gains its paired-bootstrap SE over the drops and its difference to the
-    ``reference`` row with SE and 95 % interval (:func:`agents.benchmarking.score.bootstrap_scores`, the
-    leaderboards' resamples and seed)."""
+    ``reference`` row (:func:`agents.benchmarking.score.attach_bootstrap`, the leaderboards'
+    resamples, seed and fields)."""
     names = [e["controller"] for e in summary]
     costs = np.array([[s["rows"][n]["J"] for s in per_scenario] for n in names])
     passive = np.array([s["rows"]["passive"]["J"] for s in per_scenario])
-    b = bootstrap_scores(costs, passive, names.index(reference))
-    for i, e in enumerate(summary):
-        e.update(score_se=float(b["score_se"][i]), diff_vs_reference=float(b["diff"][i]),
-                 diff_se=float(b["diff_se"][i]), diff_ci=[float(b["diff_ci_low"][i]),
-                                                          float(b["diff_ci_high"][i])],
-                 reference=reference)
+    attach_bootstrap(summary, costs, passive, names.index(reference))
 
 
 def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iterations: int = 10,

@@ -87,7 +87,7 @@ def test_every_oracle_row_has_its_bootstrap_se_against_the_best_designed_row(tmp
     assert rows["oracle"]["score_se"] == pytest.approx(b["score_se"][i]) and b["score_se"][i] > 0
     assert rows["oracle"]["diff_vs_reference"] == pytest.approx(rows["oracle"]["score"]
                                                                 - rows[ref]["score"])
-    lo, hi = rows["oracle"]["diff_ci"]
+    lo, hi = rows["oracle"]["diff_ci95"]
     assert lo <= rows["oracle"]["diff_vs_reference"] <= hi
     run = budget_run(rep)
     assert run["rollouts_per_drop"] == 5 and run["scenarios"] == 3
