@@ -12,7 +12,7 @@ from .model import (I_PLANES, J_HX, J_SX, N_PLANE_IDX, P_G, P_HALF_PLAY,
                     P_KLIN, P_KS, P_KTOT, P_MH, P_MS, P_NB, P_UB_PHASE, RB_LINEAR, RB_SM, F_RB, F_AMB,
                     AMB_LINEAR, S_PHI, S_VX, S_X, S_W, Model, AMB_ACTUATOR, AMB_AXES, I_AMB_INT,
                     I_AMB_FILT, I_AMB_COIL, P_AMB_IFF1, I_CS, I_THERM, I_SENS, P_SENS_TAU,
-                    P_Z_AMB1)
+                    P_Z_AMB1, A_STF, FX_ROW, I_FX, N_AUX, P_FX_SHAPE, P_FX_W2, ST_AMB1, rhs)
 from .rotor import axis_at
 from .sensor import STATES_PER_PLANE, pade_response, steady_states
 from .amb import actuator_constants, pid_dynamic_stiffness, pid_steady_states
@@ -62,6 +62,8 @@ def levitated_state(model: Model) -> np.ndarray:
         y[I[I_CS]] = y[I[I_CS] + 1] = s.support.damping
     if I[I_THERM] >= 0:                 # sleeve temperatures (effects.thermal)
         y[I[I_THERM]] = y[I[I_THERM] + 1] = s.thermal.initial_rise
+    if model.elastic_modes:
+        _elastic_sag(model, y)
     uy = sleeve_rest_offset(P, I) if I[F_RB] in (RB_SM, RB_LINEAR) else 0.0
     sleeve_mass = P[P_MS] if I[I_PLANES + J_SX] >= 0 else 0.0
     for k in range(2):
@@ -73,6 +75,26 @@ def levitated_state(model: Model) -> np.ndarray:
         if I[base + J_SX] >= 0:
             y[I[base + J_SX] + 1] = hy + uy
     return y
+
+
+def _elastic_sag(model: Model, y: np.ndarray, iterations: int = 4) -> None:
+    """A flexible rotor's static elastic deflection under the AMB forces at t = 0: each modal
+    coordinate is its share of the AMB station forces over omega^2 (gravity does no work on the
+    elastic modes, physics/flexible/floating.py); the AMB forces follow the deflection, hence a
+    few fixed-point passes (the AMBs are far softer than the shaft)."""
+    P, I, n = model.P, model.I, model.elastic_modes
+    i0 = int(I[I_FX])
+    w2 = P[P_FX_W2:P_FX_W2 + n]
+    aux, dy = np.zeros(N_AUX), np.zeros(model.n_state)
+    U = model.controls(True)
+    for _ in range(iterations):
+        rhs(0.0, y, P, I, U, dy, aux)
+        for a in range(2):                       # x, then y plane
+            q = np.zeros(n)
+            for k in range(2):
+                s = ST_AMB1 + k
+                q += P[P_FX_SHAPE + s * FX_ROW:P_FX_SHAPE + s * FX_ROW + n] * aux[A_STF + 2 * s + a]
+            y[i0 + a * n:i0 + (a + 1) * n] = q / w2
 
 
 def _amb_support(model: Model, omega: float) -> tuple[float, float]:

@@ -38,7 +38,8 @@ from .layout import Layout, StateSizes
 from .rotor import axis_at, rotor_energy, tilt_accelerations, unbalance_load
 from .scene import Scene
 from . import sensor as sensor_mod
-from . import seal
+from . import flexible_rotor, seal
+from .flexible_rotor import elastic_motion, elastic_rates, damping_power, tilt_coupling, elastic_energy
 from .seal import seal_load
 from .stator import mount_energy, mount_power, mount_rates, stator_force, stator_potential
 from .support import (body_energy, damper_rate, housing_rates, spin_energy, spring_energy,
@@ -72,7 +73,7 @@ class EnergyAudit:
 
 #: the registered effects, in the order their states are laid out (adding an effect: one line)
 EFFECTS = (rotor, contact, ball_bearing, amb_mod, support, EnergyAudit, thermal, stator, sensor,
-           seal)
+           seal, flexible_rotor)
 #: the packed arrays' named slots, from the effects' declarations
 LAYOUT = Layout.build(EFFECTS)
 _P, _I, _J, _U, _A, _AP = (LAYOUT.params, LAYOUT.index, LAYOUT.plane, LAYOUT.controls,
@@ -82,8 +83,16 @@ _P, _I, _J, _U, _A, _AP = (LAYOUT.params, LAYOUT.index, LAYOUT.plane, LAYOUT.con
 P_M, P_IP, P_ID, P_G, P_RJ = _P.indices("rotor.mass", "rotor.polar_inertia",
                                         "rotor.diametral_inertia", "world.gravity",
                                         "rotor.journal_radius")
-P_Z_RB1, P_Z_RB2, P_Z_AMB1, P_Z_AMB2 = _P.indices("rb1.z", "rb2.z", "amb1.z", "amb2.z")
-P_MUE, P_UB_PHASE, P_Z_UB = _P.indices("unbalance.me", "unbalance.phase", "unbalance.z")
+# the force stations' block: station s is at P[P_Z_RB1 + s] (ST_* below)
+P_Z_RB1, P_Z_RB2, P_Z_AMB1, P_Z_AMB2, P_Z_UB = _P.indices("rb1.z", "rb2.z", "amb1.z", "amb2.z",
+                                                         "unbalance.z")
+ST_RB1, ST_AMB1, ST_UB = P_Z_RB1 - P_Z_RB1, P_Z_AMB1 - P_Z_RB1, P_Z_UB - P_Z_RB1
+P_MUE, P_UB_PHASE = _P.indices("unbalance.me", "unbalance.phase")
+# flexible rotor (physics/flexible_rotor.py): omega^2, 2 zeta omega, station shapes (MAX_MODES
+# per station), tilt-to-mode and mode-to-mode gyroscopic couplings
+P_FX_W2, P_FX_DAMP, P_FX_SHAPE, P_FX_G1, P_FX_G = _P.indices(
+    "flex.omega2", "flex.damping", "flex.shape", "flex.gyro_rigid", "flex.gyro")
+FX_ROW = flexible_rotor.MAX_MODES
 P_CLR, P_RS, P_KC, P_EC, P_CMAX, P_DC, P_MU, P_WL, P_VL, P_HL_A, P_HL_CHI = _P.indices(
     "contact.clearance", "sleeve.radius", "contact.stiffness", "contact.exponent",
     "contact.damping", "contact.damping_depth", "contact.friction", "contact.threshold_speed",
@@ -130,6 +139,8 @@ F_STATOR, F_LAW, F_SENSOR, F_SEAL = _I.indices("flag.stator", "flag.law", "flag.
 S_X, S_Y, S_A, S_B, S_VX, S_VY, S_VA, S_VB, S_W, S_PHI = _I.indices(
     *("state." + n for n in rotor.STATE_NAMES + ("phi",)))
 S_EDISS, S_WEXT = _I.indices("state.E_dissipated", "state.W_external")
+# elastic modes of a flexible rotor: their number (0: rigid) and the first modal state
+I_FX_N, I_FX = _I.indices("flex.modes", "state.elastic")
 # per retainer plane k, the block I[I_PLANES + k*N_PLANE_IDX + j]:
 I_PLANES = _I["planes"]
 J_SX, J_SY, J_SVX, J_SVY, J_TH, J_WS = _J.indices(*ball_bearing.PLANE_STATES)
@@ -177,6 +188,8 @@ N_AUX_PLANE = _AP.size
 # and its mount's dashpot (effects.stator_mount) at A_ST_PMOUNT + k
 A_STATOR, A_ST_PDAMP, A_ST_PFRIC, A_ST_PMOUNT = _A.indices(
     "stator.normal_force", "stator.damping_power", "stator.friction_power", "stator.mount_power")
+# the flexible rotor's station forces (x, y per station) and its modal damping power
+A_STF, A_FX_PDAMP = _A.indices("rotor.station_force", "rotor.damping_power")
 N_AUX = _A.size
 
 PLANES = ("RB1", "RB2")
@@ -246,6 +259,11 @@ class Model:
         return self.flag("retainer_bearing") == RB_SM
 
     @property
+    def elastic_modes(self) -> int:
+        """Elastic modes per bending plane of a flexible rotor (0: rigid)."""
+        return int(self.I[I_FX_N])
+
+    @property
     def has_ambs(self) -> bool:
         """The scene has AMBs (``effects.amb`` is not ``none``)."""
         return self.flag("amb") != AMB_NONE
@@ -265,7 +283,8 @@ class Model:
 
     def sensor_positions(self, y: np.ndarray) -> np.ndarray:
         """(4,) x1, y1, x2, y2 [m]: the rotor axis at the AMB (sensor) planes in state ``y``."""
-        return np.array([v for z in self.amb_z() for v in axis_motion(y, self.I, z)[:2]])
+        return np.array([v for k in range(2)
+                         for v in axis_motion(y, self.P, self.I, ST_AMB1 + k)[:2]])
 
     def rotor_axis_indices(self) -> np.ndarray:
         """State indices of the rotor's centre and tilt: x, y, a, b."""
@@ -320,10 +339,16 @@ def build_model(scene: Scene) -> Model:
 
 # ------------------------------------------------------------------------------- kernels --
 @njit
-def axis_motion(y, I, z):
-    """Rotor axis position and velocity (px, py, vx, vy) at axial station z."""
+def axis_motion(y, P, I, s):
+    """Rotor axis position and velocity (px, py, vx, vy) at force station s (``ST_RB1 + k``,
+    ``ST_AMB1 + k``, ``ST_UB``; axial station P[P_Z_RB1 + s]): the rigid body's, plus the elastic
+    modes' of a flexible rotor (physics/flexible_rotor.py)."""
+    z = P[P_Z_RB1 + s]
     px, py = axis_at(z, y[I[S_X]], y[I[S_Y]], y[I[S_A]], y[I[S_B]])
     vx, vy = axis_at(z, y[I[S_VX]], y[I[S_VY]], y[I[S_VA]], y[I[S_VB]])
+    if I[I_FX_N] > 0:
+        ex, ey, evx, evy = elastic_motion(y, P, I[I_FX], I[I_FX_N], P_FX_SHAPE + s * FX_ROW)
+        return px + ex, py + ey, vx + evx, vy + evy
     return px, py, vx, vy
 
 
@@ -406,6 +431,9 @@ def rhs(t, y, P, I, U, dy, aux):
     T = 0.0             # spin torque
     p_diss = 0.0        # power dissipated by dampers, friction and drag
     p_ext = 0.0         # power of external and non-potential forces (unbalance, AMB, film, cage)
+    n_fx = I[I_FX_N]    # elastic modes of a flexible rotor (0: rigid)
+    for j in range(A_STF, A_FX_PDAMP + 1):
+        aux[j] = 0.0
 
     # unbalance (physics/rotor.py)
     if dy is not None and I[F_UNB]:
@@ -418,6 +446,11 @@ def rhs(t, y, P, I, U, dy, aux):
         Mb += my
         p_ext += p
         dy[iphi] = W
+        if n_fx > 0:                             # the unbalance station's elastic motion
+            aux[A_STF + 2 * ST_UB] += ux
+            aux[A_STF + 2 * ST_UB + 1] += uy
+            _, _, evx, evy = elastic_motion(y, P, I[I_FX], n_fx, P_FX_SHAPE + ST_UB * FX_ROW)
+            p_ext += ux * evx + uy * evy
 
     # seal cross-coupling (physics/seal.py)
     if dy is not None and I[F_SEAL]:
@@ -439,7 +472,7 @@ def rhs(t, y, P, I, U, dy, aux):
         pulls = U[U_AMB_POWER] > 0.0 or U[U_AMB_DIRECT] > 0.0
         for k in range(2):
             z = P[P_Z_AMB1 + k]
-            dx, dyy, ddx, ddy = axis_motion(y, I, z)
+            dx, dyy, ddx, ddy = axis_motion(y, P, I, ST_AMB1 + k)
             # the controller's view (physics/sensor.py): the true motion without sensing
             sx, sy, svx, svy = dx, dyy, ddx, ddy
             if I[F_SENSOR]:
@@ -482,11 +515,14 @@ def rhs(t, y, P, I, U, dy, aux):
             Ma += z * fx
             Mb += z * fy
             p_ext += fx * ddx + fy * ddy
+            if n_fx > 0:
+                aux[A_STF + 2 * (ST_AMB1 + k)] += fx
+                aux[A_STF + 2 * (ST_AMB1 + k) + 1] += fy
     i_sens = I[I_SENS]
     if dy is not None and i_sens >= 0:           # sensor delay states (physics/sensor.py, S1)
         tau = P[P_SENS_TAU]
         for k in range(2):
-            dx, dyy, _, _ = axis_motion(y, I, P[P_Z_AMB1 + k])
+            dx, dyy, _, _ = axis_motion(y, P, I, ST_AMB1 + k)
             sensor_mod.delay_rates(dx, dyy, y, i_sens + sensor_mod.STATES_PER_PLANE * k, tau, dy)
 
     # retainer planes: rotor-sleeve contact, sleeve on ball bearing, housing
@@ -500,7 +536,7 @@ def rhs(t, y, P, I, U, dy, aux):
             continue
         base = I_PLANES + k * N_PLANE_IDX
         z = P[P_Z_RB1 + k]
-        px, py, pvx, pvy = axis_motion(y, I, z)
+        px, py, pvx, pvy = axis_motion(y, P, I, ST_RB1 + k)
         i_sx = I[base + J_SX]
         i_hx = I[base + J_HX]
         hx, hy, hvx, hvy = housing_motion(y, I, k)
@@ -572,6 +608,9 @@ def rhs(t, y, P, I, U, dy, aux):
         Ma -= z * cfx
         Mb -= z * cfy
         T -= P[P_RJ] * f_mu
+        if n_fx > 0:
+            aux[A_STF + 2 * (ST_RB1 + k)] -= cfx
+            aux[A_STF + 2 * (ST_RB1 + k) + 1] -= cfy
 
         # --- retainer bearing between sleeve (inner ring) and housing (outer ring) ---
         bfx = 0.0                                # bearing force on the sleeve
@@ -679,7 +718,7 @@ def rhs(t, y, P, I, U, dy, aux):
     if I[F_STATOR]:                              # rotor-stator contact at the AMB planes
         for k in range(2):
             z = P[P_Z_AMB1 + k]
-            px, py, pvx, pvy = axis_motion(y, I, z)
+            px, py, pvx, pvy = axis_motion(y, P, I, ST_AMB1 + k)
             qx, qy, qvx, qvy = stator_motion(y, I, k)
             sfx, sfy, torque, f_n, _, p_sd, p_sf = stator_force(
                 px - qx, py - qy, pvx - qvx, pvy - qvy, W, P[P_ST_GAP], P[P_ST_K], P[P_ST_C],
@@ -698,14 +737,21 @@ def rhs(t, y, P, I, U, dy, aux):
             Ma += z * sfx
             Mb += z * sfy
             T += torque
+            if n_fx > 0:
+                aux[A_STF + 2 * (ST_AMB1 + k)] += sfx
+                aux[A_STF + 2 * (ST_AMB1 + k) + 1] += sfy
             p_diss += p_sd + p_sf
             aux[A_STATOR + k] = f_n
             aux[A_ST_PDAMP + k] = p_sd
             aux[A_ST_PFRIC + k] = p_sf
             aux[A_ST_PMOUNT + k] = p_mount
     else:
-        for j in range(A_STATOR, N_AUX):
+        for j in range(A_STATOR, A_STF):
             aux[j] = 0.0
+    if n_fx > 0:                                 # structural damping of the elastic modes
+        p_fd = damping_power(y, P, I[I_FX], n_fx, P_FX_DAMP)
+        aux[A_FX_PDAMP] = p_fd
+        p_diss += p_fd
 
     if dy is None:
         return
@@ -716,6 +762,14 @@ def rhs(t, y, P, I, U, dy, aux):
     dy[I[S_B]] = vb
     dy[I[S_VX]] = Fx / m
     dy[I[S_VY]] = Fy / m
+    if n_fx > 0:                                 # elastic modes (physics/flexible_rotor.py)
+        spin = W if I[F_GYRO] else 0.0
+        if spin != 0.0:
+            cx, cy = tilt_coupling(y, P, I[I_FX], n_fx, P_FX_G1)
+            Ma -= spin * cy
+            Mb += spin * cx
+        elastic_rates(y, P, I[I_FX], n_fx, aux, A_STF, P_FX_W2, P_FX_DAMP, P_FX_SHAPE, P_FX_G1,
+                      P_FX_G, spin, va, vb, dy)
     aa, ab = tilt_accelerations(Ma, Mb, va, vb, W, P[P_ID], P[P_IP], I[F_GYRO])
     dy[I[S_VA]] = aa
     dy[I[S_VB]] = ab
@@ -736,8 +790,8 @@ def twin_planes(y, P, I):
     """The second retainer plane's inputs to :func:`rhs` (rotor axis, sleeve and housing motion,
     sleeve speed, cage angle, sleeve temperature) are the first one's bit for bit, so are its
     diagnostics: what a symmetric rotor on symmetric supports keeps through a drop."""
-    px, py, vx, vy = axis_motion(y, I, P[P_Z_RB1])
-    qx, qy, wx, wy = axis_motion(y, I, P[P_Z_RB2])
+    px, py, vx, vy = axis_motion(y, P, I, ST_RB1)
+    qx, qy, wx, wy = axis_motion(y, P, I, ST_RB1 + 1)
     if not (_same(px, qx) and _same(py, qy) and _same(vx, wx) and _same(vy, wy)):
         return False
     for j in range(N_PLANE_IDX):                 # the plane's bodies: every state or none
@@ -775,7 +829,7 @@ def amb_currents(t, y, P, I, U, out):
             out[j] = y[I[I_AMB_COIL] + j]
             continue
         k = j // 2
-        dx, dyy, ddx, ddy = axis_motion(y, I, P[P_Z_AMB1 + k])
+        dx, dyy, ddx, ddy = axis_motion(y, P, I, ST_AMB1 + k)
         if I[F_SENSOR]:
             dx, dyy, _, _ = sensed_motion(y, P, I, U, k, dx, dyy, ddx, ddy)
         ox, oy = orbit_offset(dx, dyy, U[U_REF_OFF + 2 * k], U[U_REF_OFF + 2 * k + 1], y[I[S_W]],
@@ -798,10 +852,12 @@ def mechanical_energy(y, P, I):
     vx, vy, va, vb = y[I[S_VX]], y[I[S_VY]], y[I[S_VA]], y[I[S_VB]]
     W = y[I[S_W]]
     E = rotor_energy(m, P[P_ID], P[P_IP], vx, vy, va, vb, W)
+    if I[I_FX_N] > 0:
+        E += elastic_energy(y, P, I[I_FX], I[I_FX_N], P_FX_W2)
     E += m * g * yy
     for k in range(2):
         base = I_PLANES + k * N_PLANE_IDX
-        px, py, _, _ = axis_motion(y, I, P[P_Z_RB1 + k])
+        px, py, _, _ = axis_motion(y, P, I, ST_RB1 + k)
         hx, hy, hvx, hvy = housing_motion(y, I, k)
         sx, sy, svx, svy = sleeve_motion(y, I, k)
         if I[base + J_HX] >= 0:
@@ -819,7 +875,7 @@ def mechanical_energy(y, P, I):
         else:
             E += line_potential(er - P[P_CLR], P[P_HL_A], P[P_CLR])
         if I[F_STATOR]:
-            ax, ay, _, _ = axis_motion(y, I, P[P_Z_AMB1 + k])
+            ax, ay, _, _ = axis_motion(y, P, I, ST_AMB1 + k)
             qx, qy, qvx, qvy = stator_motion(y, I, k)
             E += stator_potential(ax - qx, ay - qy, P[P_ST_GAP], P[P_ST_K])
             E += mount_energy(qx, qy, qvx, qvy, P[P_STM_K], P[P_STM_M])

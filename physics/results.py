@@ -6,9 +6,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import thermal
-from .model import (A_DELTA, A_DRAG, A_FMU, A_FR, A_LOAD, A_PFRIC, A_QMAX, A_STATOR, A_WS, I_PLANES,
+from .model import (FX_ROW, I_FX, P_FX_SHAPE, ST_AMB1, ST_RB1, A_DELTA, A_DRAG, A_FMU, A_FR, A_LOAD, A_PFRIC, A_QMAX, A_STATOR, A_WS, I_PLANES,
                     I_STM, I_THERM, J_HX, J_SX, N_AUX_PLANE, N_PLANE_IDX, P_MU, P_TH_C, P_TH_RMAX, P_TH_RMIN,
-                    P_TH_SLOPE, P_Z_AMB1, P_Z_RB1, PLANES, S_EDISS, S_W, S_WEXT, S_X, Model, energies)
+                    P_TH_SLOPE, P_Z_RB1, PLANES, S_EDISS, S_W, S_WEXT, S_X, Model, energies)
 
 AMB_PLANES = ("AMB1", "AMB2")
 
@@ -77,20 +77,31 @@ class Result:
         except ValueError:
             raise ValueError(f"plane must be one of {planes}, got {plane!r}") from None
 
-    def _axis(self, z: float, offset: int = 0) -> np.ndarray:
-        """Rotor axis (x + z a, y + z b) at axial station z; offset 4: its velocity. Computed
-        once per station (the metrics ask several times), read-only."""
-        i = self.model.I[S_X] + offset
-        return self._memo((z, offset), lambda: _axis_series(self.Y, i, z))
+    def _axis(self, s: int, offset: int = 0) -> np.ndarray:
+        """Rotor axis (x + z a, y + z b) at force station s (``physics.model.ST_*``), plus a
+        flexible rotor's elastic modes there; offset 4: its velocity. Computed once per station
+        (the metrics ask several times), read-only."""
+        m = self.model
+
+        def compute():
+            out = _axis_series(self.Y, m.I[S_X] + offset, m.P[P_Z_RB1 + s])
+            n = m.elastic_modes
+            if n:
+                i0 = m.I[I_FX] + (2 * n if offset else 0)
+                shape = m.P[P_FX_SHAPE + s * FX_ROW:P_FX_SHAPE + s * FX_ROW + n]
+                out[:, 0] += self.Y[:, i0:i0 + n] @ shape
+                out[:, 1] += self.Y[:, i0 + n:i0 + 2 * n] @ shape
+            return out
+        return self._memo((s, offset), compute)
 
     def orbit(self, plane: str) -> np.ndarray:
         """Rotor axis position (x, y) at a retainer plane, relative to the nominal centre [m]."""
-        return self._axis(self.model.P[P_Z_RB1 + self._plane(plane)])
+        return self._axis(ST_RB1 + self._plane(plane))
 
     def amb_orbit(self, plane: str) -> np.ndarray:
         """Rotor axis position (x, y) at AMB plane ``AMB1``/``AMB2`` [m], relative to the stator
         centre: what the environments check against the stator (``amb.air_gap``)."""
-        return self._axis(self.model.P[P_Z_AMB1 + self._plane(plane, AMB_PLANES)])
+        return self._axis(ST_AMB1 + self._plane(plane, AMB_PLANES))
 
     def stator(self, plane: str) -> np.ndarray:
         """Stator centre (x, y) at AMB plane ``AMB1``/``AMB2`` on its mount [m] (zeros when the
@@ -146,7 +157,7 @@ class Result:
         return self._derived[key]
 
     def orbit_velocity(self, plane: str) -> np.ndarray:
-        return self._axis(self.model.P[P_Z_RB1 + self._plane(plane)], offset=4)
+        return self._axis(ST_RB1 + self._plane(plane), offset=4)
 
     def _body(self, plane: str, j: int) -> np.ndarray:
         i = self.model.I[I_PLANES + self._plane(plane) * N_PLANE_IDX + j]

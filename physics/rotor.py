@@ -23,9 +23,9 @@ def declare(layout) -> None:
     for name in ("rotor.mass", "rotor.polar_inertia", "rotor.diametral_inertia", "world.gravity",
                  "rotor.journal_radius"):
         p.add(name)
-    p.block("rb1.z", "rb2.z")
-    p.block("amb1.z", "amb2.z")
-    for name in ("unbalance.me", "unbalance.phase", "unbalance.z"):
+    # the force stations, one block (physics/flexible/floating.py STATIONS order)
+    p.block("rb1.z", "rb2.z", "amb1.z", "amb2.z", "unbalance.z")
+    for name in ("unbalance.me", "unbalance.phase"):
         p.add(name)
     i = layout.index
     for name in ("gravity", "unbalance", "gyroscopic"):

@@ -42,6 +42,10 @@ class Rotor:
     diametral_inertia: float = param(2.82, "kg m^2", 1e-6, 1e5, "diametral moment of inertia I_d")
     speed_rpm: float = param(10000.0, "rpm", 0.0, 60000.0, "initial spin speed")
     journal_radius: float = param(0.030, "m", 1e-3, 1.0, "journal radius r at the retainer planes", "D")
+    model: str = param("rigid", "-", doc="rigid body (the paper's model), or flexible: the rigid"
+                       " body plus the elastic modes of the shaft flexible.shaft (flexible.*);"
+                       " a flexible rotor's mass, I_d and I_p must equal its shaft's",
+                       tag="A", choices=("rigid", "flexible"))
 
 
 @dataclass(frozen=True)
@@ -260,6 +264,27 @@ class Seal:
 
 
 @dataclass(frozen=True)
+class Flexible:
+    """The flexible rotor (rotor.model = "flexible"; physics/flexible_rotor.py, docs/flexible.md):
+    Timoshenko shaft elements reduced to the rigid-body motion plus elastic modes. The force
+    stations are positions.* and unbalance.z, in the centre-of-mass frame."""
+    shaft: str = param("paper", "-", doc="the shaft and disks: 'paper' (the paper rotor's m, I_d,"
+                       " I_p on a stiff shaft, first bending 740 Hz), 'machine' (the same on a"
+                       " slender shaft, first bending 399 Hz) or the path of a TOML rotor file"
+                       " (rotordrop's, or ROSS's Rotor.save)", tag="A")
+    modulus_scale: float = param(1.0, "-", 1e-3, 1e6, "factor on E and G_s of every shaft"
+                                 " section (1000: the stiff limit)", "A")
+    mode_cutoff_hz: float = param(2000.0, "Hz", 0.0, 1e6, "free-free bending modes below this"
+                                  " frequency are kept", "A")
+    static_modes: bool = param(True, "-", doc="add one static correction (inertia-relief"
+                               " attachment) mode per force station, so that the local"
+                               " compliance under a contact force is exact", tag="A")
+    damping_ratio: float = param(0.005, "-", 0.0, 1.0, "modal damping ratio zeta of every"
+                                 " elastic mode (assumed; steel rotors 0.001-0.01)", "A")
+    element_length: float = param(0.025, "m", 1e-4, 10.0, "longest shaft finite element", "A")
+
+
+@dataclass(frozen=True)
 class Effects:
     """Switches: an effect that is off adds no state and no right-hand-side work (spec §8)."""
     gravity: bool = param(True, "-", doc="gravity on all bodies")
@@ -309,7 +334,7 @@ class Effects:
 GROUPS: dict[str, type] = {
     "rotor": Rotor, "positions": Positions, "unbalance": Unbalance, "world": World, "amb": Amb,
     "contact": Contact, "stator": Stator, "sleeve": Sleeve, "thermal": Thermal, "bearing": Bearing,
-    "support": Support, "sensor": Sensor, "seal": Seal,
+    "support": Support, "sensor": Sensor, "seal": Seal, "flexible": Flexible,
     "solver": Solver, "effects": Effects,
 }
 
@@ -331,6 +356,7 @@ class Scene:
     support: Support = field(default_factory=Support)
     sensor: Sensor = field(default_factory=Sensor)
     seal: Seal = field(default_factory=Seal)
+    flexible: Flexible = field(default_factory=Flexible)
     solver: Solver = field(default_factory=Solver)
     effects: Effects = field(default_factory=Effects)
 
@@ -481,7 +507,9 @@ def parameter_table() -> list[dict[str, Any]]:
     rows = []
     for key, value, meta in _leaves(Scene()):
         allowed = ("|".join(meta["choices"]) if meta["choices"] else
-                   "true|false" if isinstance(value, bool) else f"[{meta['lo']:g}, {meta['hi']:g}]")
+                   "true|false" if isinstance(value, bool) else
+                   "name|path.toml" if isinstance(value, str) else
+                   f"[{meta['lo']:g}, {meta['hi']:g}]")
         rows.append(dict(key=key, default=value, unit=meta["unit"], allowed=allowed,
                          tag=meta["tag"], doc=meta["doc"]))
     return rows
@@ -583,6 +611,8 @@ def _check_consistency(s: Scene) -> None:
         raise SceneError("solver.t_end / solver.dt must be <= 1e9 steps for the fixed-step method")
     if s.effects.amb == "actuator":
         _check_actuator(s)
+    if s.rotor.model == "flexible":
+        _check_flexible(s)
     if s.effects.thermal:
         _check_thermal(s)
     if s.effects.semi_active_damper:
@@ -597,6 +627,28 @@ def _check_consistency(s: Scene) -> None:
             raise SceneError(f"support.damping = {sp.damping:g} must lie in [support.damping_min,"
                              f" support.damping_max] = [{sp.damping_min:g}, {sp.damping_max:g}] N s/m"
                              " with effects.semi_active_damper")
+
+
+def _check_flexible(s: Scene) -> None:
+    """The flexible rotor's shaft exists and carries the scene's mass properties; the stations
+    lie on it; the reduction is possible (physics/flexible/shafts.py names what is wrong)."""
+    from .flexible.shafts import ShaftError, drop_rotor, mass_properties
+    if s.effects.seal:
+        raise SceneError("effects.seal = true: allowed only with rotor.model = 'rigid' (the seal"
+                         " load has no station on the flexible rotor yet)")
+    try:
+        props = mass_properties(s)
+        for key, value in props.items():
+            given = s.get(key)
+            if not math.isclose(given, value, rel_tol=1e-6):
+                raise SceneError(
+                    f"{key} = {given:g}: allowed {value:.6g} with rotor.model = 'flexible' (the"
+                    f" shaft {s.flexible.shaft!r} has m = {props['rotor.mass']:.6g} kg, I_d ="
+                    f" {props['rotor.diametral_inertia']:.6g} kg m^2, I_p ="
+                    f" {props['rotor.polar_inertia']:.6g} kg m^2; set these rotor.* keys)")
+        drop_rotor(s)
+    except ShaftError as exc:
+        raise SceneError(str(exc)) from None
 
 
 def _check_bearing_geometry(s: Scene) -> None:

@@ -25,7 +25,7 @@ from physics.jit import njit, njit_parallel
 from physics.integrate import integrate_segment
 from physics.layout import Slots
 from physics.model import (A_DELTA, A_FR, A_QMAX, A_WS, F_SENSOR, I_AMB_FILT, I_AMB_INT, I_CS,
-                           N_AUX_PLANE, P_CLR, P_Z_AMB1, P_Z_RB1, S_W, U_AMB_DIRECT, U_AMB_GAIN,
+                           N_AUX_PLANE, P_CLR, ST_AMB1, ST_RB1, S_W, U_AMB_DIRECT, U_AMB_GAIN,
                            U_AMB_POWER, U_CS1, U_ICMD, U_REF0, U_REF_OFF, U_T_ON, amb_currents,
                            axis_motion, delayed_motion, rhs, sensed_motion, sleeve_motion,
                            stator_motion)
@@ -137,7 +137,7 @@ def _switch_on(t, y, P, I, U):
     U[U_AMB_DIRECT] = 0.0
     U[U_T_ON] = t
     for j in range(4):
-        px, py, vx, vy = axis_motion(y, I, P[P_Z_AMB1 + j // 2])
+        px, py, vx, vy = axis_motion(y, P, I, ST_AMB1 + j // 2)
         if I[F_SENSOR]:
             px, py, _, _ = sensed_motion(y, P, I, U, j // 2, px, py, vx, vy)
         U[U_REF0 + j] = px if j % 2 == 0 else py
@@ -197,7 +197,7 @@ def orbit_frame(y, P, I, k):
     [rad/s] (< 0: the orbit turns backwards; 0 below ``SUP_MIN_RADIUS`` x clearance, where the
     direction of the orbit is noise). With ``sensor.delay`` of the delayed motion; the noise is
     added by :mod:`rotordrop_env.sensors`, which recomputes these from the noisy values."""
-    px, py, vx, vy = axis_motion(y, I, P[P_Z_AMB1 + k])
+    px, py, vx, vy = axis_motion(y, P, I, ST_AMB1 + k)
     px, py, vx, vy = delayed_motion(y, P, I, k, px, py, vx, vy)
     spin = 1.0 if y[I[S_W]] >= 0.0 else -1.0
     r = math.sqrt(px * px + py * py)
@@ -226,7 +226,7 @@ def observe(t, y, P, I, U, C, M, aux, cur, scale, obs):
             n += 1
     else:
         for k in range(2):                      # as the sensors report it (delayed)
-            px, py, vx, vy = axis_motion(y, I, P[P_Z_AMB1 + k])
+            px, py, vx, vy = axis_motion(y, P, I, ST_AMB1 + k)
             px, py, vx, vy = delayed_motion(y, P, I, k, px, py, vx, vy)
             obs[n], obs[n + 1], obs[n + 2], obs[n + 3] = px, py, vx, vy
             n += 4
@@ -320,7 +320,7 @@ def step_one(a, y, P, I, U, atol, work, t_sub, Y_sub, aux, cur, C, M, scale, obs
             fr = aux[k * N_AUX_PLANE + A_FR]
             f_step = max(f_step, fr)
             q_step = max(q_step, aux[k * N_AUX_PLANE + A_QMAX])
-            px, py, pvx, pvy = axis_motion(ys, I, P[P_Z_RB1 + k])
+            px, py, pvx, pvy = axis_motion(ys, P, I, ST_RB1 + k)
             sx, sy, svx, svy = sleeve_motion(ys, I, k)
             r_abs = math.sqrt(px * px + py * py)
             disp_step = max(disp_step, r_abs)
@@ -333,7 +333,7 @@ def step_one(a, y, P, I, U, atol, work, t_sub, Y_sub, aux, cur, C, M, scale, obs
                 back += 0.5 * db
             if fr > 0.0 or r_abs >= C[C_RELEV_RADIUS]:
                 ok = False
-            ax, ay, _, _ = axis_motion(ys, I, P[P_Z_AMB1 + k])
+            ax, ay, _, _ = axis_motion(ys, P, I, ST_AMB1 + k)
             a2 = ax * ax + ay * ay
             if a2 >= C[C_GAP] * C[C_GAP]:
                 stator = True

@@ -202,7 +202,10 @@ def mesh(rotor: FlexibleRotor) -> tuple[np.ndarray, list[int]]:
     z_nodes, owner = [ends[0]], []
     for k, s in enumerate(rotor.sections):
         a, b = ends[k], ends[k + 1]
-        cuts = sorted({b, *[z for z in extra if a + _ZTOL < z < b - _ZTOL]})
+        cuts = [b]
+        for z in sorted((z for z in extra if a + _ZTOL < z < b - _ZTOL), reverse=True):
+            if cuts[0] - z > _ZTOL:              # stations closer than _ZTOL share a node
+                cuts.insert(0, z)
         prev = a
         for c in cuts:
             n = 1 if rotor.max_element_length is None else max(

@@ -10,7 +10,7 @@ from physics import SceneError, build_model, compute_metrics, load_scene, simula
 from agents.cli import main
 from physics.integrate import NOT_FINITE, STEP_COLLAPSE, TOO_MANY_STEPS
 from physics.metrics import PEAK_TOLERANCE, SAMPLES_PER_PERIOD, contact_period
-from physics.model import axis_motion
+from physics.model import ST_AMB1, axis_motion
 from physics.scene import param_meta
 from physics.simulate import explain_status
 
@@ -101,7 +101,7 @@ def test_stator_contact_at_the_amb_planes(whirl_run):
         x = whirl_run.Y[:, i("x")] + z * whirl_run.Y[:, i("a")]     # rigid axis at the AMB plane
         y = whirl_run.Y[:, i("y")] + z * whirl_run.Y[:, i("b")]
         r = np.hypot(x, y).max()
-        kernel = [axis_motion(s, whirl_run.model.I, z)[:2] for s in whirl_run.Y]
+        kernel = [axis_motion(s, whirl_run.model.P, whirl_run.model.I, ST_AMB1 + k)[:2] for s in whirl_run.Y]
         assert np.array_equal(whirl_run.amb_orbit(p), np.array(kernel))   # the env's criterion
         assert m["amb_planes"][p]["max_displacement_um"] == pytest.approx(r * 1e6, rel=1e-12)
         assert r > gap and m["amb_planes"][p]["stator_contact"]     # the reviewer's 831 um

@@ -70,7 +70,12 @@ def test_the_kernels_constants_are_the_declared_slots():
     assert M.P_AMB_IFF2 == M.P_AMB_IFF1 + 1 and M.U_CS2 == M.U_CS1 + 1
     assert M.P_TH_B - M.P_TH_C == len(M.thermal.PARAM_NAMES) - 1
     assert M.LAYOUT.controls.width("amb.current_command") == 4 == len(M.AMB_AXES)
-    assert M.A_ST_PMOUNT + 2 == M.N_AUX
+    assert M.A_ST_PMOUNT + 2 == M.A_STF        # the rhs zeroes the stator's slots up to A_STF
+    assert M.A_FX_PDAMP + 1 == M.N_AUX         # ... and the flexible rotor's, A_STF on
+    assert M.P_Z_AMB1 == M.P_Z_RB1 + M.ST_AMB1 and M.P_Z_UB == M.P_Z_RB1 + M.ST_UB
+    for s, name in enumerate(M.flexible_rotor.STATIONS):    # the station block's order
+        assert M.LAYOUT.params.spans()[[n for n, _, _ in M.LAYOUT.params.spans()].index(
+            {"unb1": "unbalance.z"}.get(name, name + ".z"))][1] == M.P_Z_RB1 + s
 
 
 def test_name_lookups_above_physics():

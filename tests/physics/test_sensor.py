@@ -11,7 +11,7 @@ import pytest
 
 import rotordrop_env  # noqa: F401  (registers the ids)
 from physics.equilibrium import levitated_state
-from physics.model import (U_SENS_NOISE, amb_currents, axis_motion, build_model, delayed_motion,
+from physics.model import (ST_AMB1, U_SENS_NOISE, amb_currents, axis_motion, build_model, delayed_motion,
                            rhs, N_AUX, S_VX, P_AMB_KP, P_AMB_KD, P_AMB_TD)
 from physics.scene import SceneError, load_scene
 from physics.sensor import pade_phase, pade_rates, pade_response
@@ -105,7 +105,7 @@ def test_the_sensed_displacement_of_a_ramp_is_the_ramp_tau_later():
     for t_next in tau * np.arange(6.0, 11.0):
         integ.advance(y, t, t_next, U)
         t = t_next
-        px, _, vx, _ = axis_motion(y, model.I, scene.positions.amb1)
+        px, _, vx, _ = axis_motion(y, model.P, model.I, ST_AMB1)
         sx, _, svx, _ = delayed_motion(y, model.P, model.I, 0, px, 0.0, vx, 0.0)
         assert px == pytest.approx(v * t, rel=1e-9)
         assert sx == pytest.approx(v * (t - tau), abs=1e-6 * v * tau)

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import rotordrop_env  # noqa: F401  (registers the ids)
-from physics.model import ORBIT_FRAME_CORE, P_Z_AMB1, axis_motion
+from physics.model import ORBIT_FRAME_CORE, ST_AMB1, axis_motion
 from rotordrop_env.layout import COMMANDS, SUPERVISOR_ACTIONS, SUPERVISOR_OBS
 
 from helpers import run_env_checkers
@@ -20,7 +20,7 @@ STILL = {"unbalance.mass": 0.0, "contact.friction": 0.0}
 
 def amb_radius(env, k: int = 0) -> float:
     u = env.unwrapped
-    px, py, _, _ = axis_motion(u._b.y, u._b.I, u._b.P[P_Z_AMB1 + k])
+    px, py, _, _ = axis_motion(u._b.y, u._b.P, u._b.I, ST_AMB1 + k)
     return math.hypot(px, py)
 
 
