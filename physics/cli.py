@@ -95,6 +95,13 @@ def summary_table(m: dict) -> str:
              f"({m['rhs_evaluations']} rhs evaluations, {m['n_state']} states; compile/cache load "
              f"{m['compile_time_s']:.2f} s)", _contact_line(m),
              f"final rotor speed {m['final_rotor_speed_rpm']:.0f} rpm"]
+    r = m.get("rotor", {})
+    if r.get("model") == "flexible":
+        lines.insert(1, f"flexible rotor (shaft {r['shaft']!r}): {r['elastic_modes']} elastic modes"
+                     f" per bending plane ({r['bending_modes']} bending below"
+                     f" {r['mode_cutoff_hz']:g} Hz, {r['static_correction_modes']} static"
+                     f" correction) at " + ", ".join(f"{f:.0f}" for f in r["frequencies_hz"])
+                     + " Hz")
     if m["fault_simulated"]:
         lines += _post_fault_tables(m)
     lines.append(f"{'AMB plane':10}{'max disp [µm]':>15}{'stator':>8}{'contacts':>10}{'peak F [N]':>12}")

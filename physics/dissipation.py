@@ -18,8 +18,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .model import (A_PBDAMP, A_PCDAMP, A_PDRAG, A_PFRIC, A_PSUPPORT, A_ST_PDAMP, A_ST_PFRIC,
-                    A_ST_PMOUNT, N_AUX_PLANE, PLANES)
+from .model import (A_FX_PDAMP, A_PBDAMP, A_PCDAMP, A_PDRAG, A_PFRIC, A_PSUPPORT, A_ST_PDAMP,
+                    A_ST_PFRIC, A_ST_PMOUNT, N_AUX_PLANE, PLANES)
 from .results import AMB_PLANES, Result
 
 #: per retainer plane: element -> diagnostics column (offset within the plane's block)
@@ -47,6 +47,8 @@ def dissipation_powers(result: Result) -> dict[str, np.ndarray]:
     for k, p in enumerate(AMB_PLANES):
         for name, j in STATOR_TERMS.items():
             out[f"{p}.{name}"] = result.aux[:, j + k]
+    if result.model.elastic_modes:               # a flexible rotor's structural damping
+        out["rotor.structural_damping"] = result.aux[:, A_FX_PDAMP]
     return out
 
 

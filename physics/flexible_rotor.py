@@ -155,11 +155,14 @@ def elastic_energy(y, P, i0, n, w2):
     return e
 
 
-def strain_energy(model, y: np.ndarray) -> float:
-    """Strain energy of the elastic modes in state ``y`` [J] (0 for a rigid rotor)."""
+def strain_energy(model, y: np.ndarray) -> np.ndarray | float:
+    """Strain energy of the elastic modes [J] in state ``y`` (or per row of a state array);
+    0 for a rigid rotor."""
     n = model.elastic_modes
+    y = np.asarray(y)
     if n == 0:
-        return 0.0
+        return 0.0 if y.ndim == 1 else np.zeros(len(y))
     i0 = model.state_index("eta_x1")
     w2 = model.P[model.param_index("flex.omega2"):][:n]
-    return float(0.5 * np.sum(w2 * (y[i0:i0 + n] ** 2 + y[i0 + n:i0 + 2 * n] ** 2)))
+    eta = y[..., i0:i0 + 2 * n]
+    return 0.5 * np.sum(np.concatenate([w2, w2]) * eta * eta, axis=-1)

@@ -17,6 +17,7 @@ from .amb import weight_shares
 from .ball_bearing import film_thickness, max_contact_pressure, static_max_ball_load
 from .contact import effective_modulus
 from .dissipation import created_energy, dissipation_check
+from .flexible_rotor import strain_energy
 from .integrate import P_FR, P_LOAD, P_QMAX
 from .model import F_FILM, F_RB, F_STATOR, P_FILM, PLANES, RB_SM
 from .results import AMB_PLANES, Result
@@ -524,9 +525,28 @@ def compute_metrics(result: Result) -> dict:
     out["rating_pressure_MPa"] = rating_pressure(result.model.scene.bearing) * 1e-6 if balls else None
     out.update(check_metrics(result, out))
     out["dissipation"] = dissipation_check(result)
+    out["rotor"] = rotor_metrics(result)
     out.update(final_slip(result))
     out["warnings"] = warnings_of(out, result.model.scene)
     return out
+
+
+def rotor_metrics(result: Result) -> dict:
+    """The rotor model: ``{"model": "rigid"}``, or for a flexible rotor its shaft, the retained
+    elastic modes per bending plane (bending below the cut-off, static correction) with their
+    frequencies, and the largest strain energy of the run."""
+    scene, model = result.model.scene, result.model
+    if not model.elastic_modes:
+        return dict(model="rigid")
+    from .flexible.shafts import drop_rotor
+    fm = drop_rotor(scene)
+    strain = strain_energy(model, result.Y)
+    return dict(model="flexible", shaft=scene.flexible.shaft, elastic_modes=fm.n_modes,
+                bending_modes=fm.n_bending, static_correction_modes=fm.n_correction,
+                mode_cutoff_hz=scene.flexible.mode_cutoff_hz,
+                frequencies_hz=[float(w / (2 * np.pi)) for w in fm.omega],
+                damping_ratio=scene.flexible.damping_ratio,
+                max_strain_energy_J=float(strain.max()))
 
 
 def _plane_table(result: Result) -> dict:

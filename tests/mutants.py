@@ -1,4 +1,4 @@
-"""Mutation check of the energy tests: flip one friction or damping sign in a copy of the package
+"""Mutation check of the energy tests: flip one friction, damping or coupling sign in a copy of the package
 and run the dissipation and energy tests against the copy; each mutant must make them fail.
 
     python3 tests/mutants.py                 # every mutant, a table of killed / survived
@@ -21,7 +21,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-TESTS = ("tests/physics/test_dissipation.py", "tests/physics/test_energy.py")
+TESTS = ("tests/physics/test_dissipation.py", "tests/physics/test_energy.py",
+         "tests/physics/flexible/test_flexible_drop.py::test_energy_audit_closes_with_strain_energy",
+         "tests/physics/flexible/test_flexible_drop.py::test_stiff_rotor_drop_closes_its_audit_too")
 
 
 @dataclass(frozen=True)
@@ -69,6 +71,16 @@ MUTANTS = (
            "(-sfy - k * qy - c * qvy) / m", "(-sfy - k * qy + c * qvy) / m"),
     Mutant("stator_mount_reaction", "physics/stator.py",
            "(-sfy - k * qy - c * qvy) / m", "(sfy - k * qy - c * qvy) / m"),
+    # the flexible rotor (physics/flexible_rotor.py): structural damping, the gyroscopic
+    # couplings of the elastic modes, and the projection of the station forces on the modes
+    Mutant("flexible_structural_damping", "physics/flexible_rotor.py",
+           "ax = qx - P[w2 + j] * ex - P[damp + j] * vx", "ax = qx - P[w2 + j] * ex + P[damp + j] * vx"),
+    Mutant("flexible_mode_gyroscopics", "physics/flexible_rotor.py",
+           "ax -= Omega * gx", "ax += Omega * gx"),
+    Mutant("flexible_tilt_coupling", "physics/model.py",
+           "Ma -= spin * cy", "Ma += spin * cy"),
+    Mutant("flexible_station_forces", "physics/flexible_rotor.py",
+           "qy += sh * aux[a_force + 2 * s + 1]", "qy -= sh * aux[a_force + 2 * s + 1]"),
 )
 
 

@@ -13,13 +13,13 @@ or the path of a TOML rotor file: either one saved by ROSS (``ross.Rotor.save``,
     nu = 0.3                     # or G_s = 81.2e9 (Pa)
     rho = 7810.0                 # kg/m^3
 
-    [[section]]                  # from the left end on, one after the other
+    [[sections]]                 # from the left end on, one after the other
     length = 0.25                # m
     outer_diameter = 0.07        # m
     inner_diameter = 0.0         # m (optional)
     material = "steel"           # optional
 
-    [[disk]]                     # rigid disks (optional)
+    [[disks]]                    # rigid disks (optional)
     z = 0.45                     # m, in the file's frame
     mass = 19.5                  # kg
     I_d = 0.21                   # kg m^2, about the disk's centre
@@ -66,23 +66,21 @@ def load_shaft(source: str) -> FlexibleRotor:
     except tomllib.TOMLDecodeError as exc:
         raise ShaftError(f"flexible.shaft = {source!r}: not valid TOML ({exc})") from None
     try:
-        if "section" in data:
+        if "sections" in data:
             return _rotordrop_file(data, path)
         from .ross_io import read_ross
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")          # the skipped bearings: rotordrop's own
             return read_ross(path).rotor
-    except ShaftError:
-        raise
-    except (ValueError, KeyError, TypeError) as exc:
+    except (ValueError, KeyError, TypeError) as exc:          # ShaftError is a ValueError
         raise ShaftError(f"flexible.shaft = {source!r}: {exc}") from None
 
 
 def _rotordrop_file(data: dict, path: Path) -> FlexibleRotor:
-    known = {"name", "z_start", "shear", "materials", "section", "disk"}
+    known = {"name", "z_start", "shear", "materials", "sections", "disks"}
     extra = sorted(set(data) - known)
     if extra:
-        raise ShaftError(f"{path}: unknown key(s) {', '.join(extra)}; allowed "
+        raise ShaftError(f"unknown key(s) {', '.join(extra)}; allowed "
                          f"{', '.join(sorted(known))}")
     materials = {"steel": STEEL}
     for name, m in data.get("materials", {}).items():
@@ -92,19 +90,31 @@ def _rotordrop_file(data: dict, path: Path) -> FlexibleRotor:
             materials[name] = Material.from_poisson(name, float(m["E"]), float(m["nu"]),
                                                     float(m["rho"]))
     sections = []
-    for i, s in enumerate(data["section"]):
+    for i, s in enumerate(data["sections"]):
         mat = s.get("material", "steel")
         if mat not in materials:
-            raise ShaftError(f"{path}: section[{i}].material = {mat!r}: allowed "
+            raise ShaftError(f"sections[{i}].material = {mat!r}: allowed "
                              f"{', '.join(map(repr, materials))}")
-        sections.append(ShaftSection(float(s["length"]), float(s["outer_diameter"]),
-                                     float(s.get("inner_diameter", 0.0)), materials[mat]))
-    disks = tuple(Disk(float(d["z"]), float(d["mass"]), float(d.get("I_d", 0.0)),
-                       float(d.get("I_p", 0.0))) for d in data.get("disk", []))
+        sections.append(ShaftSection(*(_number(s, f"sections[{i}]", key, default) for key, default
+                                       in (("length", None), ("outer_diameter", None),
+                                           ("inner_diameter", 0.0))), materials[mat]))
+    disks = tuple(Disk(*(_number(d, f"disks[{i}]", key, default) for key, default in
+                         (("z", None), ("mass", None), ("I_d", 0.0), ("I_p", 0.0))))
+                  for i, d in enumerate(data.get("disks", [])))
     shear = data.get("shear", "hutchinson")
     return FlexibleRotor(tuple(sections), disks, z_start=float(data.get("z_start", 0.0)),
                          shear=None if shear == "none" else shear,
                          name=str(data.get("name", path.stem)))
+
+
+def _number(table: dict, where: str, key: str, default: float | None) -> float:
+    """``table[key]`` as a float; a missing required key or a non-number names the key."""
+    if key not in table and default is None:
+        raise ShaftError(f"{where}.{key}: missing (a number is required)")
+    value = table.get(key, default)
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ShaftError(f"{where}.{key} = {value!r}: allowed a number")
+    return float(value)
 
 
 def _scaled(material: Material, factor: float) -> Material:
