@@ -18,13 +18,11 @@ from __future__ import annotations
 import numpy as np
 
 from ._jit import njit
-from .flexible.floating import STATIONS
+from .flexible.floating import MAX_MODES, STATIONS
 
 #: the scene keys this effect reads
 SCENE_KEYS = ("rotor.model", "flexible.shaft", "flexible.modulus_scale", "flexible.mode_cutoff_hz",
               "flexible.static_modes", "flexible.damping_ratio", "flexible.element_length")
-#: the most elastic modes per bending plane the packed arrays hold
-MAX_MODES = 24
 N_STATIONS = len(STATIONS)
 
 

@@ -478,7 +478,12 @@ def scene_from_toml(text: str, name: str = "custom", base_dir: Path | None = Non
         raise SceneError(f"scene {name!r}: base = {base_name!r} must be a string: a preset name or"
                          " a TOML file path")
     base = _load_base(base_name, _chain, base_dir) if base_name else Scene()
-    scene = base.with_overrides(_flatten(data, name))
+    flat = _flatten(data, name)
+    shaft = flat.get("flexible.shaft")
+    if isinstance(shaft, str) and shaft.endswith(".toml") and base_dir is not None \
+            and not Path(shaft).is_absolute():
+        flat["flexible.shaft"] = str(base_dir / shaft)       # a rotor file beside the scene's
+    scene = base.with_overrides(flat)
     return dataclasses.replace(scene, name=name)
 
 

@@ -39,6 +39,8 @@ from .modal import generalized_eigh
 
 #: the force stations, in the order of the drop model's axial-station block (physics/rotor.py)
 STATIONS = ("rb1", "rb2", "amb1", "amb2", "unb1")
+#: the most elastic modes per bending plane the drop kernel's packed arrays hold
+MAX_MODES = 24
 
 
 @dataclass(frozen=True)

@@ -41,7 +41,7 @@ from pathlib import Path
 
 from . import examples
 from .assembly import STEEL, Disk, FlexibleRotor, Material, ShaftSection, rigid_properties
-from .floating import FloatingModel, floating_model
+from .floating import MAX_MODES, FloatingModel, floating_model
 
 #: built-in shafts by name
 BUILT_IN = {"paper": examples.paper_flexible, "machine": examples.machine_flexible}
@@ -134,7 +134,6 @@ def centred(shaft: FlexibleRotor, modulus_scale: float, element_length: float) -
 @functools.lru_cache(maxsize=64)
 def _reduced(shaft: str, modulus_scale: float, element_length: float, stations: tuple,
              unbalance_z: float, cutoff_hz: float, static_modes: bool) -> FloatingModel:
-    from ..flexible_rotor import MAX_MODES
     base = centred(load_shaft(shaft), modulus_scale, element_length)
     rb1, rb2, amb1, amb2 = stations
     for key, z in (("positions.rb1", rb1), ("positions.rb2", rb2), ("positions.amb1", amb1),

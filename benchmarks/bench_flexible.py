@@ -1,0 +1,96 @@
+"""What a flexible rotor costs: the flexible drop against the rigid paper drop, in one run.
+
+    python benchmarks/bench_flexible.py [--repeats 5] [--t-end 1.0] [--json out.json]
+
+For each case: wall seconds per simulated second (median of ``--repeats`` drops after a JIT
+warm-up, one core), as a ratio to the rigid paper drop timed interleaved with it (so the
+machine's load moves both), the accepted and rejected steps, the cost of one rhs, and the
+drop's floor ratio (integration time over accepted steps' rhs evaluations x ns per rhs,
+benchmarks/bench_drop.py). Then the stability bound that explains the step count: DOPRI5 (the
+adaptive solver) is stable on an undamped oscillator of frequency omega only for h omega <=
+3.3 (its stability region on the imaginary axis), so a run whose highest retained mode is
+omega_max needs at least ``t omega_max / 3.3`` steps, whatever its tolerance.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import statistics
+
+from bench_drop import floor_ratio, ns_per_rhs
+from physics import load_scene, simulate
+from physics.model import build_model
+from physics.simulate import warm_up
+
+#: DOPRI5's stability limit on the imaginary axis (h omega), e.g. Hairer & Wanner, Solving ODEs
+#: II, fig. IV.2.1: the boundary crosses the imaginary axis near 3.3
+DOPRI5_IMAGINARY_LIMIT = 3.3
+
+CASES = [
+    ("rigid paper drop", "paper", {}),
+    ("paper-flexible (default modes)", "paper-flexible", {}),
+    ("paper-flexible, no static modes", "paper-flexible", {"flexible.static_modes": False}),
+    ("paper-flexible, static modes only", "paper-flexible", {"flexible.mode_cutoff_hz": 0.0}),
+    ("machine-flexible (default modes)", "machine-flexible", {}),
+    ("machine-flexible, no static modes", "machine-flexible", {"flexible.static_modes": False}),
+]
+
+
+def paired_ratio(scene, reference, t_end: float, repeats: int) -> tuple[float, dict, dict]:
+    """Median over ``repeats`` interleaved pairs of wall(scene) / wall(reference), and the
+    last run's statistics of each."""
+    ratios = []
+    for i in range(repeats):
+        pair = [None, None]
+        for j in ((0, 1) if i % 2 == 0 else (1, 0)):
+            pair[j] = simulate((scene, reference)[j], t_end=t_end)
+        ratios.append(pair[0].stats.wall_time_s / pair[1].stats.wall_time_s)
+    return statistics.median(ratios), pair[0], pair[1]
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeats", type=int, default=5)
+    ap.add_argument("--t-end", type=float, default=1.0)
+    ap.add_argument("--json", default=None, help="also write the figures to this JSON file")
+    args = ap.parse_args()
+    reference = load_scene("paper")
+    for _, source, ov in CASES:
+        warm_up(build_model(load_scene(source, ov)))
+    out: dict = {"repeats": args.repeats, "t_end": args.t_end, "cases": {}}
+    print(f"median of {args.repeats} interleaved pairs of {args.t_end:g} s drops; ratio = wall "
+          f"time over the rigid paper drop's")
+    print(f"{'case':36}{'modes':>6}{'states':>7}{'ratio':>7}{'steps':>8}{'rejected':>9}"
+          f"{'ns/rhs':>8}{'floor':>7}{'min steps':>10}")
+    for name, source, ov in CASES:
+        scene = load_scene(source, ov)
+        ratio, r, _ = paired_ratio(scene, reference, args.t_end, args.repeats)
+        model = r.model
+        omega_max = 0.0
+        if model.elastic_modes:
+            from physics.flexible.shafts import drop_rotor
+            omega_max = float(drop_rotor(scene).omega.max())
+        floor = floor_ratio(scene, args.t_end, max(1, args.repeats // 2))
+        min_steps = math.ceil(args.t_end * omega_max / DOPRI5_IMAGINARY_LIMIT)
+        row = dict(elastic_modes=model.elastic_modes, n_state=model.n_state,
+                   wall_ratio_vs_rigid=ratio, wall_s_per_sim_s=r.stats.wall_time_s / args.t_end,
+                   steps=r.stats.steps, rejected=r.stats.rejected_steps, ns_per_rhs=ns_per_rhs(r),
+                   floor_ratio_wall=floor["floor_ratio_wall"],
+                   floor_ratio_cpu=floor["floor_ratio_cpu"],
+                   highest_mode_hz=omega_max / (2 * math.pi),
+                   stability_min_steps=min_steps)
+        out["cases"][name] = row
+        print(f"{name:36}{row['elastic_modes']:6d}{row['n_state']:7d}{ratio:7.2f}"
+              f"{row['steps']:8d}{row['rejected']:9d}{row['ns_per_rhs']:8.0f}"
+              f"{row['floor_ratio_cpu']:7.2f}{min_steps:10d}")
+    print(f"\nmin steps: t x omega_max / {DOPRI5_IMAGINARY_LIMIT} (DOPRI5's stability bound for the "
+          f"highest retained mode); floor: CPU time over accepted steps' rhs x ns per rhs")
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(out, f, indent=2)
+        print(f"wrote {args.json}")
+
+
+if __name__ == "__main__":
+    main()
