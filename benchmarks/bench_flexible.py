@@ -1,6 +1,9 @@
 """What a flexible rotor costs: the flexible drop against the rigid paper drop, in one run.
 
-    python benchmarks/bench_flexible.py [--repeats 5] [--t-end 1.0] [--json out.json]
+    python benchmarks/bench_flexible.py [--repeats 5] [--t-end 1.0] [--out docs/data]
+
+writes ``bench-flexible.json`` and the table ``bench-flexible-table.txt`` (docs/scaling.md pastes
+it) into ``--out``.
 
 For each case: wall seconds per simulated second (median of ``--repeats`` drops after a JIT
 warm-up, one core), as a ratio to the rigid paper drop timed interleaved with it (so the
@@ -16,7 +19,10 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import platform
 import statistics
+from datetime import date
+from pathlib import Path
 
 from bench_drop import floor_ratio, ns_per_rhs
 from physics import load_scene, simulate
@@ -53,7 +59,8 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--t-end", type=float, default=1.0)
-    ap.add_argument("--json", default=None, help="also write the figures to this JSON file")
+    ap.add_argument("--out", default=None, help="write bench-flexible.json and "
+                    "bench-flexible-table.txt into this directory")
     args = ap.parse_args()
     reference = load_scene("paper")
     for _, source, ov in CASES:
@@ -86,11 +93,29 @@ def main() -> None:
               f"{row['floor_ratio_cpu']:7.2f}{min_steps:10d}")
     print(f"\nmin steps: t x omega_max / {DOPRI5_IMAGINARY_LIMIT} (DOPRI5's stability bound for the "
           f"highest retained mode); floor: CPU time over accepted steps' rhs x ns per rhs")
-    if args.json:
-        with open(args.json, "w") as f:
-            json.dump(out, f, indent=2)
-        print(f"wrote {args.json}")
+    if args.out:
+        out.update(date=date.today().isoformat(), machine=platform.processor() or platform.machine())
+        d = Path(args.out)
+        d.mkdir(parents=True, exist_ok=True)
+        (d / "bench-flexible.json").write_text(json.dumps(out, indent=1))
+        (d / "bench-flexible-table.txt").write_text(table(out))
+        print(f"wrote {d / 'bench-flexible.json'}, {d / 'bench-flexible-table.txt'}")
 
+
+def table(out: dict) -> str:
+    """The markdown table docs/scaling.md pastes (between its markers)."""
+    lines = ["| case | elastic modes | states | wall time / rigid drop | steps | rejected | "
+             "highest mode | stability bound on steps | floor ratio (CPU) |",
+             "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for name, r in out["cases"].items():
+        top = f"{r['highest_mode_hz']:,.0f} Hz" if r["elastic_modes"] else "-"
+        bound = f"{r['stability_min_steps']:,}" if r["elastic_modes"] else "-"
+        lines.append(f"| {name} | {r['elastic_modes']} | {r['n_state']} | "
+                     f"{r['wall_ratio_vs_rigid']:.2f} | {r['steps']:,} | {r['rejected']:,} | {top} | "
+                     f"{bound} | {r['floor_ratio_cpu']:.2f} |")
+    lines.append(f"\n{out['t_end']:g} s drops (mu = 0.25), medians of {out['repeats']} interleaved "
+                 f"pairs, {out.get('date', '')}: `python benchmarks/bench_flexible.py --out docs/data`.")
+    return "\n".join(lines) + "\n"
 
 if __name__ == "__main__":
     main()

@@ -36,7 +36,6 @@ import dataclasses
 import functools
 import math
 import tomllib
-import warnings
 from pathlib import Path
 
 from . import examples
@@ -69,9 +68,7 @@ def load_shaft(source: str) -> FlexibleRotor:
         if "sections" in data:
             return _rotordrop_file(data, path)
         from .ross_io import read_ross
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")          # the skipped bearings: rotordrop's own
-            return read_ross(path).rotor
+        return read_ross(path).rotor     # warns in one line of the bearings it leaves out
     except (ValueError, KeyError, TypeError) as exc:          # ShaftError is a ValueError
         raise ShaftError(f"flexible.shaft = {source!r}: {exc}") from None
 
