@@ -139,3 +139,15 @@ def test_flexible_study_finds_the_modulus_scale_of_a_bending_ratio():
     assert s["ratio"] == pytest.approx(2.0, rel=study.RATIO_TOL)
     assert s["modulus_scale"] == pytest.approx((2.0 / 2.4134) ** 2, rel=0.02)
     assert s["bending_hz"] == pytest.approx(2.0 * 10000 / 60, rel=study.RATIO_TOL)
+
+
+@pytest.mark.parametrize("full", [False, True])
+def test_modal_damping_is_the_bending_modes_damping_on_undamped_amb_springs(full):
+    """amb.damping = 0: the rigid-body modes are all but undamped (they bend the shaft a little:
+    ~1e-5) and the first bending pair carries the modal damping ratio flexible.damping_ratio (the
+    full model's modal damping matrix included)."""
+    scene = load_scene("machine-flexible", {**campbell.SPRINGS_ONLY, "flexible.damping_ratio": 0.02})
+    w = campbell.flexible_whirl(scene, [10000.0 * RPM], 3, full=full)
+    for d in ("forward", "backward"):
+        np.testing.assert_allclose(w[f"{d}_damping"][0, :2], 0.0, atol=1e-4)
+        assert w[f"{d}_damping"][0, 2] == pytest.approx(0.02, rel=0.05)
