@@ -71,6 +71,34 @@ def test_generated_physics_tables_match_their_data():
     assert all(r["stator_penetration_um"] <= r["validity_bound_um"] + 1e-9 for r in rows)
 
 
+def _example(name: str):
+    import importlib.util
+    spec = importlib.util.spec_from_file_location(name, ROOT / "docs/examples" / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_flexible_study_tables_match_their_data():
+    """docs/physics.md "When flexibility matters" holds exactly the tables
+    docs/examples/flexible_study.py renders from docs/data/flexible-study.json (re-run the script:
+    it rewrites the block), and the data is the study the script describes."""
+    study = _example("flexible_study")
+    page = (ROOT / "docs/physics.md").read_text()
+    assert page.count(study.START) == 1
+    i = page.index(study.START) + len(study.START)
+    data = json.loads((ROOT / "docs/data/flexible-study.json").read_text())
+    assert page[i:page.index(study.END, i)] == study.tables(data)
+    assert data["frictions"] == list(study.FRICTIONS) and data["mu_grid"] == list(study.MU_GRID)
+    flexible = [r["stiffness"] for r in data["rotors"][1:]]
+    assert sorted(s["target_ratio"] for s in flexible if s["target_ratio"]) == list(study.RATIOS)
+    for s in flexible:
+        if s["target_ratio"]:
+            assert abs(s["ratio"] / s["target_ratio"] - 1) < study.RATIO_TOL
+    assert (ROOT / "docs/img/flexible-study.png").stat().st_size > 10_000
+    assert (ROOT / "docs/data/flexible-study.csv").read_text().count("\n") == 1 + sum(
+        len(r["grid"]) + len(r["bisection"]) for r in data["rotors"])
+
 def test_the_flexible_cost_table_is_the_benchmarks_output():
     """docs/scaling.md pastes the table benchmarks/bench_flexible.py wrote next to its data."""
     page = (ROOT / "docs/scaling.md").read_text()

@@ -164,6 +164,45 @@ def plot_thermal(result: Result, path: Path, title: str = "") -> Path:
     return save_figure(fig, path)
 
 
+def plot_mode_shapes(result: Result, path: Path, title: str = "") -> Path:
+    """A flexible rotor's retained elastic modes (physics/flexible/floating.py): the x
+    displacement of each along the shaft, scaled to a largest |x| of 1, with the retainer, AMB and
+    unbalance stations and each mode's free-free frequency; the same numbers in a CSV next to
+    the PNG (``z_m``, then one column per mode)."""
+    from ..flexible.shafts import drop_rotor
+    scene = result.model.scene
+    fm = drop_rotor(scene)
+    z = fm.fe.z
+    shapes = fm.basis[0::2, 2:].copy()
+    for j in range(fm.n_modes):
+        k = int(np.argmax(np.abs(shapes[:, j])))
+        shapes[:, j] /= shapes[k, j]
+    names = [f"{'bending' if j < fm.n_bending else 'static correction'} {j + 1}: "
+             f"{fm.omega[j] / (2 * np.pi):.1f} Hz" for j in range(fm.n_modes)]
+    fig, ax = plt.subplots(figsize=(11, 5), constrained_layout=True)
+    for j, name in enumerate(names):
+        ax.plot(z, shapes[:, j], "-" if j < fm.n_bending else "--", lw=1.2, label=name)
+    p = scene.positions
+    for stations, label, style in (((p.rb1, p.rb2), "retainer", dict(color="k", ls="-")),
+                                   ((p.amb1, p.amb2), "AMB", dict(color="C7", ls="-.")),
+                                   ((scene.unbalance.z,), "unbalance", dict(color="C3", ls=":"))):
+        for i, zs in enumerate(stations):
+            ax.axvline(zs, lw=1.0, label=label if i == 0 else None, **style)
+    ax.axhline(0.0, color="0.6", lw=0.5)
+    ax.set_xlabel("z from the centre of mass [m]")
+    ax.set_ylabel("x displacement (largest = 1)")
+    ax.set_title(f"Elastic modes of the shaft {scene.flexible.shaft!r} (E x "
+                 f"{scene.flexible.modulus_scale:g}; free-free, floating frame) {title}".strip(),
+                 fontsize=10)
+    ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5))
+    ax.grid(alpha=0.3)
+    header = ",".join(["z_m"] + [n.split(":")[0].replace(" ", "_") + "_" + n.split(": ")[1]
+                                 .replace(" ", "_") for n in names])
+    np.savetxt(Path(path).with_suffix(".csv"), np.column_stack([z, shapes]), delimiter=",",
+               header=header, comments="", fmt="%.8g")
+    return save_figure(fig, path)
+
+
 def plot_drop(result: Result, out_dir: Path, title: str = "") -> list[Path]:
     out_dir = Path(out_dir)
     paths = [plot_orbits(result, out_dir / "orbits.png", title),
@@ -174,6 +213,9 @@ def plot_drop(result: Result, out_dir: Path, title: str = "") -> list[Path]:
              plot_amb_planes(result, out_dir / "amb_planes.png", title)]
     if result.has_thermal:
         paths.append(plot_thermal(result, out_dir / "thermal.png", title))
+    if result.model.scene.rotor.model == "flexible":
+        paths.append(plot_mode_shapes(result, out_dir / "mode_shapes.png", title))
+        paths.append(paths[-1].with_suffix(".csv"))
     return paths
 
 
