@@ -31,9 +31,17 @@ def audit_residual(result) -> float:
 BUDGET = {"solver.max_steps": 400_000}
 
 
-def test_energy_audit_closes_with_strain_energy():
+#: the stations moved 80 mm towards RB2 (as in the asymmetric preset, within this 0.9 m shaft):
+#: the rotor tilts as it drops, so the elastic modes that couple to the tilt take part
+ASYMMETRIC = {"positions.rb1": -0.30, "positions.rb2": 0.44, "positions.amb1": -0.20,
+              "positions.amb2": 0.36, "unbalance.z": 0.08}
+
+
+@pytest.mark.parametrize("overrides", [{}, ASYMMETRIC], ids=["symmetric", "asymmetric"])
+def test_energy_audit_closes_with_strain_energy(overrides):
     """The slender machine-like rotor whirling (mu = 0.5): the shaft bends most here."""
-    r = simulate(load_scene("machine-flexible", {"contact.friction": 0.5, **BUDGET}), t_end=0.35)
+    r = simulate(load_scene("machine-flexible", {"contact.friction": 0.5, **BUDGET, **overrides}),
+                 t_end=0.35)
     strain = strain_energy(r.model, r.Y)
     assert strain.max() > 1.0                     # J: the shaft does bend in the whirl
     assert audit_residual(r) <= AUDIT_TOL
@@ -83,12 +91,14 @@ def test_a_1000x_stiffer_shaft_reproduces_the_rigid_drop():
     assert stiff["backward_whirl"] == rigid["backward_whirl"] is False
 
 
-@pytest.mark.parametrize("mus", [(0.15, 0.5), pytest.param((0.1, 0.2, 0.3, 0.4, 0.5),
-                                                             marks=pytest.mark.slow)])
-def test_the_stiff_limit_makes_the_same_whirl_decision_across_friction(mus):
+@pytest.mark.parametrize("mus, t_end", [
+    ((0.15, 0.5), 0.4),
+    # the paper's study range 0.1-0.5 (spec section 2) in steps of 0.05, over the paper's 1 s drop
+    pytest.param(tuple(np.round(np.arange(0.1, 0.501, 0.05), 2)), 1.0, marks=pytest.mark.slow)])
+def test_the_stiff_limit_makes_the_same_whirl_decision_across_friction(mus, t_end):
     decisions = []
     for mu in mus:
-        rigid, stiff = stiff_and_rigid(mu, 0.4)
+        rigid, stiff = stiff_and_rigid(float(mu), t_end)
         assert stiff["backward_whirl"] == rigid["backward_whirl"], mu
         decisions.append(rigid["backward_whirl"])
     assert decisions[0] is False and decisions[-1] is True      # the sweep crosses the onset
