@@ -49,7 +49,7 @@ EXTREMES = (             # whole-run peaks scored against the reference: (error 
 )
 WHOLE_KEYS = tuple(f"{name}_rel" for name, _ in EXTREMES)
 #: bending modes per plane of the --modes sweep (each with and without the static correction
-#: modes; capped at what the packed arrays hold, physics.flexible_rotor.MAX_MODES, whose
+#: modes; capped at what the packed arrays hold, physics.flexible.floating.MAX_MODES, whose
 #: largest count is always run: the sweep's reference)
 MODE_COUNTS = (0, 1, 2, 3, 5, 8, 12, 19)
 QUICK_MODE_COUNTS = (0, 2, 5, 19)
@@ -191,7 +191,7 @@ def mode_settings(scene, counts: tuple[int, ...]) -> list[Setting]:
     """The --modes rows: each bending-mode count with the static correction modes, then
     without; the most the packed arrays hold is always among them (the sweep's reference,
     with the static modes: the first row)."""
-    from ..flexible_rotor import MAX_MODES
+    from ..flexible.floating import MAX_MODES
     if scene.rotor.model != "flexible":
         raise AccuracyError(f"--modes: rotor.model = {scene.rotor.model!r}: the mode sweep needs a"
                             f" flexible rotor (rotor.model = 'flexible', e.g. --scene paper-flexible)")
