@@ -290,18 +290,32 @@ def _register_accuracy(subparsers) -> None:
     add_scene_args(p)
     p.add_argument("--out", default="out/accuracy", help="output directory")
     p.add_argument("--quick", action="store_true", help="2 drops of 0.3 s, fewer settings")
+    p.add_argument("--modes", nargs="?", const="auto", default=None, metavar="N,N,...",
+                   help="a flexible rotor: also run the drops with fewer elastic modes (these "
+                        "bending-mode counts per plane, each with and without the static "
+                        "correction modes; default 0,1,2,3,5,8,12,19, --quick 0,2,5,19) against "
+                        "the run with the most modes: modes.csv, modes.png, a table in accuracy.md")
+    p.add_argument("--modes-only", action="store_true",
+                   help="run the --modes sweep alone (no solver settings, no tight reference)")
     p.add_argument("--jobs", type=at_least(1), default=None, help="threads (default: all cores)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_accuracy)
 
 
 def cmd_accuracy(args) -> int:
-    from .runs.accuracy import run_accuracy, scene_setting_text
+    from .runs.accuracy import mode_counts, run_accuracy, scene_setting_text
+    asked = "auto" if args.modes is None and args.modes_only else args.modes
     a, paths = run_accuracy(args.scene, overrides_from_args(args), args.out, quick=args.quick,
-                            jobs=args.jobs, progress=not args.quiet)
-    print(Path(paths[1]).read_text().split("\n\n![")[0])
-    print(f"\nrecommended: {a['recommended']} ({a['recommended_reason']}); "
-          f"scene's setting: {scene_setting_text(a)}")
+                            jobs=args.jobs, progress=not args.quiet,
+                            modes=mode_counts(asked, args.quick), tolerances=not args.modes_only)
+    solver, _, modes = Path(paths[1]).read_text().partition("## Retained elastic modes")
+    if not args.modes_only:
+        print(solver.split("\n\n![")[0])
+    if modes:
+        print("\n## Retained elastic modes" + modes.split("\n\n![")[0])
+    if not args.modes_only:
+        print(f"\nrecommended: {a['recommended']} ({a['recommended_reason']}); "
+              f"scene's setting: {scene_setting_text(a)}")
     print("wrote " + ", ".join(str(p) for p in paths))
     return 0
 

@@ -555,18 +555,20 @@ class RotorDropEnv(gym.Env):
 
     # ---------------------------------------------------------------------- rendering --
     def _record(self, step: bool = True) -> None:
-        """One row of the episode view (``rotordrop_env.render.COLUMNS``) and the orbit at the
-        step's monitor samples (at reset: the present state only)."""
+        """One row of the episode view (``rotordrop_env.render.COLUMNS``) and the orbits at the
+        step's monitor samples (at reset: the present state only): the rotor axis at the
+        retainer planes, a flexible rotor's elastic deflection included."""
         b = self._b
         y, M, model = b.y, b.M, self.model
-        axis = model.rotor_axis_indices()               # x, y, a, b of the rotor
         damping = ((y[model.state_index("RB1.Cs")], y[model.state_index("RB2.Cs")])
                    if model.has_state("RB1.Cs") else (math.nan, math.nan))
         amb = (M[K.M_POWER], M[K.M_CTRL_ON]) if self._relevitate else (math.nan, math.nan)
+        states = b.Y_sub if step else y[None]
+        orbit = np.empty((len(states), 4))              # the axis at RB1, RB2 (elastic included)
+        K.retainer_orbits(states, b.P, b.I, orbit)
         self._renderer.add((self.time, b.out[K.O_FORCE], y[model.state_index("Omega")],
                             M[K.M_REV1], M[K.M_REV2],
-                            M[K.M_WHIRL], *damping, *amb),
-                           b.Y_sub[:, axis] if step else y[None, axis])
+                            M[K.M_WHIRL], *damping, *amb), orbit)
 
     def render(self):
         self._check_open("render")
@@ -588,8 +590,7 @@ class RotorDropEnv(gym.Env):
 
     def _reset_view(self) -> None:
         s = self.scene
-        self._ensure_renderer().reset(s.contact.friction, s.contact.clearance, s.amb.air_gap,
-                                      self.model.retainer_z())
+        self._ensure_renderer().reset(s.contact.friction, s.contact.clearance, s.amb.air_gap)
 
     def close(self):
         """Release the view; afterwards reset(), step() and render() raise

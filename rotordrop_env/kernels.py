@@ -206,6 +206,18 @@ def orbit_frame(y, P, I, k):
 
 
 @njit
+def retainer_orbits(Y, P, I, out):
+    """The rotor axis (x, y) at retainer plane 1 and 2 in each state row of ``Y``, a flexible
+    rotor's elastic motion included (:func:`physics.model.axis_motion`): ``out[j] = (x1, y1, x2,
+    y2)`` [m], the episode view's orbits (:mod:`rotordrop_env.render`)."""
+    for j in range(Y.shape[0]):
+        for k in range(2):
+            px, py, _, _ = axis_motion(Y[j], P, I, ST_RB1 + k)
+            out[j, 2 * k] = px
+            out[j, 2 * k + 1] = py
+
+
+@njit
 def supervise(a, o, U, C):
     """The supervisor's commands (action entries o: gain, o+1...o+4: radial and tangential
     offset of AMB plane 1 and 2) onto the built-in PID: gain scale 2^(a C_SUP_OCTAVES), reference

@@ -18,8 +18,6 @@ from pathlib import Path
 
 import numpy as np
 
-from physics.rotor import axis_at
-
 #: one recorded row per control step (SI units, NaN where the environment lacks the quantity)
 COLUMNS = ("t", "force", "speed", "rev1", "rev2", "whirl", "damping1", "damping2", "amb_power",
            "controller_on")
@@ -55,14 +53,13 @@ class Renderer:
         self.episode_time = episode_time
         self.rows = np.full((n_steps + 1, len(COLUMNS)), np.nan)
         self.n = 0
-        #: the rotor's centre and tilt (x, y, a, b: physics.model's state entries) at the
-        #: monitor samples, samples_per_step per step: the orbit at any axial station
+        #: the rotor axis at the retainer planes (x1, y1, x2, y2 [m]; a flexible rotor's
+        #: elastic deflection included) at the monitor samples, samples_per_step per step
         self.orbit = np.full((n_steps * samples_per_step + 1, 4), np.nan)
         self.n_orbit = 0
         self.trail = TRAIL * samples_per_step
         self.friction = math.nan
         self.geometry = (0.0, 0.0)          # (clearance, air gap) [m] of this episode
-        self.planes = (0.0, 0.0)            # axial stations of the retainer bearings [m]
         self._cache: dict = {}              # fonts, background, human window: never copied
 
     def __getstate__(self) -> dict:
@@ -71,19 +68,17 @@ class Renderer:
         return state
 
     # ------------------------------------------------------------------------ recording --
-    def reset(self, friction: float, clearance: float, air_gap: float,
-              planes: tuple[float, float]) -> None:
-        """Start a new episode view (μ, the circles and the retainer planes of the scene)."""
+    def reset(self, friction: float, clearance: float, air_gap: float) -> None:
+        """Start a new episode view (μ and the circles of the scene)."""
         self.n = self.n_orbit = 0
         self.rows[:] = np.nan
         self.orbit[:] = np.nan
         self.friction = float(friction)
         self.geometry = (float(clearance), float(air_gap))
-        self.planes = (float(planes[0]), float(planes[1]))
 
     def add(self, row, orbit: np.ndarray) -> None:
-        """One step's values in :data:`COLUMNS` order, and the rotor's (x, y, a, b) at the
-        step's monitor samples ((k, 4))."""
+        """One step's values in :data:`COLUMNS` order, and the rotor axis at the retainer
+        planes (x1, y1, x2, y2) at the step's monitor samples ((k, 4))."""
         if self.n == self.rows.shape[0]:    # stepping on after the episode's end
             self.rows = _grow(self.rows)
         while self.n_orbit + len(orbit) > self.orbit.shape[0]:
@@ -175,7 +170,7 @@ class Renderer:
         n, trail = len(orbit), self.trail
         for k, left in enumerate(PANELS):
             cx = left + ORBIT / 2
-            x, y = axis_at.py_func(self.planes[k], *orbit.T)
+            x, y = orbit[:, 2 * k], orbit[:, 2 * k + 1]
             pts = np.empty((n, 2))
             pts[:, 0] = cx + x * scale
             pts[:, 1] = cy - y * scale

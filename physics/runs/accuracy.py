@@ -12,6 +12,12 @@ The peaks are extremes over the whole run, so in a drop whose late motion is cha
 not converged even at the reference tolerance. Such drops are detected (reference and a 10x
 looser run disagree by more than ``CHAOS_REL``) and excluded from the whole-run criterion of the
 recommended setting; the first-20-ms quantities are judged for every drop.
+
+For a flexible rotor (``rotor.model = "flexible"``) ``--modes`` adds what the retained elastic
+modes cost: the same drops with 0, 1, 2, ... free-free bending modes (``flexible.mode_cutoff_hz``
+set between two bending frequencies of the scene's shaft), with and without the static
+correction modes (``flexible.static_modes``), at the scene's own solver setting, each scored
+against the run with the most modes (wall time, steps, right-hand-side evaluations, errors).
 """
 from __future__ import annotations
 
@@ -42,6 +48,11 @@ EXTREMES = (             # whole-run peaks scored against the reference: (error 
     ("peak_bearing_load", "peak_bearing_load_N"), ("max_ball_load", "max_ball_load_N"),
 )
 WHOLE_KEYS = tuple(f"{name}_rel" for name, _ in EXTREMES)
+#: bending modes per plane of the --modes sweep (each with and without the static correction
+#: modes; capped at what the packed arrays hold, physics.flexible.floating.MAX_MODES, whose
+#: largest count is always run: the sweep's reference)
+MODE_COUNTS = (0, 1, 2, 3, 5, 8, 12, 19)
+QUICK_MODE_COUNTS = (0, 2, 5, 19)
 
 
 class AccuracyError(SceneError):
@@ -51,8 +62,9 @@ class AccuracyError(SceneError):
 @dataclass(frozen=True)
 class Setting:
     label: str
-    kind: str                 # reference | adaptive | fixed | reduced
+    kind: str                 # reference | adaptive | fixed | reduced | modes
     overrides: dict
+    info: dict | None = None  # kind modes: the retained modes (mode_info)
 
     @property
     def full_fidelity(self) -> bool:
@@ -104,7 +116,10 @@ def accuracy_observables(result) -> dict:
                 force={p: result.contact_force(p)[sel].tolist() for p in ("RB1", "RB2")})
 
 
-def plan_runs(plan: AccuracyPlan, source: str, overrides: dict):
+def plan_runs(plan: AccuracyPlan, source: str, overrides: dict, modes: tuple[int, ...] = (),
+              tolerances: bool = True):
+    """The settings (tolerance rows, then mode rows) and their runs, every setting on the same
+    perturbed drops."""
     from ..scene import load_scene
     from .study.ensemble import perturbations
     from .sweep import Run
@@ -112,10 +127,125 @@ def plan_runs(plan: AccuracyPlan, source: str, overrides: dict):
     check_fault_in_span(scene, plan)
     members = perturbations(plan.members, scene.amb.off_time, plan.seed)
     extra = {} if plan.t_end is None else {"solver.t_end": plan.t_end}
-    rows = settings(plan, scene)
+    rows = (settings(plan, scene) if tolerances else []) + (mode_settings(scene, modes) if modes else [])
     runs = [Run.of(source, {**overrides, **extra, **m, **s.overrides}, setting=s.label, member=k)
             for s in rows for k, m in enumerate(members)]
     return rows, runs
+
+
+# ------------------------------------------------------------------------ elastic modes --
+def bending_frequencies(scene) -> np.ndarray:
+    """The free-free bending frequencies [Hz] of the scene's flexible shaft, ascending, on the
+    mesh the drop's reduction uses (physics/flexible/shafts.py: centred, force stations as
+    nodes)."""
+    import dataclasses
+    from ..flexible.assembly import assemble
+    from ..flexible.floating import planar_dofs
+    from ..flexible.modal import generalized_eigh
+    from ..flexible.shafts import centred, load_shaft
+    f, p = scene.flexible, scene.positions
+    rotor = dataclasses.replace(centred(load_shaft(f.shaft), f.modulus_scale, f.element_length),
+                                retainer_planes=(p.rb1, p.rb2), amb_planes=(p.amb1, p.amb2),
+                                unbalance_planes=(scene.unbalance.z,))
+    fe = assemble(rotor)
+    xp, _ = planar_dofs(fe)
+    lam, _ = generalized_eigh(fe.K[np.ix_(xp, xp)], fe.M[np.ix_(xp, xp)])
+    return np.sqrt(np.clip(lam[2:], 0.0, None)) / (2.0 * np.pi)     # the two rigid modes off
+
+
+def cutoff_for(freqs: np.ndarray, n: int) -> float:
+    """A ``flexible.mode_cutoff_hz`` that keeps exactly the ``n`` lowest bending modes (the
+    geometric mean of the n-th and the next frequency; half the first for none)."""
+    if n == 0:
+        return float(0.5 * freqs[0])
+    return float(np.sqrt(freqs[n - 1] * freqs[n]))
+
+
+def mode_info(scene) -> dict:
+    """The retained elastic modes of a flexible scene: bending and static correction modes per
+    plane, all of them, the highest modal frequency [Hz] (0 without modes)."""
+    from ..flexible.shafts import drop_rotor
+    fm = drop_rotor(scene)
+    return dict(bending=fm.n_bending, static=fm.n_correction, modes=fm.n_modes,
+                highest_mode_hz=float(fm.omega.max() / (2 * np.pi)) if fm.n_modes else 0.0)
+
+
+def mode_counts(text: str | None, quick: bool) -> tuple[int, ...]:
+    """``--modes`` as typed: ``auto`` (:data:`MODE_COUNTS`, quick: :data:`QUICK_MODE_COUNTS`)
+    or comma-separated bending-mode counts."""
+    if text is None:
+        return ()
+    if text == "auto":
+        return QUICK_MODE_COUNTS if quick else MODE_COUNTS
+    try:
+        counts = tuple(sorted({int(v) for v in text.split(",")}))
+    except ValueError:
+        raise AccuracyError(f"--modes {text}: allowed 'auto' or comma-separated bending-mode "
+                            f"counts, e.g. 0,2,5") from None
+    if not counts or counts[0] < 0:
+        raise AccuracyError(f"--modes {text}: the counts must be >= 0")
+    return counts
+
+
+def mode_settings(scene, counts: tuple[int, ...]) -> list[Setting]:
+    """The --modes rows: each bending-mode count with the static correction modes, then
+    without; the most the packed arrays hold is always among them (the sweep's reference,
+    with the static modes: the first row)."""
+    from ..flexible.floating import MAX_MODES
+    if scene.rotor.model != "flexible":
+        raise AccuracyError(f"--modes: rotor.model = {scene.rotor.model!r}: the mode sweep needs a"
+                            f" flexible rotor (rotor.model = 'flexible', e.g. --scene paper-flexible)")
+    freqs = bending_frequencies(scene)
+    out = []
+    for static in (True, False):
+        probe = mode_info(scene.with_overrides({"flexible.mode_cutoff_hz": cutoff_for(freqs, 0),
+                                                "flexible.static_modes": static}))
+        most = min(MAX_MODES - probe["static"], len(freqs) - 1)
+        if max(counts) > most:
+            raise AccuracyError(f"--modes {','.join(map(str, counts))}: allowed at most {most}"
+                                f" bending modes {'with' if static else 'without'} the"
+                                f" {probe['static']} static correction modes (at most"
+                                f" {MAX_MODES} elastic modes per plane)")
+        rows = []
+        for n in sorted(set(counts) | {most if static else max(counts)}, reverse=True):
+            ov = {"flexible.mode_cutoff_hz": cutoff_for(freqs, n), "flexible.static_modes": static}
+            info = mode_info(scene.with_overrides(ov))
+            assert info["bending"] == n, (n, info)
+            bending = f"{n} bending mode" + ("" if n == 1 else "s")
+            label = f"{n} bending + {info['static']} static modes" if static else \
+                f"{bending}, no static"
+            rows.append(Setting(label, "modes", ov, info))
+        out += rows
+    return out
+
+
+def analyse_modes(plan: AccuracyPlan, rows: list[Setting], outcomes: list) -> dict:
+    """Cost and errors of each mode row against the row with the most modes (the first), drop
+    by drop; whole-run errors over every drop (the runs differ in their model, not in their
+    integration: no drop is left out as chaotic, so a late whirl's peaks may dominate)."""
+    by = {(o.run.label["setting"], o.run.label["member"]): o for o in outcomes}
+    ref_row = rows[0]
+    refs = {k: by[(ref_row.label, k)] for k in range(plan.members)}
+    bad = [k for k, o in refs.items() if not o.ok]
+    if bad:
+        raise AccuracyError(f"the mode sweep's reference ({ref_row.label}) failed for drop(s) "
+                            f"{', '.join(map(str, bad))}: {refs[bad[0]].error.splitlines()[0]}")
+    table = []
+    for s in rows:
+        runs = [by[(s.label, k)] for k in range(plan.members)]
+        per = [dict(member=k, wall_time_s=o.metrics["wall_time_s"], steps=o.metrics["steps"],
+                    rhs_evaluations=o.metrics["rhs_evaluations"], chaotic=False, **score(o, refs[k]))
+               for k, o in enumerate(runs) if o.ok]
+        row = dict(setting=s.label, kind=s.kind, overrides=s.overrides, **s.info,
+                   failed=[dict(member=k, error=o.error.splitlines()[0])
+                           for k, o in enumerate(runs) if not o.ok])
+        if per:
+            row.update(wall_time_s=float(np.median([p["wall_time_s"] for p in per])),
+                       steps=int(np.median([p["steps"] for p in per])),
+                       rhs_evaluations=int(np.median([p["rhs_evaluations"] for p in per])),
+                       errors=_aggregate(per, []), per_member=per)
+        table.append(row)
+    return dict(reference=ref_row.label, rows=table, members=plan.members)
 
 
 def check_fault_in_span(scene, plan: AccuracyPlan) -> None:
@@ -408,19 +538,133 @@ def scene_setting_text(a: dict) -> str:
     return own + (f" (row '{s['row']}')" if s["row"] else " (not among the rows)")
 
 
+# ------------------------------------------------------------------------ mode outputs --
+MODE_COLUMNS = ("setting", "bending", "static", "modes", "highest_mode_hz", "wall_time_s", "steps",
+                "rhs_evaluations", "peak_contact_force_rel", "max_displacement_rel",
+                "early_peak_force_rel", "trajectory_um", "whirl_agreement")
+
+
+def _mode_value(r: dict, key: str):
+    if key in r:
+        return r[key]
+    e = r.get("errors")
+    if e is None:
+        return None
+    return e[key] if key == "whirl_agreement" else e[key]["max"]
+
+
+def write_mode_outputs(m: dict, out: Path, meta: dict) -> list[Path]:
+    """modes.csv (one row per mode setting, worst errors over the drops) and modes.png (error
+    against wall time, and steps against the number of modes)."""
+    import csv
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    out.mkdir(parents=True, exist_ok=True)
+    paths = [out / "modes.csv", out / "modes.png"]
+    with paths[0].open("w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(MODE_COLUMNS)
+        for r in m["rows"]:
+            w.writerow(["" if (v := _mode_value(r, k)) is None else v for k in MODE_COLUMNS])
+    rows = [r for r in m["rows"] if "errors" in r]
+    fig, axes = plt.subplots(1, 2, figsize=(13, 5), constrained_layout=True)
+    for static, mk, name in ((True, "C0o-", "with static correction modes"),
+                             (False, "C1s--", "bending modes only")):
+        sel = sorted((r for r in rows if (r["static"] > 0) == static), key=lambda r: r["modes"])
+        if not sel:
+            continue
+        scored = [r for r in sel if r["setting"] != m["reference"]]   # error 0 by definition
+        err = [max(100 * (_mode_value(r, "peak_contact_force_rel") or 0.0), FLOOR) for r in scored]
+        axes[0].plot([r["wall_time_s"] for r in scored], err, mk, label=name, ms=6)
+        for r, v in zip(scored, err):
+            axes[0].annotate(f"{r['bending']}+{r['static']}", (r["wall_time_s"], v), fontsize=7,
+                             xytext=(3, 2), textcoords="offset points")
+        axes[1].plot([r["modes"] for r in sel], [r["steps"] for r in sel], mk, label=name, ms=6)
+        for r in sel:
+            axes[1].annotate(f"{r['highest_mode_hz'] / 1e3:.1f} kHz", (r["modes"], r["steps"]),
+                             fontsize=7, xytext=(3, -9), textcoords="offset points")
+    axes[0].set_xscale("log")
+    axes[0].set_yscale("log")
+    axes[0].set_xlabel("wall time per run [s] (median)")
+    axes[0].set_ylabel("peak contact force error, whole run [%] (worst drop)")
+    axes[1].set_xlabel("elastic modes per bending plane (bending + static; labels: the highest"
+                       " mode's frequency)")
+    axes[1].set_ylabel("integration steps per run (median)")
+    for ax in axes:
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle(f"What the elastic modes cost: scene {meta['scene']}, {m['members']} drops, "
+                 f"{meta['t_end']:g} s simulated each, errors against {m['reference']}")
+    fig.savefig(paths[1], dpi=110)
+    plt.close(fig)
+    return paths
+
+
+def modes_markdown(m: dict, meta: dict) -> str:
+    L = ["## Retained elastic modes\n",
+         f"The same {m['members']} drops on the flexible rotor with fewer elastic modes per bending "
+         f"plane (`flexible.mode_cutoff_hz` between two free-free bending frequencies, "
+         f"`flexible.static_modes` on and off), at the scene's own solver setting; errors against "
+         f"the run with the most modes ({m['reference']}), worst over the drops. The highest "
+         f"retained mode sets the explicit integrator's step: what a mode costs is its "
+         f"frequency.\n",
+         "| modes | bending | static | highest mode [Hz] | wall per run [s] | steps | rhs "
+         "evaluations | peak force err, whole run [%] | max disp err [%] | early peak force err "
+         "[%] | orbit err, 20 ms [µm] | whirl decision agrees |",
+         "|---" * 12 + "|"]
+    for r in m["rows"]:
+        head = f"| {r['setting']} | {r['bending']} | {r['static']} | {r['highest_mode_hz']:.0f} | "
+        if "errors" not in r:
+            L.append(head + f"failed: {r['failed'][0]['error']} " + "|" * 8)
+            continue
+        e = r["errors"]
+        pct = lambda k: "–" if e[k]["max"] is None else f"{100 * e[k]['max']:.3g}"  # noqa: E731
+        um = "–" if e["trajectory_um"]["max"] is None else f"{e['trajectory_um']['max']:.3g}"
+        fail = f" ({len(r['failed'])} failed)" if r["failed"] else ""
+        L.append(head + f"{r['wall_time_s']:.3f}{fail} | {r['steps']} | {r['rhs_evaluations']} | "
+                 f"{pct('peak_contact_force_rel')} | {pct('max_displacement_rel')} | "
+                 f"{pct('early_peak_force_rel')} | {um} | {100 * e['whirl_agreement']:.0f} % |")
+    L += ["", "![Cost of the elastic modes](modes.png)", ""]
+    return "\n".join(L)
+
+
 # ---------------------------------------------------------------------------------- CLI --
 def run_accuracy(source: str, overrides: dict, out_dir, quick: bool = False,
-                 jobs: int | None = None, progress: bool = True) -> tuple[dict, list[Path]]:
+                 jobs: int | None = None, progress: bool = True, modes: tuple[int, ...] = (),
+                 tolerances: bool = True) -> tuple[dict, list[Path]]:
+    """The accuracy study of a scene: solver settings and reduced models against a tight
+    reference (``tolerances``), and with ``modes`` (bending-mode counts, a flexible rotor) the
+    cost of the retained elastic modes; outputs in ``out_dir``."""
     from ..scene import load_scene
     from .sweep import run_sweep
+    if not tolerances and not modes:
+        raise AccuracyError("--modes-only needs mode counts (--modes)")
     plan = AccuracyPlan.make(quick)
-    rows, runs = plan_runs(plan, source, overrides)
+    rows, runs = plan_runs(plan, source, overrides, modes, tolerances)
     t0 = time.perf_counter()
     outcomes = run_sweep(runs, accuracy_observables, jobs=jobs, desc="accuracy", progress=progress)
-    a = analyse(plan, rows, outcomes)
     scene = load_scene(source, overrides)
-    a["scene_setting"] = scene_setting(scene, rows)
+    solver_rows = [r for r in rows if r.kind != "modes"]
+    a = dict(rows=[], recommended=None)
+    if tolerances:
+        a = analyse(plan, solver_rows, outcomes)
+        a["scene_setting"] = scene_setting(scene, solver_rows)
+    if modes:
+        a["modes"] = analyse_modes(plan, [r for r in rows if r.kind == "modes"], outcomes)
     meta = dict(scene=source, overrides=overrides, quick=quick,
                 t_end=plan.t_end if plan.t_end is not None else scene.solver.t_end,
                 wall_time_s=time.perf_counter() - t0)
-    return a, write_outputs(a, Path(out_dir), meta)
+    out = Path(out_dir)
+    if tolerances:
+        paths = write_outputs(a, out, meta)
+    else:
+        out.mkdir(parents=True, exist_ok=True)
+        paths = [out / "accuracy.json", out / "accuracy.md"]
+        paths[0].write_text(json.dumps({**a, **meta}, indent=1, default=float))
+        paths[1].write_text(f"# Elastic modes and cost: scene `{meta['scene']}`\n\n")
+    if modes:
+        paths[1].write_text(paths[1].read_text() + "\n" + modes_markdown(a["modes"], meta))
+        paths += write_mode_outputs(a["modes"], out, meta)
+    return a, paths

@@ -58,3 +58,27 @@ def test_batched_env_errors_and_factory():
 def test_checkers_pass_on_the_batched_envs_single_counterpart():
     venv = BatchedRotorDropVecEnv("RotorDrop-Full-v1", 2, seed=0, episode_time=0.004)
     run_env_checkers(lambda: venv.envs[0])
+
+
+def test_a_batch_of_flexible_rotors_equals_single_envs():
+    """machine-flexible (7 elastic modes per plane, randomised machines): the batch steps each
+    row as the single environment of the same seed, through SB3's auto-reset."""
+    n, steps = 3, 8
+    kw = dict(scene="machine-flexible", episode_time=0.005, randomize=True)
+    venv = make_batched("RotorDrop-Damping-v1", n, seed=3, n_threads=2, **kw)
+    assert venv.envs[0].model.elastic_modes == 7
+    acts = _actions(n, steps, seed=1)
+    obs0 = venv.reset()
+    batched = [venv.step(acts[k]) for k in range(steps)]
+    for e in range(n):
+        env = gym.make("RotorDrop-Damping-v1", **kw)
+        obs, _ = env.reset(seed=3 + e)
+        assert np.array_equal(obs, obs0[e])
+        for k in range(steps):
+            obs, r, term, trunc, info = env.step(acts[k, e])
+            b_obs, b_r, b_done, b_info = batched[k]
+            assert b_r[e] == np.float32(r) and b_done[e] == (term or trunc)
+            if term or trunc:
+                assert np.array_equal(b_info[e]["terminal_observation"], obs)
+                obs, _ = env.reset()
+            assert np.array_equal(b_obs[e], obs)

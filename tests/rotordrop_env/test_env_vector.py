@@ -195,3 +195,33 @@ def test_the_vector_env_set_attr_call_and_errors():
         envs.step(np.full((2, 2), 2.0, np.float32))
     with pytest.raises(ValueError, match="max_episode_steps"):
         make_vec("RotorDrop-Damping-v1", 2, max_episode_steps=3)
+
+
+def test_a_flexible_vector_env_steps_as_single_envs_episode_by_episode():
+    """make_vec with the paper-flexible scene (supervisor Full, random scenarios): each row is
+    the single environment of the same seed, through the auto-resets."""
+    n, steps = 3, 8
+    kw = dict(scene="paper-flexible", command="supervisor", randomize=True, episode_time=0.004)
+    envs = make_vec("RotorDrop-Full-v1", n, **kw)
+    singles = [gym.make("RotorDrop-Full-v1", **kw) for _ in range(n)]
+    assert envs.unwrapped.envs[0].model.elastic_modes == 7
+    obs, info = envs.reset(seed=9)
+    for e, env in enumerate(singles):
+        o, i = env.reset(seed=9 + e)
+        assert np.array_equal(obs[e], o)
+        _compare_info(info, e, i)
+    rng = np.random.default_rng(2)
+    ends = 0
+    for _ in range(steps):
+        a = rng.uniform(-1, 1, (n, 8)).astype(np.float32)
+        obs, rew, term, trunc, info = envs.step(a)
+        for e, env in enumerate(singles):
+            o, r, t, tr, i = env.step(a[e])
+            assert (rew[e], term[e], trunc[e]) == (r, t, tr)
+            if t or tr:
+                ends += 1
+                assert np.array_equal(info["final_obs"][e], o)
+                o, i = env.reset()
+            assert np.array_equal(obs[e], o)
+            _compare_info(info, e, i)
+    assert ends == 2 * n                             # every row ended at the time limit twice

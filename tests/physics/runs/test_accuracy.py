@@ -4,7 +4,10 @@ import json
 
 import pytest
 
-from physics.runs.accuracy import TOLERANCE, recommend
+from physics import compute_metrics, load_scene, simulate
+from physics.runs.accuracy import (TOLERANCE, AccuracyPlan, accuracy_observables, analyse_modes,
+                                   bending_frequencies, plan_runs, recommend)
+from physics.runs.sweep import run_sweep
 from agents.cli import main as cli_main
 from physics.scene import Scene
 
@@ -150,3 +153,85 @@ def test_recommend_takes_the_cheapest_setting_within_one_percent():
             _row("cheap-model", "reduced", 5, 0.0, 0.0)]
     assert recommend(rows)[0] == "ok"
     assert recommend(rows[:2])[0] is None
+
+
+# ------------------------------------------------------------------------ elastic modes --
+TINY = AccuracyPlan(1, 0.2, 1e-9, (1e-4,), (2e-5,))
+
+
+@pytest.fixture(scope="module")
+def modes_sweep():
+    """The mode sweep of paper-flexible with 0 and 2 bending modes, one drop of 0.2 s."""
+    rows, runs = plan_runs(TINY, "paper-flexible", {}, modes=(0, 2), tolerances=False)
+    outcomes = run_sweep(runs, accuracy_observables, jobs=2, progress=False)
+    return rows, outcomes, analyse_modes(TINY, rows, outcomes)
+
+
+def test_the_mode_sweep_keeps_the_asked_modes_and_takes_the_most_as_reference(modes_sweep):
+    rows, _, m = modes_sweep
+    got = [(r["bending"], r["static"]) for r in m["rows"]]
+    assert got == [(19, 5), (2, 5), (0, 5), (2, 0), (0, 0)]         # 24 = MAX_MODES first
+    assert m["reference"] == rows[0].label == "19 bending + 5 static modes"
+    ref = m["rows"][0]
+    assert ref["errors"]["peak_contact_force_rel"]["max"] == 0.0
+    assert ref["errors"]["trajectory_um"]["max"] == 0.0
+    freqs = bending_frequencies(load_scene("paper-flexible"))
+    assert freqs[0] == pytest.approx(740.5, abs=1.0)                  # the preset's first mode
+    for r in m["rows"]:
+        assert not r["failed"] and r["modes"] == r["bending"] + r["static"]
+
+
+def test_what_the_modes_cost_and_what_they_buy(modes_sweep):
+    """The highest retained mode sets the explicit integrator's step: more and higher modes,
+    more steps. Without any mode the flexible rotor is the rigid one and misses the shaft's
+    compliance in the impact (a peak force several % too high); two bending modes with the
+    static correction modes are within a fraction of a percent of the reference."""
+    _, _, m = modes_sweep
+    r = {(x["bending"], x["static"]): x for x in m["rows"]}
+    assert r[(19, 5)]["steps"] > r[(2, 5)]["steps"] > r[(0, 0)]["steps"]
+    assert r[(2, 5)]["highest_mode_hz"] > r[(2, 0)]["highest_mode_hz"] == pytest.approx(1042, abs=2)
+    err = {k: x["errors"]["early_peak_force_rel"]["max"] for k, x in r.items()}
+    assert err[(0, 0)] > 0.05 and err[(2, 5)] < 0.005
+    assert err[(0, 0)] > err[(2, 0)] and err[(0, 0)] > err[(0, 5)]
+
+
+def test_the_flexible_rotor_without_modes_drops_as_the_rigid_rotor(modes_sweep):
+    """0 bending modes, no static modes: no elastic state, and the drop is the rigid paper
+    rotor's to the last bit (the same perturbed drop of the paper preset)."""
+    _, outcomes, _ = modes_sweep
+    o = next(o for o in outcomes if o.run.label["setting"] == "0 bending modes, no static")
+    rigid = {k: v for k, v in o.run.settings.items() if not k.startswith("flexible.")}
+    m = compute_metrics(simulate(load_scene("paper", rigid)))
+    assert o.metrics["steps"] == m["steps"]
+    for p in ("RB1", "RB2"):
+        assert o.metrics["planes"][p]["peak_contact_force_N"] == m["planes"][p]["peak_contact_force_N"]
+
+
+def test_accuracy_modes_from_the_command_line(tmp_path, monkeypatch, capsys):
+    """`accuracy --modes-only --modes 0`: the table, modes.csv and modes.png; the solver study
+    and the mode sweep in one run write both tables; a rigid scene or a bad count is one line."""
+    monkeypatch.setattr(AccuracyPlan, "make", classmethod(lambda cls, quick=False: TINY))
+    out = tmp_path / "modes"
+    assert cli_main(["accuracy", "--scene", "machine-flexible", "--modes-only", "--modes", "0",
+                     "--jobs", "2", "--quiet", "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "| 0 bending modes, no static | 0 | 0 |" in printed and "recommended" not in printed
+    a = json.loads((out / "accuracy.json").read_text())
+    assert [r["bending"] for r in a["modes"]["rows"]] == [19, 0, 0]
+    lines = (out / "modes.csv").read_text().splitlines()
+    assert lines[0].startswith("setting,bending,static,modes,highest_mode_hz,wall_time_s,steps")
+    assert len(lines) == 4 and (out / "modes.png").stat().st_size > 10000
+    both = tmp_path / "both"
+    assert cli_main(["accuracy", "--scene", "machine-flexible", "--modes", "0", "--jobs", "2",
+                     "--quiet", "--out", str(both)]) == 0
+    text = (both / "accuracy.md").read_text()
+    assert "| adaptive rtol 0.0001" in text and "## Retained elastic modes" in text
+    assert (both / "pareto.png").is_file() and (both / "modes.png").is_file()
+    capsys.readouterr()
+    for args, match in ((["--scene", "paper", "--modes"], "needs a flexible rotor"),
+                        (["--scene", "paper-flexible", "--modes", "0,30"], "allowed at most 19"),
+                        (["--scene", "paper-flexible", "--modes", "two"], "comma-separated")):
+        assert cli_main(["accuracy", "--modes-only", "--quiet", "--out", str(tmp_path / "x")]
+                        + args) == 2
+        err = capsys.readouterr().err
+        assert match in err and err.count("\n") == 1, err

@@ -164,6 +164,25 @@ def test_one_node_ray_gives_the_local_numbers_of_the_paper_study_drops(tmp_path)
         assert without_timing(a.metrics) == without_timing(b.metrics) and a.extra == b.extra
 
 
+def test_a_flexible_rotor_study_on_ray_gives_the_local_numbers(tmp_path, monkeypatch):
+    """`study sweep --scene paper-flexible --backend ray` (a Ray started for the run): the
+    elastic modes travel as the scene's name, the workers rebuild the reduced rotor, and the
+    cells and per-drop metrics are the local backend's."""
+    pytest.importorskip("ray")
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]))
+    args = ["study", "sweep", "--scene", "paper-flexible", "--vary", "contact.friction=0.1,0.6",
+            "--members", "2", "--set", "solver.t_end=0.15", "--quiet", "--no-plots"]
+    assert cli_main(args + ["--out", str(tmp_path / "local")]) == 0
+    assert cli_main(args + ["--out", str(tmp_path / "ray"), "--backend", "ray"]) == 0
+    a, b = (json.loads((tmp_path / d / "sweep.json").read_text()) for d in ("local", "ray"))
+    assert b["backend"]["backend"] == "ray" and b["backend"]["tasks"] >= 1
+    assert a["cells"] == b["cells"] and len(b["runs"]) == 4
+    assert [without_timing(r["metrics"]) for r in a["runs"]] == \
+        [without_timing(r["metrics"]) for r in b["runs"]]
+    rest, whirl = b["cells"]                        # the high friction drives the rotor round
+    assert whirl["peak_contact_force_N"]["min"] > 2.0 * rest["peak_contact_force_N"]["max"]
+
+
 TINY = ("RotorDrop-Damping-v1:\n  n_steps: 64\n  batch_size: 64\n  n_epochs: 1\n  eval_freq: 0\n"
         "  checkpoint_freq: 0\n  env_kwargs:\n    episode_time: 0.02\n")
 

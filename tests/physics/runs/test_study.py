@@ -247,3 +247,20 @@ def test_parametric_sweep_over_three_keys_maps_the_first_two_per_value_of_the_th
     assert cell[(5e6, 0.1)] == cell[(5e7, 0.1)] == 0.0
     assert (out / "sweep_1.png").is_file() and (out / "sweep_2.png").is_file()
     assert not (out / "sweep.png").exists()
+
+
+def test_a_sweep_over_a_flexible_rotor_sees_its_softer_impact(tmp_path):
+    """`study sweep --scene paper-flexible`: the same decisions as the rigid paper rotor (rest at
+    mu = 0.1, whirl at mu = 0.6) and a softer first impact (the shaft's compliance in series
+    with the contact: a lower peak contact force in the resting cell); each run names its scene."""
+    args = ["study", "sweep", "--vary", "contact.friction=0.1,0.6", "--members", "2",
+            "--set", "solver.t_end=0.3", "--jobs", "2", "--quiet", "--no-plots"]
+    for scene in ("paper", "paper-flexible"):
+        assert cli_main(args + ["--scene", scene, "--out", str(tmp_path / scene)]) == 0
+    rigid, flex = (json.loads((tmp_path / s / "sweep.json").read_text())
+                   for s in ("paper", "paper-flexible"))
+    rest, whirl = flex["cells"]
+    assert rest["whirl_probability"] == 0.0 and whirl["whirl_probability"] == 1.0
+    assert all(run["ok"] and "--scene paper-flexible" in run["command"] for run in flex["runs"])
+    soft, stiff = rest["peak_contact_force_N"]["max"], rigid["cells"][0]["peak_contact_force_N"]["min"]
+    assert 0.8 * stiff < soft < 0.95 * stiff
