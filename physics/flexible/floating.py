@@ -89,9 +89,8 @@ def reduce_floating(fe: FEModel, omega_cut: float, static_modes: bool = True,
     z_cg = float((r1 @ M @ _tilt(z, 0.0)) / mass)
     r2 = _tilt(z, z_cg)
     R = np.column_stack([r1, r2])
-    lam, V = generalized_eigh(K, M)
-    wb = np.sqrt(np.clip(lam[2:], 0.0, None))
-    Phi = V[:, 2:][:, wb < omega_cut]
+    wb, Vb = free_free_bending(fe)
+    Phi = Vb[:, wb < omega_cut]
     cols = [Phi]
     nodes = sorted({fe.planes[s] for s in STATIONS if s in fe.planes})
     if static_modes:
@@ -121,6 +120,14 @@ def reduce_floating(fe: FEModel, omega_cut: float, static_modes: bool = True,
     return FloatingModel(fe, mass, float(r2 @ M @ r2), float(Gr[1, 1]), z_cg, omega, shape,
                          Gr[1, 2:].copy(), (Gr[2:, 2:] + Gr[2:, 2:].T) / 2, B,
                          int(Phi.shape[1]), n - int(Phi.shape[1]))
+
+
+def free_free_bending(fe: FEModel) -> tuple[np.ndarray, np.ndarray]:
+    """The free-free bending modes of one bending plane: frequencies (rad/s, ascending) and
+    shapes over (x, a) per node, M-normalised (the two rigid-body modes left out)."""
+    xp, _ = planar_dofs(fe)
+    lam, V = generalized_eigh(fe.K[np.ix_(xp, xp)], fe.M[np.ix_(xp, xp)])
+    return np.sqrt(np.clip(lam[2:], 0.0, None)), V[:, 2:]
 
 
 def _tilt(z: np.ndarray, z0: float) -> np.ndarray:

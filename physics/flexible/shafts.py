@@ -39,8 +39,10 @@ import tomllib
 from pathlib import Path
 
 from . import examples
-from .assembly import STEEL, Disk, FlexibleRotor, Material, ShaftSection, rigid_properties
-from .floating import MAX_MODES, FloatingModel, floating_model
+import numpy as np
+
+from .assembly import STEEL, Disk, FlexibleRotor, Material, ShaftSection, assemble, rigid_properties
+from .floating import MAX_MODES, FloatingModel, floating_model, free_free_bending
 
 #: built-in shafts by name
 BUILT_IN = {"paper": examples.paper_flexible, "machine": examples.machine_flexible}
@@ -128,9 +130,9 @@ def centred(shaft: FlexibleRotor, modulus_scale: float, element_length: float) -
                          max_element_length=element_length, shear=shaft.shear, name=shaft.name)
 
 
-@functools.lru_cache(maxsize=64)
-def _reduced(shaft: str, modulus_scale: float, element_length: float, stations: tuple,
-             unbalance_z: float, cutoff_hz: float, static_modes: bool) -> FloatingModel:
+def _station_rotor(shaft: str, modulus_scale: float, element_length: float, stations: tuple,
+                   unbalance_z: float) -> FlexibleRotor:
+    """The centred shaft with the scene's force stations (each checked to lie on it)."""
     base = centred(load_shaft(shaft), modulus_scale, element_length)
     rb1, rb2, amb1, amb2 = stations
     for key, z in (("positions.rb1", rb1), ("positions.rb2", rb2), ("positions.amb1", amb1),
@@ -138,19 +140,37 @@ def _reduced(shaft: str, modulus_scale: float, element_length: float, stations: 
         if not base.z_start - 1e-9 <= z <= base.z_end + 1e-9:
             raise ShaftError(f"{key} = {z:g}: allowed [{base.z_start:.4g}, {base.z_end:.4g}] m "
                              f"(on the shaft {shaft!r}, centre-of-mass frame)")
-    rotor = dataclasses.replace(base, retainer_planes=(rb1, rb2), amb_planes=(amb1, amb2),
-                                unbalance_planes=(unbalance_z,))
+    return dataclasses.replace(base, retainer_planes=(rb1, rb2), amb_planes=(amb1, amb2),
+                               unbalance_planes=(unbalance_z,))
+
+
+def _key(scene) -> tuple:
+    f, p = scene.flexible, scene.positions
+    return (f.shaft, f.modulus_scale, f.element_length, (p.rb1, p.rb2, p.amb1, p.amb2),
+            scene.unbalance.z)
+
+
+@functools.lru_cache(maxsize=64)
+def _reduced(key: tuple, cutoff_hz: float, static_modes: bool) -> FloatingModel:
     try:
-        return floating_model(rotor, 2.0 * math.pi * cutoff_hz, static_modes, MAX_MODES)
+        return floating_model(_station_rotor(*key), 2.0 * math.pi * cutoff_hz, static_modes,
+                              MAX_MODES)
+    except ShaftError:
+        raise
     except ValueError as exc:
         raise ShaftError(f"flexible.mode_cutoff_hz = {cutoff_hz:g}: {exc}") from None
 
 
+def bending_frequencies(scene) -> np.ndarray:
+    """The free-free bending frequencies [Hz] of the scene's shaft, ascending, on the mesh the
+    drop's reduction uses (every one, retained or not)."""
+    return free_free_bending(assemble(_station_rotor(*_key(scene))))[0] / (2.0 * math.pi)
+
+
 def drop_rotor(scene) -> FloatingModel:
     """The reduced flexible rotor of a scene with ``rotor.model = "flexible"`` (cached)."""
-    f, p = scene.flexible, scene.positions
-    return _reduced(f.shaft, f.modulus_scale, f.element_length, (p.rb1, p.rb2, p.amb1, p.amb2),
-                    scene.unbalance.z, f.mode_cutoff_hz, f.static_modes)
+    f = scene.flexible
+    return _reduced(_key(scene), f.mode_cutoff_hz, f.static_modes)
 
 
 def mass_properties(scene) -> dict:

@@ -134,25 +134,6 @@ def plan_runs(plan: AccuracyPlan, source: str, overrides: dict, modes: tuple[int
 
 
 # ------------------------------------------------------------------------ elastic modes --
-def bending_frequencies(scene) -> np.ndarray:
-    """The free-free bending frequencies [Hz] of the scene's flexible shaft, ascending, on the
-    mesh the drop's reduction uses (physics/flexible/shafts.py: centred, force stations as
-    nodes)."""
-    import dataclasses
-    from ..flexible.assembly import assemble
-    from ..flexible.floating import planar_dofs
-    from ..flexible.modal import generalized_eigh
-    from ..flexible.shafts import centred, load_shaft
-    f, p = scene.flexible, scene.positions
-    rotor = dataclasses.replace(centred(load_shaft(f.shaft), f.modulus_scale, f.element_length),
-                                retainer_planes=(p.rb1, p.rb2), amb_planes=(p.amb1, p.amb2),
-                                unbalance_planes=(scene.unbalance.z,))
-    fe = assemble(rotor)
-    xp, _ = planar_dofs(fe)
-    lam, _ = generalized_eigh(fe.K[np.ix_(xp, xp)], fe.M[np.ix_(xp, xp)])
-    return np.sqrt(np.clip(lam[2:], 0.0, None)) / (2.0 * np.pi)     # the two rigid modes off
-
-
 def cutoff_for(freqs: np.ndarray, n: int) -> float:
     """A ``flexible.mode_cutoff_hz`` that keeps exactly the ``n`` lowest bending modes (the
     geometric mean of the n-th and the next frequency; half the first for none)."""
@@ -192,6 +173,7 @@ def mode_settings(scene, counts: tuple[int, ...]) -> list[Setting]:
     without; the most the packed arrays hold is always among them (the sweep's reference,
     with the static modes: the first row)."""
     from ..flexible.floating import MAX_MODES
+    from ..flexible.shafts import bending_frequencies
     if scene.rotor.model != "flexible":
         raise AccuracyError(f"--modes: rotor.model = {scene.rotor.model!r}: the mode sweep needs a"
                             f" flexible rotor (rotor.model = 'flexible', e.g. --scene paper-flexible)")

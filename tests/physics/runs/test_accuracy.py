@@ -5,8 +5,9 @@ import json
 import pytest
 
 from physics import compute_metrics, load_scene, simulate
+from physics.flexible.shafts import bending_frequencies
 from physics.runs.accuracy import (TOLERANCE, AccuracyPlan, accuracy_observables, analyse_modes,
-                                   bending_frequencies, plan_runs, recommend)
+                                   plan_runs, recommend)
 from physics.runs.sweep import run_sweep
 from agents.cli import main as cli_main
 from physics.scene import Scene
