@@ -276,9 +276,11 @@ class Flexible:
                                  " section (1000: the stiff limit)", "A")
     mode_cutoff_hz: float = param(2000.0, "Hz", 0.0, 1e6, "free-free bending modes below this"
                                   " frequency are kept", "A")
-    static_modes: bool = param(True, "-", doc="add one static correction (inertia-relief"
+    static_modes: bool = param(False, "-", doc="add one static correction (inertia-relief"
                                " attachment) mode per force station, so that the local"
-                               " compliance under a contact force is exact", tag="A")
+                               " compliance under a contact force is exact; they are the"
+                               " highest modes and cost 2-5 x the steps (docs/accuracy.md:"
+                               " what they change; docs/scaling.md: what they cost)", tag="A")
     damping_ratio: float = param(0.005, "-", 0.0, 1.0, "modal damping ratio zeta of every"
                                  " elastic mode (assumed; steel rotors 0.001-0.01)", "A")
     element_length: float = param(0.025, "m", 1e-4, 10.0, "longest shaft finite element", "A")

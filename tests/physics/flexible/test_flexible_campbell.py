@@ -18,6 +18,9 @@ RPM = np.pi / 30
 HZ = 1 / (2 * np.pi)
 ROOT = Path(__file__).resolve().parents[3]
 UNDAMPED = {**campbell.SPRINGS_ONLY, "flexible.damping_ratio": 0.0}
+#: the static correction modes at the AMB nodes make the reduced model's support compliance
+#: exact: the reduced-vs-full checks keep them (the drop's default leaves them out)
+STATIC = {"flexible.static_modes": True}
 
 
 def signed(w, i, n):
@@ -28,7 +31,7 @@ def signed(w, i, n):
 def test_stiff_flexible_rotor_whirls_as_the_rigid_rotor(full):
     """E x 1000: the two forward and two backward rigid-body modes are the rigid rotor's
     (measured <= 1e-5, the shaft's residual compliance), and the bending modes are far above."""
-    scene = load_scene("machine-flexible", {**UNDAMPED, "flexible.modulus_scale": 1000.0})
+    scene = load_scene("machine-flexible", {**UNDAMPED, **STATIC, "flexible.modulus_scale": 1000.0})
     speeds = np.array([0.0, 10000.0, 30000.0]) * RPM
     w = campbell.flexible_whirl(scene, speeds, 3, full=full)
     for i, om in enumerate(speeds):
@@ -57,7 +60,7 @@ def test_reduced_model_whirls_as_the_full_fe_model(preset):
     running speed within 1e-4 and at 3 x it within 1e-3 (measured: machine 5e-5, paper 5.5e-4,
     its forward conical mode; the non-spinning modes of the basis approximate the gyroscopic
     ones)."""
-    scene = load_scene(preset)
+    scene = load_scene(preset, STATIC)
     for speeds, rtol in (([0.0, 10000.0], 1e-4), ([30000.0], 1e-3)):
         om = np.array(speeds) * RPM
         red = campbell.flexible_whirl(scene, om, 4)
@@ -94,7 +97,8 @@ def test_the_campbell_example_draws_a_flexible_scene(tmp_path):
     assert data["first_forward_bending_ratio"] == pytest.approx(2.41, abs=0.01)
     assert [r["rpm"] for r in data["speeds"]] == [0.0, 10000.0]
     assert max(r["max_rel_difference"] for r in data["speeds"]) < 1e-4
-    assert max(r["reduced_vs_full"] for r in data["speeds"]) < 1e-4
+    # the drop's default basis (bending modes only) against the full model: 1.2e-3, 1.6e-3
+    assert max(r["reduced_vs_full"] for r in data["speeds"]) < 2e-3
     header = (tmp_path / "campbell.csv").read_text().splitlines()[0].split(",")
     assert header[:3] == ["rpm", "forward_1_hz", "forward_1_damping_ratio"]
     assert (tmp_path / "campbell.png").stat().st_size > 10_000
