@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._jit import njit
+from ._jit import njit_borrow
 from .flexible.floating import MAX_MODES, STATIONS
 
 #: the scene keys this effect reads
@@ -78,7 +78,7 @@ def states(scene, I, layout, sizes, add) -> None:
     I[layout.index["state.elastic"]] = first
 
 
-@njit
+@njit_borrow
 def elastic_motion(y, P, i0, n, row):
     """Elastic displacement and velocity (dx, dy, dvx, dvy) of the axis at the station whose
     mode shapes start at P[row] (the modal states start at y[i0])."""
@@ -92,7 +92,7 @@ def elastic_motion(y, P, i0, n, row):
     return dx, dy, dvx, dvy
 
 
-@njit
+@njit_borrow
 def damping_power(y, P, i0, n, damp):
     """Power the modal damping takes out: sum 2 zeta omega (eta_x'^2 + eta_y'^2) [W]."""
     p = 0.0
@@ -102,7 +102,7 @@ def damping_power(y, P, i0, n, damp):
     return p
 
 
-@njit
+@njit_borrow
 def tilt_coupling(y, P, i0, n, g1):
     """g . eta_x' and g . eta_y': the elastic rates' gyroscopic share in the tilt equations."""
     cx = cy = 0.0
@@ -112,7 +112,7 @@ def tilt_coupling(y, P, i0, n, g1):
     return cx, cy
 
 
-@njit
+@njit_borrow
 def elastic_rates(y, P, i0, n, aux, a_force, w2, damp, shape, g1, gyro, Omega, va, vb, dy):
     """d/dt of the modal states (module docstring of physics/flexible/floating.py); the station
     forces are aux[a_force + 2 s], aux[a_force + 2 s + 1]; Omega = 0 switches the gyroscopic
@@ -142,7 +142,7 @@ def elastic_rates(y, P, i0, n, aux, a_force, w2, damp, shape, g1, gyro, Omega, v
         dy[i0 + 3 * n + j] = ay
 
 
-@njit
+@njit_borrow
 def elastic_energy(y, P, i0, n, w2):
     """Strain + kinetic energy of the elastic modes: sum (omega^2 eta^2 + eta'^2) / 2 [J]."""
     e = 0.0

@@ -338,7 +338,7 @@ def build_model(scene: Scene) -> Model:
 
 
 # ------------------------------------------------------------------------------- kernels --
-@njit
+@njit_borrow
 def axis_motion(y, P, I, s):
     """Rotor axis position and velocity (px, py, vx, vy) at force station s (``ST_RB1 + k``,
     ``ST_AMB1 + k``, ``ST_UB``; axial station P[P_Z_RB1 + s]): the rigid body's, plus the elastic
