@@ -101,10 +101,27 @@ def cmd_train(args) -> int:
     return 0
 
 
+def _evaluate_env_kwargs(args) -> dict:
+    """evaluate's env kwargs: ``--env-kwarg`` entries, then what --scene / --set /
+    --power-return-ms say (their ``overrides`` merged key by key; another key given both ways
+    is an error)."""
+    from .training.dataset import parse_env_kwargs
+    kw = parse_env_kwargs(args.env_kwarg)
+    for key, value in _env_kwargs(args).items():
+        if key == "overrides":
+            kw["overrides"] = {**(kw.get("overrides") or {}), **value}
+        elif key in kw:
+            raise ValueError(f"{key} is given twice, by --env-kwarg and by its own flag; keep one")
+        else:
+            kw[key] = value
+    return kw
+
+
 def cmd_evaluate(args) -> int:
     from .benchmarking.evaluate import evaluate, print_summary
     try:
-        report = evaluate(args.policy, args.env, args.episodes, args.out, env_kwargs=_env_kwargs(args),
+        report = evaluate(args.policy, args.env, args.episodes, args.out,
+                          env_kwargs=_evaluate_env_kwargs(args),
                           seed=args.seed, plots=not args.no_plots, compare_passive=not args.no_passive,
                           randomize=not args.fixed, video=args.video)
     except ERRORS as exc:
@@ -288,6 +305,10 @@ def register(sub) -> None:
     p.add_argument("--scene", default=None, help="scene preset or TOML (default: the env's)")
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="scene override (repeatable), e.g. contact.friction=0.4")
+    p.add_argument("--env-kwarg", action="append", default=[], metavar="KEY=VALUE",
+                   help="gym.make kwarg over the policy's own (repeatable; Python literals), "
+                        "e.g. sensor_noise=1e-6, sensor_delay=1e-4 (the sensing every controller "
+                        "and policy then sees)")
     _output_args(p, "out/evaluate", progress=False)
     p.add_argument("--no-passive", action="store_true", help="skip the passive reference runs")
     p.add_argument("--fixed", action="store_true",

@@ -1,5 +1,5 @@
 """Self-contained policy zips: plain ``PPO.load`` / ``SAC.load`` / ``TD3.load`` (and
-sb3-contrib's ``TQC.load``) act like the project's loader.
+sb3-contrib's ``TQC.load`` / ``CrossQ.load``) act like the project's loader.
 
 A policy trained by ``rotordrop train`` needs two things besides its network: the observation
 normalisation (``VecNormalize`` statistics) and, for a residual policy (config ``residual:``),
@@ -36,10 +36,11 @@ from stable_baselines3.common.policies import ActorCriticPolicy
 from stable_baselines3.sac.policies import SACPolicy
 from stable_baselines3.td3.policies import TD3Policy
 
-try:                                    # TQC is sb3-contrib's (the rl extra installs it)
+try:                                    # TQC and CrossQ are sb3-contrib's (the rl extra installs it)
+    from sb3_contrib.crossq.policies import CrossQPolicy
     from sb3_contrib.tqc.policies import TQCPolicy
 except ImportError:                     # pragma: no cover
-    TQCPolicy = None
+    TQCPolicy = CrossQPolicy = None
 
 #: the ``policy_kwargs`` entry that carries the environment, normalisation and residual
 KEY = "rotordrop"
@@ -186,13 +187,25 @@ if TQCPolicy is not None:
 
     POLICY_CLASSES[TQCPolicy] = RotorDropTQCPolicy
 
+if CrossQPolicy is not None:
+    class RotorDropCrossQPolicy(SelfContained, CrossQPolicy):
+        """CrossQ's (sb3-contrib) ``MlpPolicy`` with the normalisation and residual inside."""
+
+        def __init__(self, *args, rotordrop: dict | None = None, **kwargs):
+            super().__init__(*args, **kwargs)
+            self._setup_rotordrop(rotordrop)
+
+    POLICY_CLASSES[CrossQPolicy] = RotorDropCrossQPolicy
+
 
 #: the module of a plain SB3 model's policy class -> its algorithm
 PLAIN_MODULES = {"stable_baselines3.common.policies": "ppo", "stable_baselines3.sac.policies": "sac",
-                 "stable_baselines3.td3.policies": "td3", "sb3_contrib.tqc.policies": "tqc"}
+                 "stable_baselines3.td3.policies": "td3", "sb3_contrib.tqc.policies": "tqc",
+                 "sb3_contrib.crossq.policies": "crossq"}
 #: the self-contained policy classes -> their algorithm
 EXPORTED_ALGOS = {"RotorDropActorCriticPolicy": "ppo", "RotorDropSACPolicy": "sac",
-                  "RotorDropTD3Policy": "td3", "RotorDropTQCPolicy": "tqc"}
+                  "RotorDropTD3Policy": "td3", "RotorDropTQCPolicy": "tqc",
+                  "RotorDropCrossQPolicy": "crossq"}
 
 
 def current_env_id(env_id: str) -> str:
@@ -230,7 +243,7 @@ def _exported_class(policy) -> type:
         if type(policy) in (base, cls):
             return cls
     raise ValueError(f"cannot export a {type(policy).__name__}: only the MlpPolicy of PPO, SAC, "
-                     "TD3 and TQC is supported")
+                     "TD3, TQC and CrossQ is supported")
 
 
 def export_self_contained(model, vecnormalize, out_path: str | Path, *, env_id: str | None = None,

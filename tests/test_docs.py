@@ -44,6 +44,39 @@ def test_results_command_stores_benchmark_output_and_regenerates(tmp_path):
     assert results.main(["--root", str(root), "--check"]) == 1
 
 
+def test_results_command_builds_the_hard_algorithm_table(tmp_path, capsys):
+    """--hard-run (a run's kpis.json and run directory) and --hard-ref add rows to
+    docs/data/hard-table.json; an evaluation whose sensing is not the variant's is refused."""
+    root = tmp_path / "repo"
+    (root / "docs" / "img").mkdir(parents=True)
+    (root / "README.md").write_text(f"# x\n\n{results.START}\nold\n{results.END}\n")
+    ref = ROOT / "docs/data/hard-whirl-brake.json"
+    kpis = json.loads(ref.read_text())
+    for seed in (0, 1):
+        run = tmp_path / f"tqc-{seed}"
+        run.mkdir()
+        (run / "training.json").write_text(json.dumps(dict(
+            algo="tqc", seed=seed, timesteps=40000 + seed, wall_time_s=300.2, steps_per_s=133.3,
+            time_limit_s=300.0, command="rotordrop train ...", learning_curve=[
+                dict(timesteps=40000, wall_time_s=290.0, mean_relevitated=0.5)])))
+        kpis["policy"] = f"tqc-relevitate@tqc-{seed}/best"
+        (run / "kpis.json").write_text(json.dumps(kpis))
+        assert results.main(["--root", str(root), "--hard-run", "nominal", str(run / "kpis.json"),
+                             str(run)]) == 0
+    assert results.main(["--root", str(root), "--hard-ref", "nominal", str(ref)]) == 0
+    table = json.loads((root / "docs/data/hard-table.json").read_text())
+    assert [(r["algo"], r["seed"], r["model"]) for r in table["runs"]] == [("tqc", 0, "best"),
+                                                                            ("tqc", 1, "best")]
+    assert len(table["runs"][0]["relevitated"]) == 200 and table["references"][0]["sensing"] == {}
+    page = (root / "docs/results.md").read_text()
+    assert "### Algorithm table" in page and "300 s wall clock" in page
+    assert "| `tqc` | learned | **1.00 ± 0.00** | 1.00 ± 0.00, 1.00 ± 0.00 (200, 200 / 200) |" in page
+    assert "| `whirl-brake` | designed | **1.00** |" in page and "40 k, 40 k |" in page
+    assert results.main(["--root", str(root), "--hard-ref", "noisy", str(ref)]) == 2
+    assert "is not the noisy variant's" in capsys.readouterr().err
+    assert results.main(["--root", str(root), "--check"]) == 0
+
+
 def test_user_pages_name_no_issue_numbers_or_time_boxes():
     bad = re.compile(r"\bissue\s*#?\d+|(?<![\w&])#\d+\b|time[- ]box", re.I)
     hits = [f"{p.relative_to(ROOT)}:{i}: {line.strip()}" for p in USER_PAGES

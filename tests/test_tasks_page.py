@@ -51,3 +51,16 @@ def test_oracle_margins_robust_target_and_hard_reference():
         hard = _load(name)
         n, rate = hard["summary"]["episodes"], hard["summary"]["relevitation_success_rate"]
         assert f"{round(rate * n)} / {n}" in sections["Hard benchmark: raw currents"]
+
+
+def test_hard_benchmark_algorithm_rows_quote_the_committed_table():
+    """Every `algo` (variant) mean ± std the hard-benchmark section quotes is the algorithm
+    table's (docs/data/hard-table.json, as docs/results.md shows it), and each variant is quoted."""
+    from agents.benchmarking.results import hard_algorithm_rows
+    table = _load("hard-table")
+    text = _sections()["Hard benchmark: raw currents"]
+    quoted = re.findall(r"`(\w+)` \((nominal|noisy)\) (\d\.\d\d) ± (\d\.\d\d)", text)
+    assert {variant for _, variant, _, _ in quoted} == {"nominal", "noisy"}
+    for algo, variant, mean, std in quoted:
+        row = {r["name"]: r for r in hard_algorithm_rows(table, variant)}[algo]
+        assert (f"{row['rate_mean']:.2f}", f"{row['rate_std']:.2f}") == (mean, std), (algo, variant)

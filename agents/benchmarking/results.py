@@ -16,6 +16,12 @@ Data files (each written by the project's own commands; only what the tables nee
 ``docs/data/oracle-nominal.json``       ``rotordrop oracle --out DIR``: ``DIR/oracle.json``
 ``docs/data/oracle-robust.json``        ``rotordrop oracle --suite robust --out DIR``: ``DIR/oracle.json``
 ``docs/data/hard-<name>.json``          ``rotordrop evaluate ... --episodes 200 --seed 900000 --out DIR``: ``DIR/kpis.json``
+``docs/data/hard-table.json``           the hard benchmark's algorithm table: per training run
+                                        (``--hard-run VARIANT KPIS RUN``: the run's
+                                        ``training.json`` and ``rotordrop evaluate``'s
+                                        ``kpis.json`` of its model) and per designed reference
+                                        (``--hard-ref VARIANT KPIS``) the per-drop outcomes and
+                                        their summary, no trajectories
 =====================================  =======================================================
 
 After re-running a benchmark, hand its output to the command, which stores it and regenerates
@@ -24,6 +30,8 @@ the pages in one go::
     python -m agents.benchmarking.results --nominal out/bench/benchmark.json --robust out/robust/benchmark.json \\
         --oracle-nominal out/oracle/oracle.json --oracle-robust out/oracle-robust/oracle.json \\
         --hard out/hard-tqc/kpis.json
+    python -m agents.benchmarking.results --hard-run noisy out/tqc-noisy-0/kpis.json runs/tqc-noisy-0 \
+        --hard-ref noisy out/whirl-brake-noisy/kpis.json
 
 ``--check`` writes nothing and exits 1 when the committed pages differ from what the committed
 data give (the test suite runs it). The module needs only the standard library.
@@ -48,6 +56,14 @@ START, END = "<!-- leaderboard:start -->", "<!-- leaderboard:end -->"
 DROPPED_KEYS = ("rows",)
 #: the kpis.json keys kept for the hard benchmark (the passive comparison is left out)
 HARD_KEYS = ("policy", "env_id", "env_kwargs", "seeds", "summary", "episodes")
+#: the hard benchmark's algorithm table (not a kpis.json: left out of the hard-*.json rows)
+HARD_TABLE = "hard-table.json"
+#: the algorithm table's variants: title, and the sensing env kwargs every entry must have
+HARD_VARIANTS = {"nominal": ("nominal sensing (the env defaults)", {}),
+                 "noisy": ("noisy and delayed sensing: `sensor_noise=1e-6` (1 µm), "
+                           "`sensor_delay=1e-4` (0.1 ms)",
+                           {"sensor_noise": 1e-6, "sensor_delay": 1e-4})}
+SENSING = ("sensor_noise", "sensor_delay", "obs_latency_steps")
 TASK_TITLES = {"damping": "Damping (`RotorDrop-Damping-v1`)",
                "relevitate": "Re-levitation (`RotorDrop-Relevitate-v1`)",
                "full": "Damping and re-levitation (`RotorDrop-Full-v1`)"}
@@ -285,9 +301,7 @@ def _quantile(values: list[float], q: float) -> float:
 def hard_row(report: dict, source: str) -> str:
     eps = report["episodes"]
     s = report["summary"]
-    after = [1e3 * (e["relevitation_time_s"] - e["scenario"]["power_return_time"])
-             for e in eps if e.get("relevitated") and e.get("relevitation_time_s") is not None
-             and "power_return_time" in e.get("scenario", {})]
+    after = _after_power_return_ms(eps)
     n_ok = sum(1 for e in eps if e.get("relevitated"))
     stator = [bool(e.get("stator_contact")) for e in eps if "stator_contact" in e]
     times = (f"{statistics.median(after):.1f} / {_quantile(after, 0.9):.1f} / {max(after):.1f} ms"
@@ -312,6 +326,167 @@ def hard_section(reports: list[tuple[dict, str]]) -> list[str]:
            "|---|---|---:|---:|---:|---:|---|"]
     out += [hard_row(r, src) for r, src in reports]
     return out + [""]
+
+
+def _after_power_return_ms(eps: list[dict]) -> list[float]:
+    return [1e3 * (e["relevitation_time_s"] - e["scenario"]["power_return_time"])
+            for e in eps if e.get("relevitated") and e.get("relevitation_time_s") is not None
+            and "power_return_time" in e.get("scenario", {})]
+
+
+def hard_entry(variant: str, report: dict, source: str, run: Path | None = None) -> dict:
+    """The algorithm table's record of one evaluation (a ``rotordrop evaluate`` kpis.json on
+    the 200 held-out drops): per-drop re-levitation and whirl as 0/1 strings, the times after
+    the power return (median, 90 %, max), the stator-contact rate, the sensing it ran with;
+    with ``run`` (a training run directory) the run's algorithm, seed, steps, wall time and its
+    own evaluation curve (steps, wall time, re-levitation rate of its 16 evaluation drops).
+    ValueError when the sensing is not the variant's."""
+    if variant not in HARD_VARIANTS:
+        raise ValueError(f"variant must be one of {', '.join(HARD_VARIANTS)}, got {variant!r}")
+    kw = report["env_kwargs"]
+    sensing = {k: kw[k] for k in SENSING if kw.get(k)}
+    if sensing != HARD_VARIANTS[variant][1]:
+        raise ValueError(f"{source}: sensing {sensing or 'none'} is not the {variant} variant's "
+                         f"({HARD_VARIANTS[variant][1] or 'none'})")
+    eps = report["episodes"]
+    after = _after_power_return_ms(eps)
+    stator = [bool(e.get("stator_contact")) for e in eps]
+    entry = dict(variant=variant, policy=report["policy"], env_id=report["env_id"],
+                 command=kw.get("command"), sensing=sensing, source=source,
+                 seeds=[report["seeds"][0], report["seeds"][-1]], episodes=len(eps),
+                 relevitated="".join("1" if e.get("relevitated") else "0" for e in eps),
+                 backward_whirl="".join("1" if e.get("backward_whirl") else "0" for e in eps),
+                 after_power_return_ms=([round(statistics.median(after), 2),
+                                         round(_quantile(after, 0.9), 2), round(max(after), 2)]
+                                        if after else None),
+                 stator_contact=sum(stator) / len(stator))
+    if run is not None:
+        info = json.loads((Path(run) / "training.json").read_text())
+        entry.update(algo=info["algo"], seed=info["seed"], run=Path(run).name,
+                     model="best" if report["policy"].endswith("/best") else "final",
+                     time_limit_s=info.get("time_limit_s"),
+                     timesteps=info["timesteps"], wall_time_s=round(info["wall_time_s"], 1),
+                     steps_per_s=round(info["steps_per_s"], 1), command_line=info["command"],
+                     curve=[[h["timesteps"], round(h["wall_time_s"], 1),
+                             round(h.get("mean_relevitated", float("nan")), 4)]
+                            for h in info["learning_curve"]])
+    return entry
+
+
+def store_hard_table(path: Path, runs: list[tuple[str, str, str]], refs: list[tuple[str, str]],
+                     root: Path) -> Path:
+    """Add (or replace) ``runs`` ((variant, kpis.json, run dir)) and ``refs`` ((variant,
+    kpis.json)) in the algorithm table ``path`` (keyed by variant and algorithm and seed, or
+    variant and policy)."""
+    table = json.loads(path.read_text()) if path.exists() else {"runs": [], "references": []}
+
+    def rel(p):
+        p = Path(p).resolve()
+        return p.relative_to(root.resolve()).as_posix() if p.is_relative_to(root.resolve()) else str(p)
+
+    for variant, kpis, run in runs:
+        e = hard_entry(variant, json.loads(Path(kpis).read_text()), rel(kpis), Path(run))
+        table["runs"] = [r for r in table["runs"] if (r["variant"], r["algo"], r["seed"])
+                         != (variant, e["algo"], e["seed"])] + [e]
+    for variant, kpis in refs:
+        e = hard_entry(variant, json.loads(Path(kpis).read_text()), rel(kpis))
+        table["references"] = [r for r in table["references"]
+                               if (r["variant"], r["policy"]) != (variant, e["policy"])] + [e]
+    order = list(HARD_VARIANTS)
+    table["runs"].sort(key=lambda r: (order.index(r["variant"]), r["algo"], r["seed"]))
+    table["references"].sort(key=lambda r: (order.index(r["variant"]), r["policy"]))
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(table, indent=1, sort_keys=True) + "\n")
+    return path
+
+
+def _rate(bits: str) -> float:
+    return bits.count("1") / len(bits)
+
+
+def _binomial_se(p: float, n: int) -> float:
+    return (p * (1.0 - p) / n) ** 0.5
+
+
+def _mean_std(values: list[float], spec: str = ".2f") -> str:
+    """mean ± std (ddof 1) over seeds; the value alone for one."""
+    if not values:
+        return "–"
+    if len(values) == 1:
+        return format(values[0], spec)
+    return f"{format(statistics.mean(values), spec)} ± {format(statistics.stdev(values), spec)}"
+
+
+def hard_algorithm_rows(table: dict, variant: str) -> list[dict]:
+    """Per algorithm of ``variant`` (seeds pooled) and per reference: the table's numbers."""
+    rows = []
+    runs = [r for r in table["runs"] if r["variant"] == variant]
+    for algo in dict.fromkeys(r["algo"] for r in runs):
+        mine = sorted((r for r in runs if r["algo"] == algo), key=lambda r: r["seed"])
+        rates = [_rate(r["relevitated"]) for r in mine]
+        rows.append(dict(
+            name=algo, kind="learned", runs=mine, seeds=[r["seed"] for r in mine], rates=rates,
+            rate_mean=statistics.mean(rates),
+            rate_std=statistics.stdev(rates) if len(rates) > 1 else None,
+            ses=[_binomial_se(p, r["episodes"]) for p, r in zip(rates, mine)],
+            medians=[r["after_power_return_ms"][0] for r in mine if r["after_power_return_ms"]],
+            whirl=[_rate(r["backward_whirl"]) for r in mine],
+            stator=[r["stator_contact"] for r in mine],
+            steps=[r["timesteps"] for r in mine]))
+    for ref in (r for r in table["references"] if r["variant"] == variant):
+        p = _rate(ref["relevitated"])
+        rows.append(dict(name=ref["policy"], kind="designed", runs=[ref], seeds=[], rates=[p],
+                         rate_mean=p, rate_std=None, ses=[_binomial_se(p, ref["episodes"])],
+                         medians=[ref["after_power_return_ms"][0]] if ref["after_power_return_ms"] else [],
+                         whirl=[_rate(ref["backward_whirl"])], stator=[ref["stator_contact"]],
+                         steps=[]))
+    return rows
+
+
+def hard_table_section(table: dict, source: str) -> list[str]:
+    """The algorithm table of each variant: learned rows (mean ± std over seeds, per seed with its
+    SE over the drops) and the designed references on the same drops and sensing."""
+    budgets = sorted({r.get("time_limit_s") for r in table["runs"]} - {None})
+    budget = " / ".join(f"{b:g} s" for b in budgets) or "–"
+    seeds = sorted({r["seed"] for r in table["runs"]})
+    out = ["### Algorithm table", "",
+           f"Each learned row: {len(seeds)} training runs (seeds "
+           f"{', '.join(map(str, seeds))}) of {budget} wall clock each "
+           "(`--time-limit`; **a 5-minute budget, 1/12 of the benchmark's 60 minutes**: the "
+           "table had to fit 4 algorithms × 3 seeds × 2 variants on two shared cores), one core "
+           "per run (`--threads 1`, two runs side by side under `nice`), evaluated on the 200 "
+           "held-out drops with the sensing it was trained with; the model evaluated is the run's "
+           "`best/` (kept by the return on its own 16 evaluation drops, seed + 10 000), nothing "
+           "selected on the held-out drops. Re-levitation rate and whirl rate: mean ± std "
+           "(ddof 1) over the seeds; *per seed*: each seed's rate ± its binomial SE over the "
+           "200 drops, sqrt(p (1 − p) / 200); *after the power return*: the median over the "
+           "re-levitated drops, mean ± std over the seeds that re-levitated any; *steps*: "
+           "environment steps trained within the budget, per seed. Designed rows: the same "
+           "200 drops, the same sensing (the observations they act on carry the noise and the "
+           "delay), one row each, its SE over the drops. Configs: "
+           "`docs/experiments/configs/<algo>-currents[-noisy].yaml`; commands and verdict: "
+           "[experiments, 2026-11-27](experiments/2026-11-27-hard-benchmark-table.md).", ""]
+    for variant, (title, _) in HARD_VARIANTS.items():
+        rows = hard_algorithm_rows(table, variant)
+        if not rows:
+            continue
+        out += [f"**{variant.capitalize()}**: {title}.", "",
+                "| algorithm | kind | re-levitation rate (mean ± std) | per seed (± SE over the "
+                "200 drops) | after the power return, median [ms] | whirl rate (mean ± std) | "
+                "stator contact | steps per seed |",
+                "|---|---|---:|---:|---:|---:|---:|---:|"]
+        for r in rows:
+            per_seed = ", ".join(f"{p:.2f} ± {se:.2f}" for p, se in zip(r["rates"], r["ses"]))
+            counts = ", ".join(f"{run['relevitated'].count('1')}" for run in r["runs"])
+            counts += f" / {r['runs'][0]['episodes']}"
+            out.append(
+                f"| `{r['name']}` | {r['kind']} | **{_mean_std(r['rates'])}** | {per_seed} "
+                f"({counts}) | {_mean_std(r['medians'], '.1f')} | {_mean_std(r['whirl'])} | "
+                f"{statistics.mean(r['stator']):.2f} | "
+                f"{', '.join(f'{s // 1000} k' for s in r['steps']) or '–'} |")
+        out.append("")
+    return out + [f"Data: `{source}` (per run and reference: the per-drop outcomes, the run's "
+                  "steps, wall time and its own evaluation curve).", ""]
 
 
 def learning_curves(root: Path) -> list[str]:
@@ -390,9 +565,12 @@ def results_page(root: Path = ROOT) -> str:
     if budget:
         lines += oracle_budget_section(budget, (DATA / "oracle-budget.json").as_posix())
     hard = [(json.loads(p.read_text()), (DATA / p.name).as_posix())
-            for p in sorted(data.glob("hard-*.json"))]
+            for p in sorted(data.glob("hard-*.json")) if p.name != HARD_TABLE]
     if hard:
         lines += hard_section(hard)
+    table = _load(data / HARD_TABLE)
+    if table:
+        lines += hard_table_section(table, (DATA / HARD_TABLE).as_posix())
     lines += learning_curves(root)
     return "\n".join(lines).rstrip() + "\n"
 
@@ -443,6 +621,15 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--hard", action="append", default=[],
                    help="a `rotordrop evaluate` kpis.json of the hard benchmark to store as "
                         "docs/data/hard-<policy>.json (repeatable)")
+    p.add_argument("--hard-run", nargs=3, action="append", default=[],
+                   metavar=("VARIANT", "KPIS", "RUN"),
+                   help="add a training run to the hard benchmark's algorithm table "
+                        "(docs/data/hard-table.json): the variant (nominal | noisy), the "
+                        "kpis.json of `rotordrop evaluate` on its model, its run directory "
+                        "(repeatable; a run of the same variant, algorithm and seed is replaced)")
+    p.add_argument("--hard-ref", nargs=2, action="append", default=[], metavar=("VARIANT", "KPIS"),
+                   help="add a designed reference row to the algorithm table: the variant and "
+                        "the kpis.json of `rotordrop evaluate` on the same drops and sensing")
     p.add_argument("--oracle-nominal", help="a `rotordrop oracle` oracle.json (nominal drops) to "
                                             "store as docs/data/oracle-nominal.json")
     p.add_argument("--oracle-robust", help="a `rotordrop oracle --suite robust` oracle.json to "
@@ -462,7 +649,7 @@ def run(args) -> int:
     """Store the given benchmark output in docs/data and regenerate the pages (or ``--check``)."""
     root = Path(args.root)
     given = (args.nominal, args.robust, args.hard, args.oracle_nominal, args.oracle_robust,
-             args.oracle_budget, args.headroom)
+             args.oracle_budget, args.headroom, args.hard_run, args.hard_ref)
     if args.check and any(given):
         print("results: error: --check takes no data files", file=sys.stderr)
         return 2
@@ -485,6 +672,13 @@ def run(args) -> int:
     for h in args.hard:
         name = re.sub(r"[^A-Za-z0-9_.-]+", "-", json.loads(Path(h).read_text())["policy"]).strip("-")
         stored.append(store(h, root / DATA / f"hard-{name}.json", keep=HARD_KEYS))
+    if args.hard_run or args.hard_ref:
+        try:
+            stored.append(store_hard_table(root / DATA / HARD_TABLE, args.hard_run, args.hard_ref,
+                                           root))
+        except (ValueError, KeyError, FileNotFoundError) as exc:
+            print(f"results: error: {exc}", file=sys.stderr)
+            return 2
     stale = []
     for path, text in generated(root).items():
         if path.exists() and path.read_text() == text:

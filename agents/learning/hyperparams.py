@@ -75,9 +75,14 @@ from typing import Any
 
 from .config_checks import ConfigError, check_keys, is_finite_number
 
-ALGOS = ("ppo", "sac", "td3", "tqc")
+#: the algorithms ``rotordrop train`` runs: name -> (module, class); one line per algorithm, and
+#: a shipped ``agents/configs/<name>.yaml`` with a block per env id
+ALGO_CLASSES = {"ppo": ("stable_baselines3", "PPO"), "sac": ("stable_baselines3", "SAC"),
+                "td3": ("stable_baselines3", "TD3"), "tqc": ("sb3_contrib", "TQC"),
+                "crossq": ("sb3_contrib", "CrossQ")}
+ALGOS = tuple(ALGO_CLASSES)
 #: algorithms from sb3-contrib (the ``rl`` extra installs it)
-CONTRIB_ALGOS = ("tqc",)
+CONTRIB_ALGOS = tuple(a for a, (module, _) in ALGO_CLASSES.items() if module == "sb3_contrib")
 META_KEYS = ("n_timesteps", "n_envs", "policy", "policy_kwargs", "normalize", "env_kwargs",
              "eval_freq", "n_eval_episodes", "checkpoint_freq", "noise_type", "noise_std",
              "reward", "reward_kwargs", "residual", "residual_scale", "validation",
@@ -140,15 +145,14 @@ def load_yaml(text: str):
 
 
 def algo_class(algo: str):
-    """The Stable-Baselines3 (or sb3-contrib: TQC) class of ``algo``."""
-    import stable_baselines3 as sb3
-    if algo in CONTRIB_ALGOS:
-        try:
-            import sb3_contrib
-        except ImportError as exc:   # pragma: no cover - the rl extra installs it
-            raise ConfigError(f"--algo {algo} needs sb3-contrib: pip install 'rotordrop[rl]'") from exc
-        return {"tqc": sb3_contrib.TQC}[algo]
-    return {"ppo": sb3.PPO, "sac": sb3.SAC, "td3": sb3.TD3}[algo]
+    """The Stable-Baselines3 (or sb3-contrib: TQC, CrossQ) class of ``algo``
+    (:data:`ALGO_CLASSES`)."""
+    import importlib
+    module, name = ALGO_CLASSES[algo]
+    try:
+        return getattr(importlib.import_module(module), name)
+    except ImportError as exc:   # pragma: no cover - the rl extra installs sb3-contrib
+        raise ConfigError(f"--algo {algo} needs sb3-contrib: pip install 'rotordrop[rl]'") from exc
 
 
 def shipped_dir() -> Path:

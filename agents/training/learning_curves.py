@@ -65,10 +65,13 @@ def write(groups: dict[str, list[str]], out: Path, quantities=QUANTITIES) -> lis
         steps = data["steps"]
         for ax, (key, title) in zip(axes, quantities):
             mean, std = _nan_stats(data[key])
-            ax.plot(steps, mean, color=f"C{i}", label=f"{label} ({len(runs)} run"
+            # markers: a run that evaluated once (a short wall-clock budget) still shows; past
+            # ten curves the colours repeat with another line style
+            ax.plot(steps, mean, color=f"C{i % 10}", linestyle=("-", "--", ":")[i // 10 % 3],
+                    marker="o", markersize=3, label=f"{label} ({len(runs)} run"
                     f"{'s' if len(runs) > 1 else ''})")
             if len(runs) > 1:
-                ax.fill_between(steps, mean - std, mean + std, color=f"C{i}", alpha=0.2)
+                ax.fill_between(steps, mean - std, mean + std, color=f"C{i % 10}", alpha=0.2)
             ax.set_ylabel(title)
             ax.grid(alpha=0.3)
         for j, s in enumerate(steps):

@@ -43,7 +43,7 @@ import numpy as np
 from ..learning.hyperparams import (ALGOS, ConfigError, algo_class, check_sb3, dump_yaml, load_hyperparams,
                           read_yaml, split)
 
-OFF_POLICY = ("sac", "td3", "tqc")
+OFF_POLICY = ("sac", "td3", "tqc", "crossq")
 #: what a run writes into --out (a directory holding one of them holds a run)
 RUN_FILES = ("model.zip", "vecnormalize.pkl", "config.yaml", "training.json", "learning_curve.png",
              "monitor.csv", "best", "checkpoints", "eval", "tb")

@@ -43,7 +43,8 @@ def test_shipped_policy_command_names_the_config_that_gave_its_hyperparameters(n
 
 @pytest.mark.parametrize("name", ["ppo-damping", "ppo-relevitate", "ppo-full", "ppo-full-scratch",
                                   "sac-full-scratch", "sac-robust-full-scratch",
-                                  "ppo-robust-full-scratch"])
+                                  "ppo-robust-full-scratch", "ppo-hard-currents",
+                                  "ppo-hard-currents-noisy"])
 def test_shipped_policy_acts_inside_the_action_space(name):
     pol = load_shipped(name)
     kw = {k: v for k, v in pol.env_kwargs.items() if k not in ("randomize", "randomization")}

@@ -1,6 +1,6 @@
-"""TQC (sb3-contrib) through ``rotordrop train`` like SAC, its zips under plain ``TQC.load`` and
-the project's loader (algorithm and environment read from the zip alone), and the wall-clock
-limit of a training run (``--time-limit``)."""
+"""TQC and CrossQ (sb3-contrib) through ``rotordrop train`` like SAC, their zips under plain
+``TQC.load`` / ``CrossQ.load`` and the project's loader (algorithm and environment read from the
+zip alone), and the wall-clock limit of a training run (``--time-limit``)."""
 import json
 import shutil
 
@@ -114,3 +114,36 @@ def test_tqc_hyperparameters_are_checked_like_sacs(tmp_path):
     with pytest.raises(ConfigError, match="--algo tqc needs continuous actions"):
         cfg.write_text(TINY + "    command: discrete\n")
         train(ENV, "tqc", tmp_path / "run2", config=cfg, progress=False)
+
+
+def test_crossq_trains_and_its_zip_runs_under_plain_crossq_and_evaluate(tmp_path, capsys):
+    """CrossQ (one line of the algorithm registry and agents/configs/crossq.yaml): a short run
+    under the noisy sensing, its zip self-contained under plain CrossQ.load, and evaluate with
+    the sensing given again by --env-kwarg."""
+    from agents.cli import main
+    cfg = tmp_path / "tiny.yaml"
+    cfg.write_text(TINY.replace(", n_critics=2, n_quantiles=5", "")
+                   .replace("net_arch=[16, 16]", "net_arch=dict(pi=[16, 16], qf=[32, 32])")
+                   .replace("  top_quantiles_to_drop_per_net: 1\n", "  policy_delay: 2\n")
+                   + "    sensor_noise: 1.0e-6\n    sensor_delay: 1.0e-4\n")
+    res = train(ENV, "crossq", tmp_path / "run", timesteps=256, config=cfg, seed=1, progress=False)
+    lone = tmp_path / "policy.zip"
+    shutil.copy(res.out / "best" / "best_model.zip", lone)
+    assert zip_algo(lone) == "crossq"
+    pol = LearnedPolicy.load(lone)
+    assert pol.algo == "crossq" and pol.env_kwargs["sensor_delay"] == 1e-4
+    plain = algo_class("crossq").load(lone, device="cpu")
+    assert is_self_contained(plain)
+    env = gym.make(ENV, **pol.env_kwargs)
+    obs = np.stack([env.reset(seed=s)[0] for s in range(4)])
+    assert np.array_equal(plain.predict(obs, deterministic=True)[0], pol.predict(obs)[0])
+    assert main(["evaluate", "--policy", "whirl-brake", "--env", ENV, "--episodes", "1",
+                 "--env-kwarg", "command=continuous", "--env-kwarg", "sensor_noise=1e-6",
+                 "--env-kwarg", "episode_time=0.03", "--env-kwarg", "power_return_time=0.01",
+                 "--out", str(tmp_path / "ev"), "--no-plots", "--no-passive"]) == 0
+    kw = json.loads((tmp_path / "ev" / "kpis.json").read_text())["env_kwargs"]
+    assert kw["sensor_noise"] == 1e-6 and kw["command"] == "continuous"
+    assert main(["evaluate", "--policy", "whirl-brake", "--env", ENV, "--episodes", "1",
+                 "--env-kwarg", "power_return_time=0.02", "--power-return-ms", "20",
+                 "--out", str(tmp_path / "ev2"), "--no-plots"]) == 2
+    assert "power_return_time is given twice" in capsys.readouterr().err

@@ -5,7 +5,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from agents.learning.hyperparams import (ConfigError, load_hyperparams, parse_literal, read_yaml, schedule,
+from agents.learning.hyperparams import (ALGOS, ConfigError, load_hyperparams, parse_literal, read_yaml, schedule,
                                 split)
 
 from helpers import phys
@@ -13,7 +13,7 @@ from helpers import phys
 ENV_IDS = ("RotorDrop-Damping-v1", "RotorDrop-Relevitate-v1", "RotorDrop-Full-v1")
 
 
-@pytest.mark.parametrize("algo", ["ppo", "sac", "td3", "tqc"])
+@pytest.mark.parametrize("algo", ALGOS)
 def test_shipped_configs_parse(algo):
     from gymnasium.spaces import Box
     from agents.control.plant import make_env
@@ -22,7 +22,7 @@ def test_shipped_configs_parse(algo):
         assert meta["n_timesteps"] > 0 and meta["n_envs"] >= 1
         assert isinstance(kwargs["policy_kwargs"], dict)
         env = make_env(env_id, **meta["env_kwargs"])          # the env the config trains on
-        if algo != "ppo":       # SAC/TD3/TQC need continuous actions
+        if algo != "ppo":       # SAC/TD3/TQC/CrossQ need continuous actions
             assert isinstance(env.action_space, Box), (algo, env_id)
 
 
@@ -30,7 +30,7 @@ ROOT = Path(__file__).resolve().parents[3]
 #: the experiment variants: deltas on a shipped entry or on each other (docs/experiments/configs)
 DELTAS = sorted((ROOT / "docs/experiments/configs").glob("*.yaml"))
 #: the named entries of the shipped files (one per shipped policy that shares an env id)
-ENTRIES = [(algo, key) for algo in ("ppo", "sac", "td3", "tqc")
+ENTRIES = [(algo, key) for algo in ALGOS
            for key in read_yaml(ROOT / f"agents/configs/{algo}.yaml") if not key.startswith("RotorDrop-")]
 
 
@@ -44,7 +44,7 @@ def _check(algo, env_id, config):
 
 def test_the_package_ships_one_file_per_algorithm():
     assert sorted(p.name for p in (ROOT / "agents/configs").iterdir()) == \
-        ["ppo.yaml", "sac.yaml", "td3.yaml", "tqc.yaml"]
+        sorted(f"{algo}.yaml" for algo in ALGOS)
     assert len(DELTAS) >= 20 and ENTRIES
 
 
