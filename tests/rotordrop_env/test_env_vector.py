@@ -204,7 +204,7 @@ def test_a_flexible_vector_env_steps_as_single_envs_episode_by_episode():
     kw = dict(scene="paper-flexible", command="supervisor", randomize=True, episode_time=0.004)
     envs = make_vec("RotorDrop-Full-v1", n, **kw)
     singles = [gym.make("RotorDrop-Full-v1", **kw) for _ in range(n)]
-    assert envs.unwrapped.envs[0].model.elastic_modes == 7
+    assert envs.unwrapped.envs[0].model.elastic_modes == 2
     obs, info = envs.reset(seed=9)
     for e, env in enumerate(singles):
         o, i = env.reset(seed=9 + e)
