@@ -77,24 +77,35 @@ def levitated_state(model: Model) -> np.ndarray:
     return y
 
 
-def _elastic_sag(model: Model, y: np.ndarray, iterations: int = 4) -> None:
-    """A flexible rotor's static elastic deflection under the AMB forces at t = 0: each modal
-    coordinate is its share of the AMB station forces over omega^2 (gravity does no work on the
-    elastic modes, physics/flexible/floating.py); the AMB forces follow the deflection, hence a
-    few fixed-point passes (the AMBs are far softer than the shaft)."""
+def _elastic_sag(model: Model, y: np.ndarray, iterations: int = 3) -> None:
+    """A flexible rotor's static elastic deflection under the AMB forces at t = 0: the modal
+    coordinates eta (x plane, then y) at which omega^2 eta balances the AMB station forces'
+    share S^T f(eta) (gravity does no work on the elastic modes, physics/flexible/floating.py;
+    the unbalance's rotating force is left to the motion). The AMB forces follow the deflection,
+    which a soft shaft makes large: Newton steps on a finite-difference Jacobian (the AMB laws
+    are linear in it or nearly so: one or two steps converge)."""
     P, I, n = model.P, model.I, model.elastic_modes
     i0 = int(I[I_FX])
-    w2 = P[P_FX_W2:P_FX_W2 + n]
+    w2 = np.tile(P[P_FX_W2:P_FX_W2 + n], 2)
+    shape = [P[P_FX_SHAPE + (ST_AMB1 + k) * FX_ROW:P_FX_SHAPE + (ST_AMB1 + k) * FX_ROW + n]
+             for k in range(2)]
     aux, dy = np.zeros(N_AUX), np.zeros(model.n_state)
     U = model.controls(True)
-    for _ in range(iterations):
+
+    def residual(eta: np.ndarray) -> np.ndarray:
+        y[i0:i0 + 2 * n] = eta
         rhs(0.0, y, P, I, U, dy, aux)
-        for a in range(2):                       # x, then y plane
-            q = np.zeros(n)
-            for k in range(2):
-                s = ST_AMB1 + k
-                q += P[P_FX_SHAPE + s * FX_ROW:P_FX_SHAPE + s * FX_ROW + n] * aux[A_STF + 2 * s + a]
-            y[i0 + a * n:i0 + (a + 1) * n] = q / w2
+        q = np.concatenate([sum(shape[k] * aux[A_STF + 2 * (ST_AMB1 + k) + a] for k in range(2))
+                            for a in range(2)])
+        return w2 * eta - q
+
+    eta = np.zeros(2 * n)
+    step = model.scene.contact.clearance * 1e-3 / max(float(np.abs(shape).max()), 1e-12)
+    for _ in range(iterations):
+        r0 = residual(eta)
+        J = np.column_stack([(residual(eta + step * e) - r0) / step for e in np.eye(2 * n)])
+        eta = eta - np.linalg.solve(J, r0)
+    y[i0:i0 + 2 * n] = eta
 
 
 def _amb_support(model: Model, omega: float) -> tuple[float, float]:

@@ -278,3 +278,25 @@ def test_the_box_lies_inside_the_valid_ranges():
         vlo, vhi = _range(NUMERIC[key])
         assert vlo <= lo and hi <= vhi, key
     assert isinstance(load_scene("paper", {k: v[1] for k, v in BOX.items()}), Scene)
+
+
+# ----------------------------------------------------------------- a flexible rotor's hard cases --
+HARD = {k: v[1] for k, v in BOX.items()} | {"support.damping": 0.0}
+FLEXIBLE_CASES = {
+    # the slender machine-like shaft with its first bending mode at the running speed, whirling
+    "bending at running speed, mu 0.8": {"flexible.modulus_scale": 0.1631, "contact.friction": 0.8},
+    # the softest shaft the scene allows (first bending ~13 Hz: the bending modes below 200 Hz),
+    # with the static modes
+    "softest shaft, mu 0.8, static modes": {"flexible.modulus_scale": 1e-3, "contact.friction": 0.8,
+                                            "flexible.mode_cutoff_hz": 200.0,
+                                            "flexible.static_modes": True},
+    "all stiff box corner, static modes": HARD | {"flexible.static_modes": True},
+    "30 000 rpm, 100 g unbalance, mu 0.8": {"rotor.speed_rpm": 30000.0, "unbalance.mass": 0.1,
+                                            "contact.friction": 0.8},
+}
+
+
+@pytest.mark.parametrize("overrides", FLEXIBLE_CASES.values(), ids=FLEXIBLE_CASES)
+def test_hard_case_flexible_rotor(overrides):
+    scene = load_scene("machine-flexible", overrides)
+    check_stable(simulate(scene, t_end=scene.amb.off_time + 0.2))
