@@ -200,16 +200,11 @@ def flexible_free_frequencies(scene, omega: float, t_end: float = 4.0,
     elastic coordinate after a kick of its rates. Ascending. Use a scene with
     :data:`SPRINGS_ONLY` and ``flexible.damping_ratio = 0`` (a damped bending mode dies out
     before the window ends) to compare with :func:`flexible_whirl`."""
-    from .flexible.floating import STATIONS
-    from .flexible.shafts import drop_rotor
-    fm = drop_rotor(scene)
-    shape, z = fm.shape[STATIONS.index("amb1")], scene.positions.amb1
+    from .model import ST_AMB1
+    from .results import station_series
     t, Y, m = free_response(scene, omega, t_end, rate)
-    n = fm.n_modes
-    eta = [np.column_stack([Y[:, m.index(f"eta_{p}{j + 1}")] for j in range(n)]) for p in "xy"]
-    x = Y[:, m.index("x")] + z * Y[:, m.index("a")] + eta[0] @ shape
-    y = Y[:, m.index("y")] + z * Y[:, m.index("b")] + eta[1] @ shape
-    rigid = identified_frequencies(t, x, y, 4)
+    axis = station_series(m, Y, ST_AMB1)
+    rigid = identified_frequencies(t, axis[:, 0], axis[:, 1], 4)
     t, Y, m = free_response(scene, omega, t_end, rate, kick={"deta_x1": 0.02, "deta_y1": 0.01})
     bending = identified_frequencies(t, Y[:, m.index("eta_x1")], Y[:, m.index("eta_y1")], 2)
     return np.sort(np.concatenate([rigid, bending]))

@@ -42,8 +42,9 @@ def declare(layout) -> None:
 
 
 def pack(scene, P, I, layout) -> None:
-    """The reduced model's matrices; the rigid mass properties become the flexible rotor's (the
-    scene checks that they agree: physics/scene.py)."""
+    """The reduced model's frequencies, damping, station shapes and gyroscopic couplings (the
+    rigid rotor's mass properties stay physics/rotor.py's: the scene checks that they are the
+    shaft's, physics/scene.py)."""
     I[layout.index["flex.modes"]] = 0
     if scene.rotor.model != "flexible":
         return

@@ -188,7 +188,9 @@ N_AUX_PLANE = _AP.size
 # and its mount's dashpot (effects.stator_mount) at A_ST_PMOUNT + k
 A_STATOR, A_ST_PDAMP, A_ST_PFRIC, A_ST_PMOUNT = _A.indices(
     "stator.normal_force", "stator.damping_power", "stator.friction_power", "stator.mount_power")
-# the flexible rotor's station forces (x, y per station) and its modal damping power
+# the flexible rotor's station forces (x, y per station: the rhs's scratch for the modal forces;
+# in the output samples' diagnostics only the contact and stator forces, the dy = None variant
+# skips the AMBs and the unbalance) and its modal damping power
 A_STF, A_FX_PDAMP = _A.indices("rotor.station_force", "rotor.damping_power")
 N_AUX = _A.size
 

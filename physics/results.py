@@ -6,9 +6,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import thermal
-from .model import (FX_ROW, I_FX, P_FX_SHAPE, ST_AMB1, ST_RB1, A_DELTA, A_DRAG, A_FMU, A_FR, A_LOAD, A_PFRIC, A_QMAX, A_STATOR, A_WS, I_PLANES,
-                    I_STM, I_THERM, J_HX, J_SX, N_AUX_PLANE, N_PLANE_IDX, P_MU, P_TH_C, P_TH_RMAX, P_TH_RMIN,
-                    P_TH_SLOPE, P_Z_RB1, PLANES, S_EDISS, S_W, S_WEXT, S_X, Model, energies)
+from .model import (A_DELTA, A_DRAG, A_FMU, A_FR, A_LOAD, A_PFRIC, A_QMAX, A_STATOR, A_WS, FX_ROW,
+                    I_FX, I_PLANES, I_STM, I_THERM, J_HX, J_SX, N_AUX_PLANE, N_PLANE_IDX, PLANES,
+                    P_FX_SHAPE, P_MU, P_TH_C, P_TH_RMAX, P_TH_RMIN, P_TH_SLOPE, P_Z_RB1, ST_AMB1,
+                    ST_RB1, S_EDISS, S_W, S_WEXT, S_X, Model, energies)
 
 AMB_PLANES = ("AMB1", "AMB2")
 
@@ -20,6 +21,21 @@ def _axis_series(Y: np.ndarray, i: int, z: float) -> np.ndarray:
     for c in range(2):
         np.multiply(Y[:, i + 2 + c], z, out=out[:, c])
         out[:, c] += Y[:, i + c]
+    return out
+
+
+def station_series(model: Model, Y: np.ndarray, s: int, velocity: bool = False) -> np.ndarray:
+    """The rotor axis (x, y) at force station s (``physics.model.ST_*``) over the state rows
+    ``Y``, as an (N, 2) array: the rigid body's (x + z a, y + z b), plus a flexible rotor's
+    elastic modes there (what :func:`physics.model.axis_motion` gives one state); ``velocity``:
+    its velocity."""
+    out = _axis_series(Y, model.I[S_X] + (4 if velocity else 0), model.P[P_Z_RB1 + s])
+    n = model.elastic_modes
+    if n:
+        i0 = model.I[I_FX] + (2 * n if velocity else 0)
+        shape = model.P[P_FX_SHAPE + s * FX_ROW:P_FX_SHAPE + s * FX_ROW + n]
+        out[:, 0] += Y[:, i0:i0 + n] @ shape
+        out[:, 1] += Y[:, i0 + n:i0 + 2 * n] @ shape
     return out
 
 
@@ -81,18 +97,7 @@ class Result:
         """Rotor axis (x + z a, y + z b) at force station s (``physics.model.ST_*``), plus a
         flexible rotor's elastic modes there; offset 4: its velocity. Computed once per station
         (the metrics ask several times), read-only."""
-        m = self.model
-
-        def compute():
-            out = _axis_series(self.Y, m.I[S_X] + offset, m.P[P_Z_RB1 + s])
-            n = m.elastic_modes
-            if n:
-                i0 = m.I[I_FX] + (2 * n if offset else 0)
-                shape = m.P[P_FX_SHAPE + s * FX_ROW:P_FX_SHAPE + s * FX_ROW + n]
-                out[:, 0] += self.Y[:, i0:i0 + n] @ shape
-                out[:, 1] += self.Y[:, i0 + n:i0 + 2 * n] @ shape
-            return out
-        return self._memo((s, offset), compute)
+        return self._memo((s, offset), lambda: station_series(self.model, self.Y, s, offset == 4))
 
     def orbit(self, plane: str) -> np.ndarray:
         """Rotor axis position (x, y) at a retainer plane, relative to the nominal centre [m]."""

@@ -425,7 +425,7 @@ def hard_algorithm_rows(table: dict, variant: str) -> list[dict]:
         mine = sorted((r for r in runs if r["algo"] == algo), key=lambda r: r["seed"])
         rates = [_rate(r["relevitated"]) for r in mine]
         rows.append(dict(
-            name=algo, kind="learned", runs=mine, seeds=[r["seed"] for r in mine], rates=rates,
+            name=algo, kind="learned", runs=mine, rates=rates,
             rate_mean=statistics.mean(rates),
             rate_std=statistics.stdev(rates) if len(rates) > 1 else None,
             ses=[_binomial_se(p, r["episodes"]) for p, r in zip(rates, mine)],
@@ -435,7 +435,7 @@ def hard_algorithm_rows(table: dict, variant: str) -> list[dict]:
             steps=[r["timesteps"] for r in mine]))
     for ref in (r for r in table["references"] if r["variant"] == variant):
         p = _rate(ref["relevitated"])
-        rows.append(dict(name=ref["policy"], kind="designed", runs=[ref], seeds=[], rates=[p],
+        rows.append(dict(name=ref["policy"], kind="designed", runs=[ref], rates=[p],
                          rate_mean=p, rate_std=None, ses=[_binomial_se(p, ref["episodes"])],
                          medians=[ref["after_power_return_ms"][0]] if ref["after_power_return_ms"] else [],
                          whirl=[_rate(ref["backward_whirl"])], stator=[ref["stator_contact"]],
@@ -448,21 +448,26 @@ def hard_table_section(table: dict, source: str) -> list[str]:
     SE over the drops) and the designed references on the same drops and sensing."""
     budgets = sorted({r.get("time_limit_s") for r in table["runs"]} - {None})
     budget = " / ".join(f"{b:g} s" for b in budgets) or "–"
+    share = " / ".join(f"{b / 60:g}-minute budget, 1/{3600 / b:g}" for b in budgets)
     seeds = sorted({r["seed"] for r in table["runs"]})
+    algos = {r["algo"] for r in table["runs"]}
+    variants = {r["variant"] for r in table["runs"]}
+    drops = table["runs"][0]["episodes"]
     out = ["### Algorithm table", "",
            f"Each learned row: {len(seeds)} training runs (seeds "
            f"{', '.join(map(str, seeds))}) of {budget} wall clock each "
-           "(`--time-limit`; **a 5-minute budget, 1/12 of the benchmark's 60 minutes**: the "
-           "table had to fit 4 algorithms × 3 seeds × 2 variants on two shared cores), one core "
-           "per run (`--threads 1`, two runs side by side under `nice`), evaluated on the 200 "
+           f"(`--time-limit`; **a {share} of the benchmark's 60 minutes**: the "
+           f"table had to fit {len(algos)} algorithms × {len(seeds)} seeds × {len(variants)} "
+           "variants on two shared cores), one core "
+           f"per run (`--threads 1`, two runs side by side under `nice`), evaluated on the {drops} "
            "held-out drops with the sensing it was trained with; the model evaluated is the run's "
            "`best/` (kept by the return on its own 16 evaluation drops, seed + 10 000), nothing "
            "selected on the held-out drops. Re-levitation rate and whirl rate: mean ± std "
            "(ddof 1) over the seeds; *per seed*: each seed's rate ± its binomial SE over the "
-           "200 drops, sqrt(p (1 − p) / 200); *after the power return*: the median over the "
+           f"{drops} drops, sqrt(p (1 − p) / {drops}); *after the power return*: the median over the "
            "re-levitated drops, mean ± std over the seeds that re-levitated any; *steps*: "
            "environment steps trained within the budget, per seed. Designed rows: the same "
-           "200 drops, the same sensing (the observations they act on carry the noise and the "
+           f"{drops} drops, the same sensing (the observations they act on carry the noise and the "
            "delay), one row each, its SE over the drops. Configs: "
            "`docs/experiments/configs/<algo>-currents[-noisy].yaml`; commands and verdict: "
            "[experiments, 2026-11-27](experiments/2026-11-27-hard-benchmark-table.md).", ""]
@@ -472,7 +477,7 @@ def hard_table_section(table: dict, source: str) -> list[str]:
             continue
         out += [f"**{variant.capitalize()}**: {title}.", "",
                 "| algorithm | kind | re-levitation rate (mean ± std) | per seed (± SE over the "
-                "200 drops) | after the power return, median [ms] | whirl rate (mean ± std) | "
+                f"{drops} drops) | after the power return, median [ms] | whirl rate (mean ± std) | "
                 "stator contact | steps per seed |",
                 "|---|---|---:|---:|---:|---:|---:|---:|"]
         for r in rows:

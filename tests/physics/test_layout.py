@@ -74,8 +74,7 @@ def test_the_kernels_constants_are_the_declared_slots():
     assert M.A_FX_PDAMP + 1 == M.N_AUX         # ... and the flexible rotor's, A_STF on
     assert M.P_Z_AMB1 == M.P_Z_RB1 + M.ST_AMB1 and M.P_Z_UB == M.P_Z_RB1 + M.ST_UB
     for s, name in enumerate(M.flexible_rotor.STATIONS):    # the station block's order
-        assert M.LAYOUT.params.spans()[[n for n, _, _ in M.LAYOUT.params.spans()].index(
-            {"unb1": "unbalance.z"}.get(name, name + ".z"))][1] == M.P_Z_RB1 + s
+        assert M.LAYOUT.params[{"unb1": "unbalance.z"}.get(name, name + ".z")] == M.P_Z_RB1 + s
 
 
 def test_name_lookups_above_physics():
