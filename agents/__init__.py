@@ -14,6 +14,7 @@ _NEW_HOME = {
     "research": ("oracle",),
 }
 MOVED = {f"agents.{m}": (f"agents.{pkg}.{m}",) for pkg, ms in _NEW_HOME.items() for m in ms}
-# ship_policy left the policy-file module for agents.training.ship
+# ship_policy left the policy-file module for agents.training.ship; the old path is the folder
+# of the policy files, whose __init__.py forwards (the finder never sees it)
 MOVED["agents.policies"] = ("agents.learning.policies", "agents.training.ship")
 keep_old_paths(MOVED)

@@ -20,8 +20,32 @@ import warnings
 REMOVED_IN = "2.0"
 
 
+def forward(module: types.ModuleType, targets: tuple[str, ...], stacklevel: int = 2) -> None:
+    """Make ``module`` (an old path) warn that it moved to ``targets`` and forward every
+    attribute look-up to them, in order. ``stacklevel``: of the warning, counted from the
+    caller of this function (the import machinery's frames are skipped by ``warnings``)."""
+    new = " and ".join(targets)
+    warnings.warn(f"{module.__name__} moved to {new}: import it from there (the old path goes "
+                  f"in rotordrop {REMOVED_IN})", DeprecationWarning, stacklevel=stacklevel + 1)
+    found = [importlib.import_module(t) for t in targets]
+
+    def __getattr__(name: str):
+        for t in found:
+            if hasattr(t, name):
+                return getattr(t, name)
+        raise AttributeError(f"module {module.__name__!r} (moved to {new}) has no attribute "
+                             f"{name!r}")
+
+    if not hasattr(module, "__path__") and any(hasattr(t, "__path__") for t in found):
+        module.__path__ = []                          # a package: its submodules resolve too
+    names = sorted({n for t in found for n in getattr(t, "__all__", dir(t))
+                    if not n.startswith("_")})
+    module.__dict__.update(__getattr__=__getattr__, __all__=names, __dir__=lambda: names,
+                           __doc__=f"Moved to {new}.")
+
+
 class _Forwarder(importlib.abc.Loader):
-    """Makes an old path's module: it warns once, and forwards attribute look-ups."""
+    """Makes an old path's module (:func:`forward`)."""
 
     def __init__(self, targets: tuple[str, ...]):
         self.targets = targets
@@ -30,25 +54,7 @@ class _Forwarder(importlib.abc.Loader):
         return None                                   # an ordinary empty module
 
     def exec_module(self, module: types.ModuleType) -> None:
-        new = " and ".join(self.targets)
-        warnings.warn(f"{module.__name__} moved to {new}: import it from there (the old path "
-                      f"goes in rotordrop {REMOVED_IN})", DeprecationWarning,
-                      stacklevel=2)   # the import line (warnings skips importlib's frames)
-        targets = [importlib.import_module(t) for t in self.targets]
-
-        def __getattr__(name: str):
-            for t in targets:
-                if hasattr(t, name):
-                    return getattr(t, name)
-            raise AttributeError(f"module {module.__name__!r} (moved to {new}) has no "
-                                 f"attribute {name!r}")
-
-        if any(hasattr(t, "__path__") for t in targets):
-            module.__path__ = []                      # a package: its submodules resolve too
-        names = sorted({n for t in targets for n in getattr(t, "__all__", dir(t))
-                        if not n.startswith("_")})
-        module.__dict__.update(__getattr__=__getattr__, __all__=names,
-                               __dir__=lambda: names, __doc__=f"Moved to {new}.")
+        forward(module, self.targets)                 # the warning points at the import line
 
 
 class _OldPaths(importlib.abc.MetaPathFinder):
@@ -73,11 +79,12 @@ class _OldPaths(importlib.abc.MetaPathFinder):
 
 
 def keep_old_paths(table: dict[str, tuple[str, ...]]) -> None:
-    """Make the old paths of ``table`` importable (idempotent). The finder goes first on
-    ``sys.meta_path``: an old path may name a directory that still exists (``agents/policies/``
-    holds the policy files) and would otherwise import as an empty namespace package."""
+    """Make the old paths of ``table`` importable (idempotent). The finder goes last on
+    ``sys.meta_path``: it costs nothing on the imports the other finders find. (An old path that
+    names a directory that still exists, ``agents/policies/``, is found there first: its
+    ``__init__.py`` calls :func:`forward` itself.)"""
     if not any(isinstance(f, _OldPaths) and f.table == table for f in sys.meta_path):
-        sys.meta_path.insert(0, _OldPaths(table))
+        sys.meta_path.append(_OldPaths(table))
 
 
 #: physics's own moves: the run tools went to physics/runs/ (above the model)

@@ -62,10 +62,17 @@ def test_a_moved_packages_submodules_resolve():
     assert names and all(getattr(old, n) is getattr(run, n) for n in names)
 
 
-def test_no_old_path_shadows_a_module_that_exists_now():
+def test_an_old_path_that_exists_as_a_file_is_itself_a_forwarding_shim():
     for old in MOVES:
         path = ROOT.joinpath(*old.split("."))
-        assert not path.with_suffix(".py").exists() and not (path / "__init__.py").exists(), old
+        for file in (path.with_suffix(".py"), path / "__init__.py"):
+            if file.exists():
+                assert "forward(" in file.read_text() and MOVES[old][0] in file.read_text(), old
+
+
+def test_the_finder_costs_nothing_on_imports_it_does_not_serve():
+    finders = [getattr(f, "__name__", type(f).__name__) for f in sys.meta_path]
+    assert "_OldPaths" in finders and finders.index("_OldPaths") > finders.index("PathFinder")
 
 
 def test_a_script_sees_the_warning_at_its_import_line(tmp_path):
