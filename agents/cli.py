@@ -12,6 +12,7 @@ import argparse
 import sys
 from pathlib import Path
 
+import physics
 from physics import cli as physics_cli
 from physics.runs.backend import add_backend_args
 from physics.cli import at_least
@@ -476,6 +477,7 @@ def register_results(sub) -> None:
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="rotordrop", description="AMB rotor drop onto retainer "
                                      "bearings: simulation, studies, Gymnasium environments and agents")
+    parser.add_argument("--version", action="version", version=f"rotordrop {physics.__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     for register_commands in (physics_cli.register, register,
                               register_results, research.register):

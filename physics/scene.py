@@ -648,11 +648,11 @@ def _check_flexible(s: Scene) -> None:
         for key, value in props.items():
             given = s.get(key)
             if not math.isclose(given, value, rel_tol=1e-6):
+                exact = ", ".join(f"{k} = {v!r}" for k, v in props.items())
                 raise SceneError(
-                    f"{key} = {given:g}: allowed {value:.6g} with rotor.model = 'flexible' (the"
-                    f" shaft {s.flexible.shaft!r} has m = {props['rotor.mass']:.6g} kg, I_d ="
-                    f" {props['rotor.diametral_inertia']:.6g} kg m^2, I_p ="
-                    f" {props['rotor.polar_inertia']:.6g} kg m^2; set these rotor.* keys)")
+                    f"{key} = {given:g}: allowed {value!r} (to 1e-6) with rotor.model ="
+                    f" 'flexible': the shaft {s.flexible.shaft!r} has m, I_d, I_p of {exact}"
+                    f" (kg, kg m^2, kg m^2); set these rotor.* keys")
         drop_rotor(s)
     except ShaftError as exc:
         raise SceneError(str(exc)) from None

@@ -294,3 +294,40 @@ def plot_robust(report: dict, out: Path) -> list[Path]:
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return [path]
+
+
+def plot_deltas(rows: list[dict], title: str, path: Path) -> Path:
+    """Every leaderboard row's Δ to the reference row with its 95 % interval (paired bootstrap),
+    in rank order; ``rows``: controller, kind, reference, diff, lo, hi (the CSV beside the PNG).
+    The axis is linear within ±1 point and logarithmic beyond, so that the close rows' intervals
+    and the far ones both show."""
+    plt = _plt()
+    names = [r["controller"] for r in rows]
+    diff, lo, hi = (np.array([float(r[k]) for r in rows]) for k in ("diff", "lo", "hi"))
+    y = np.arange(len(rows))[::-1]
+    fig, ax = plt.subplots(figsize=(8.5, 0.3 * len(rows) + 1.3))
+    for kind, colour in (("designed", "C0"), ("learned", "C2")):
+        on = np.array([r["kind"] == kind for r in rows])
+        if on.any():
+            ax.errorbar(diff[on], y[on], xerr=[diff[on] - lo[on], hi[on] - diff[on]], fmt="o",
+                        color=colour, ms=4, capsize=3, label=kind)
+    ax.axvline(0.0, color="k", lw=0.8)
+    ax.set_xscale("symlog", linthresh=1.0)
+    left, right = min(-1.0, 1.3 * float(lo.min())), max(1.0, 1.3 * float(hi.max()))
+    ax.set_xlim(left, right)
+    ticks = [t for t in (-300, -100, -30, -10, -3, -1, 0, 1, 3, 10, 30, 100, 300)
+             if left <= t <= right]
+    ax.set_xticks(ticks, [f"{t:+d}" if t else "0" for t in ticks])
+    ax.minorticks_off()
+    ax.set_yticks(y, names, fontsize=8)
+    for yi, d, l, h in zip(y, diff, lo, hi):
+        ax.annotate(f"{d:+.2f} [{l:+.2f}, {h:+.2f}]", (1.01, yi), xycoords=("axes fraction", "data"),
+                    va="center", fontsize=7)
+    ref = rows[0]["reference"] if rows else ""
+    ax.set(xlabel=f"Δ score vs {ref} (points; 95 % interval)", title=title)
+    ax.grid(axis="x", alpha=0.3)
+    ax.legend(fontsize=7, loc="upper left")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

@@ -33,8 +33,11 @@ the pages in one go::
     python -m agents.benchmarking.results --hard-run noisy out/tqc-noisy-0/kpis.json runs/tqc-noisy-0 \
         --hard-ref noisy out/whirl-brake-noisy/kpis.json
 
-``--check`` writes nothing and exits 1 when the committed pages differ from what the committed
-data give (the test suite runs it). The module needs only the standard library.
+Each leaderboard shows as a compact table, a figure of every row's Δ with its 95 % interval
+(``docs/img/leaderboards/<suite>-<task>.png``, drawn from the CSV of the same numbers beside it)
+and the full table one click away. ``--check`` writes nothing and exits 1 when the committed
+pages or figure data differ from what the committed data give (the test suite runs it). The
+tables need only the standard library; the figures, matplotlib.
 """
 from __future__ import annotations
 
@@ -101,6 +104,93 @@ def leaderboard_table(entries: list[dict], kind: bool = False, in_out: bool = Tr
     return lines
 
 
+#: the seat a row ran in when the data do not say (rows written before the field existed)
+DEFAULT_SEAT = "supervisor"
+#: the Δ figures of the leaderboards (PNG, with the CSV of the plotted numbers beside it)
+FIGURES = IMG / "leaderboards"
+
+
+def compact_table(entries: list[dict]) -> list[str]:
+    """The leaderboard people read first: rank, controller, seat, score ± SE, Δ to the
+    reference row with its 95 % interval, whirl rate and re-levitation rate."""
+    ref = next((e["reference"] for e in entries if e.get("reference")), None)
+    lines = [f"| rank | controller | seat | score ± SE | Δ vs `{ref}` [95 %] | whirl | "
+             "re-levitated |", "|---:|---|---|---:|---:|---:|---:|"]
+    for i, e in enumerate(entries, 1):
+        diff = "–"
+        if e.get("diff_ci95") is not None:
+            lo, hi = e["diff_ci95"]
+            diff = f"{e['diff_vs_reference']:+.2f} [{lo:+.2f}, {hi:+.2f}]"
+        lines.append(f"| {i} | `{e['controller']}` | {e.get('seat') or DEFAULT_SEAT} | "
+                     f"{_f(e['score'])} ± {_f(e.get('score_se'))} | {diff} | "
+                     f"{_f(e['whirl_rate'])} | {_f(e.get('relevitation_rate'))} |")
+    return lines
+
+
+def leaderboard_view(entries: list[dict], slug: str, **full) -> list[str]:
+    """A leaderboard on the site: the compact table, the figure of every row's Δ with its
+    interval (``docs/img/leaderboards/<slug>.png``) and the full table one click away."""
+    out = [f"Seat: the interface a row acts through (`{DEFAULT_SEAT}` where the data do not "
+           f"record it). The figure's numbers are in `{(FIGURES / slug).as_posix()}.csv`; every "
+           "column is one click below it.", "",
+           '<div class="leaderboard" markdown>', ""] + compact_table(entries) + ["", "</div>", ""]
+    if any(e.get("diff_ci95") is not None for e in entries):
+        out += [f"![Δ of every row to the reference row with its 95 % interval]"
+                f"({(FIGURES / slug).relative_to('docs').as_posix()}.png)", ""]
+    out += ['??? info "Every column"', ""]
+    out += ["    " + line for line in leaderboard_table(entries, **full)] + [""]
+    return out
+
+
+def delta_rows(entries: list[dict]) -> list[dict]:
+    """The numbers a Δ figure plots: per row (rank order) its name, kind and Δ with its 95 %
+    interval, to the reference row."""
+    return [{"controller": e["controller"], "kind": e.get("kind", ""),
+             "reference": e.get("reference") or "", "diff": repr(e["diff_vs_reference"]),
+             "lo": repr(e["diff_ci95"][0]), "hi": repr(e["diff_ci95"][1])}
+            for e in entries if e.get("diff_ci95") is not None]
+
+
+def leaderboards(root: Path) -> dict[str, tuple[str, list[dict]]]:
+    """slug -> (title, rows) of every leaderboard in the committed data."""
+    out = {}
+    nominal = _load(root / DATA / "leaderboard-nominal.json")
+    if nominal:
+        for task in _tasks(nominal):
+            out[f"nominal-{task}"] = (f"nominal suite: {TASK_TITLES.get(task, task)}",
+                                      [e for e in nominal["leaderboard"] if e["task"] == task])
+    robust = _load(root / DATA / "leaderboard-robust.json")
+    if robust:
+        out["robust-full"] = (f"robust suite, {len(robust['scenarios'])} drops",
+                              robust["leaderboard"])
+    return out
+
+
+def figure_data(root: Path) -> dict[Path, str]:
+    """The CSV of each Δ figure (the text the PNG is drawn from)."""
+    out = {}
+    for slug, (_, entries) in leaderboards(root).items():
+        rows = delta_rows(entries)
+        if rows:
+            lines = [",".join(rows[0])] + [",".join(r.values()) for r in rows]
+            out[root / FIGURES / f"{slug}.csv"] = "\n".join(lines) + "\n"
+    return out
+
+
+def draw_figures(root: Path, csvs: list[Path]) -> list[Path]:
+    """The Δ figure of each CSV (matplotlib, imported here: the tables need only the standard
+    library)."""
+    from .plots import plot_deltas
+    titles = {slug: title for slug, (title, _) in leaderboards(root).items()}
+    pngs = []
+    for path in csvs:
+        with path.open(newline="") as fh:
+            rows = list(csv.DictReader(fh))
+        title = titles.get(path.stem, path.stem).replace("`", "")
+        pngs.append(plot_deltas(rows, title, path.with_suffix(".png")))
+    return pngs
+
+
 def se_cells(e: dict) -> list[str]:
     """The SE of a row's score and its difference to the reference row (± SE, [95 %])."""
     if e.get("diff_se") is None:
@@ -125,7 +215,8 @@ def nominal_section(report: dict, source: str) -> list[str]:
            f"scenario says otherwise. {score_words(report)}", ""]
     for task in _tasks(report):
         out += [f"### {TASK_TITLES.get(task, task)}", ""]
-        out += leaderboard_table([e for e in report["leaderboard"] if e["task"] == task]) + [""]
+        out += leaderboard_view([e for e in report["leaderboard"] if e["task"] == task],
+                                f"nominal-{task}")
         out += seed_table([g for g in report.get("seed_groups") or []
                            if any(e["task"] == task and e["controller"] in g["members"]
                                   for e in report["leaderboard"])])
@@ -172,7 +263,7 @@ def robust_section(report: dict, source: str) -> list[str]:
            "latency, actuator spread and plant variation "
            "([what is perturbed](agents.md#robust-suite))."
            + (f" {score_words(report)}" if report.get("score") else ""), ""]
-    out += leaderboard_table(report["leaderboard"], kind=True, in_out=False) + [""]
+    out += leaderboard_view(report["leaderboard"], "robust-full", kind=True, in_out=False)
     out += seed_table(report.get("seed_groups") or [])
     return out
 
@@ -614,7 +705,8 @@ def store(src: str | Path, dest: Path, keep=None, drop=()) -> Path:
 
 
 def generated(root: Path = ROOT) -> dict[Path, str]:
-    return {root / RESULTS: results_page(root), root / README: readme_text(root)}
+    return {root / RESULTS: results_page(root), root / README: readme_text(root),
+            **figure_data(root)}
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -686,11 +778,15 @@ def run(args) -> int:
             return 2
     stale = []
     for path, text in generated(root).items():
-        if path.exists() and path.read_text() == text:
+        if path.exists() and path.read_text() == text and (
+                path.suffix != ".csv" or path.with_suffix(".png").exists()):
             continue
         stale.append(path)
         if not args.check:
+            path.parent.mkdir(parents=True, exist_ok=True)
             path.write_text(text)
+    if not args.check:
+        stale += draw_figures(root, [p for p in stale if p.suffix == ".csv"])
     if args.check:
         if stale:
             print("out of date (run `python -m agents.benchmarking.results`): "

@@ -2,6 +2,8 @@
 the stiff limit against the rigid drop, files, metrics and bad input."""
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -163,6 +165,22 @@ def test_a_ross_rotor_drops(tmp_path):
     r = simulate(scene, t_end=0.2)
     assert np.isfinite(r.Y).all() and audit_residual(r) <= AUDIT_TOL
     assert compute_metrics(r)["planes"]["RB1"]["peak_contact_force_N"] > 0.0
+
+
+def test_the_mass_properties_the_error_prints_are_accepted_when_pasted_back():
+    """The refusal prints the shaft's m, I_d, I_p to full precision: copying them into the scene
+    (as `--set rotor.mass=...` would, from text) loads it, whatever the check's tolerance."""
+    from pathlib import Path
+    path = str(Path(__file__).resolve().parents[2] / "data" / "ross_sample_rotor.toml")
+    where = {"rotor.model": "flexible", "flexible.shaft": path, "positions.rb1": -0.7,
+             "positions.rb2": 0.7, "positions.amb1": -0.6, "positions.amb2": 0.6}
+    with pytest.warns(UserWarning), pytest.raises(SceneError) as err:
+        load_scene("paper", where)
+    printed = dict(re.findall(r"(rotor\.\w+) = ([-+0-9.e]+)(?=[,;) ])", str(err.value).split(": ", 1)[1]))
+    assert set(printed) == {"rotor.mass", "rotor.diametral_inertia", "rotor.polar_inertia"}
+    with pytest.warns(UserWarning):
+        scene = load_scene("paper", {**where, **{k: float(v) for k, v in printed.items()}})
+    assert scene.rotor.mass == float(printed["rotor.mass"]) != 97.3     # the file's, not the paper's
 
 
 @pytest.mark.parametrize("edit, words", [
