@@ -98,10 +98,13 @@ class Commands:
     def interfaces(self) -> tuple[str, ...]:
         return tuple(n for n, on in ((DAMPER, self.damper), (AMB, self.amb)) if on)
 
-    def scene(self, base: Scene, overrides: Mapping | None, env_name: str) -> Scene:
-        """``base`` with the scene keys the interfaces need; SceneError when ``overrides``
-        asks for another value, or the damper has no elastic housing to act on."""
+    def scene(self, base: Scene, overrides: Mapping | None, env_name: str,
+              task_keys: Mapping | None = None) -> Scene:
+        """``base`` with the scene keys the interfaces need and the task's ``task_keys``;
+        SceneError when ``overrides`` asks for another value of one of them, or when the
+        damper has no elastic housing to act on."""
         forced = {k: v for n in self.interfaces for k, v in INTERFACES[n].items()}
+        forced.update(task_keys or {})
         for key, value in forced.items():
             given = (overrides or {}).get(key)
             if given is not None and str(given).lower() != str(value).lower():

@@ -35,12 +35,11 @@ from .reward import Reward, make_reward
 from .scenario import (POWER_RETURN, POWER_RETURN_LIMITS, fault_state, layout_base, reset_options,
                        resolve_ranges, sample, scenario_report, scenario_scene)
 from .sensors import Sensing, check_delay, check_latency, check_noise
-from .settings import (FIXED_SETTINGS, WEIGHT_SLOTS, SettingsGuard, check_flag,  # noqa: F401
-                       check_real, check_steps, check_unused_ranges, check_weights, make_scene,
-                       sensing_scene)
+from .settings import (FIXED_SETTINGS, WEIGHT_SLOTS, SettingsGuard, check_choice,  # noqa: F401
+                       check_flag, check_real, check_steps, check_unused_ranges, check_weights,
+                       make_scene, sensing_scene)
 from .tasks import DAMPING, FULL, PASSIVE, RELEVITATE, Task, resolve_task
 from .view import EpisodeView
-
 
 
 class RotorDropEnv(SettingsGuard, EpisodeView, gym.Env):
@@ -130,9 +129,7 @@ class RotorDropEnv(SettingsGuard, EpisodeView, gym.Env):
         self.commands = Commands.of(task.commands, name, command, damping_action,
                                     supervisor_authority, power_return_time, task.command,
                                     task.power_return_time)
-        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise ValueError(f"render_mode = {render_mode!r} must be None or one of "
-                             f"{self.metadata['render_modes']}")
+        self.render_mode = check_choice("render_mode", render_mode, self.metadata["render_modes"])
         self.reward_function = make_reward(task.reward if reward is None else reward, reward_kwargs)
         self.reward, self.reward_kwargs = self.reward_function.name, dict(reward_kwargs or {})
         terminate = check_flag("terminate_on_failure", terminate_on_failure)
@@ -150,10 +147,9 @@ class RotorDropEnv(SettingsGuard, EpisodeView, gym.Env):
         self.episode_time = self.n_steps * self.dt
         self.randomize = check_flag("randomize", randomize)
         self.full_state = check_flag("full_state", full_state)
-        self.render_mode = render_mode
         noise, delay = check_noise(sensor_noise), check_delay(sensor_delay)
         self.obs_latency_steps = check_latency(obs_latency_steps)
-        self._make_scenes(scene, overrides, noise, delay, randomization, power_return_time)
+        self._make_scenes(name, scene, overrides, noise, delay, randomization, power_return_time)
         self._make_spaces()
         self._bind(Buffers(self.model.n_state, len(self.obs_names), self._n_act,
                            int(samples_per_step), self.model.sizes))
@@ -166,15 +162,12 @@ class RotorDropEnv(SettingsGuard, EpisodeView, gym.Env):
         self._made = True                   # from here on FIXED_SETTINGS cannot be assigned
 
     # ------------------------------------------------------------------------- set-up --
-    def _make_scenes(self, scene, overrides, noise, delay, randomization, power_return_time):
+    def _make_scenes(self, name, scene, overrides, noise, delay, randomization, power_return_time):
         """The base scene (the task's and its interfaces' keys, the sensing), the scenario
         ranges and the keys the user fixed, and the model of the fault state."""
-        base = make_scene(scene, overrides)
-        if self.task.scene:
-            base = base.with_overrides(dict(self.task.scene))
-        base = self.commands.scene(base, overrides, type(self).__name__)
+        base = self.commands.scene(make_scene(scene, overrides), overrides, name, self.task.scene)
         base, self.sensor_noise, self.sensor_delay = sensing_scene(base, noise, delay)
-        self.ranges, fixed = resolve_ranges(randomization, self._relevitate, type(self).__name__,
+        self.ranges, fixed = resolve_ranges(randomization, self._relevitate, name,
                                             self.task.randomization)
         check_unused_ranges(randomization, self.randomize, overrides, power_return_time)
         self.base_scene = layout_base(base, self.ranges, fixed) if self.randomize else base

@@ -34,6 +34,13 @@ def check_flag(name: str, value) -> bool:
     return bool(value)
 
 
+def check_choice(name: str, value, allowed):
+    """``value`` if it is None or one of ``allowed``, else ValueError naming them."""
+    if value is not None and value not in allowed:
+        raise ValueError(f"{name} = {value!r} must be None or one of {allowed}")
+    return value
+
+
 def check_steps(control_dt, episode_time, relevitation_hold, samples_per_step) -> None:
     """The time grid of an episode: control step, length, re-levitation hold, monitor samples."""
     check_real("control_dt", control_dt, 1e-6, 0.1)
