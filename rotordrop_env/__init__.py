@@ -14,7 +14,7 @@ imported ``rotordrop_env`` (e.g. a spawned worker) write the id as
 """
 from .tasks import TASKS
 
-#: id -> entry point of every registered task (a live view of ``rotordrop_env.tasks.TASKS``)
+#: id -> entry point of every registered task (``rotordrop_env.tasks.TASKS``, kept in step)
 ENV_IDS = TASKS.entry_points
 
 

@@ -94,7 +94,7 @@ class RotorDropEnv(SettingsGuard, EpisodeView, gym.Env):
     w_displacement, w_effort,   0.1, 0.01,
     w_success, w_failure        10, 10
     render_mode                 None        "rgb_array" or "human"
-    task                        the class'  ``RotorDropEnv`` only: the :class:`Task` to run
+    task                        the class'  the :class:`Task` to run (``RotorDropEnv``: passive)
     ==========================  ==========  ====================================================
 
     ``info`` (see :mod:`rotordrop_env.info`): the same keys at reset and at every step, numpy

@@ -18,7 +18,7 @@ from __future__ import annotations
 import re
 from contextlib import contextmanager
 from dataclasses import dataclass, field
-from typing import Any, Iterator, Mapping
+from typing import Any, Mapping
 
 ENV_MODULE, VECTOR_MODULE = "rotordrop_env.env", "rotordrop_env.vector"
 DAMPER, AMB = "damper", "amb"
@@ -120,23 +120,20 @@ FULL = Task("Full", commands=(DAMPER, AMB), env_class="FullEnv",
             summary="semi-active damping and AMB reactivation together")
 
 
-class TaskRegistry(Mapping):
-    """Tasks by env id, each registered with Gymnasium as it is added (:meth:`register`);
-    :meth:`temporary` registers one for a ``with`` block only."""
+class TaskRegistry(dict):
+    """Tasks by env id (a dict: looking one up runs no Python code of this module), each
+    registered with Gymnasium as it is added (:meth:`register`); :meth:`temporary` registers
+    one for a ``with`` block only. ``entry_points``: each id's entry point (a dict kept in step,
+    ``rotordrop_env.ENV_IDS``)."""
 
     def __init__(self, *tasks: Task):
-        self._tasks: dict[str, Task] = {}
+        super().__init__()
+        self.entry_points: dict[str, str] = {}
         for task in tasks:
             self.register(task)
 
-    def __getitem__(self, env_id: str) -> Task:
-        return self._tasks[env_id]
-
-    def __iter__(self) -> Iterator[str]:
-        return iter(self._tasks)
-
-    def __len__(self) -> int:
-        return len(self._tasks)
+    def __setitem__(self, env_id, task):
+        raise TypeError("add a task with register(task) (it registers its Gymnasium id too)")
 
     def register(self, task: Task) -> Task:
         """Add ``task`` and register its id with Gymnasium (``gym.make``, ``gym.make_vec``);
@@ -144,20 +141,22 @@ class TaskRegistry(Mapping):
         from gymnasium.envs.registration import register, registry
         if not isinstance(task, Task):
             raise ValueError(f"{task!r} is not a rotordrop_env.tasks.Task")
-        if task.env_id in self._tasks:
+        if task.env_id in self:
             raise ValueError(f"{task.env_id} is already a task")
         if task.env_id in registry and registry[task.env_id].entry_point != task.entry_point:
             raise ValueError(f"{task.env_id} is already a Gymnasium id of another environment")
         if task.env_id not in registry:
             register(id=task.env_id, entry_point=task.entry_point,
                      vector_entry_point=task.vector_entry_point, kwargs=task.gym_kwargs)
-        self._tasks[task.env_id] = task
+        dict.__setitem__(self, task.env_id, task)
+        self.entry_points[task.env_id] = task.entry_point
         return task
 
     def unregister(self, env_id: str) -> Task:
         """Remove a task and its Gymnasium id."""
         from gymnasium.envs.registration import registry
-        task = self._tasks.pop(env_id)
+        task = self.pop(env_id)
+        del self.entry_points[env_id]
         registry.pop(env_id, None)
         return task
 
@@ -170,50 +169,18 @@ class TaskRegistry(Mapping):
         finally:
             self.unregister(task.env_id)
 
-    @property
-    def entry_points(self) -> "EntryPoints":
-        """Each id's entry point, a live view (``rotordrop_env.ENV_IDS``)."""
-        return EntryPoints(self)
-
-
-class EntryPoints(Mapping):
-    """id -> entry point of the tasks of a :class:`TaskRegistry`, as they are now."""
-
-    def __init__(self, tasks: TaskRegistry):
-        self._registry = tasks
-
-    def __getitem__(self, env_id: str) -> str:
-        return self._registry[env_id].entry_point
-
-    def __iter__(self) -> Iterator[str]:
-        return iter(self._registry)
-
-    def __len__(self) -> int:
-        return len(self._registry)
-
-    def __repr__(self) -> str:
-        return repr(dict(self))
-
 
 #: the shipped tasks (and any registered in this process)
 TASKS = TaskRegistry(PASSIVE, DAMPING, RELEVITATE, FULL)
 
 
-def task_of(env_id: str) -> Task | None:
-    """The task of a registered id (None for an id that is not a rotor-drop task)."""
-    return TASKS.get(env_id)
-
-
 def resolve_task(env_class: type, task: Task | None) -> Task:
-    """The task an environment of ``env_class`` runs: its class's (a shipped task's class), or
-    the ``task`` kwarg (``RotorDropEnv``); ValueError for none, a non-task, or another task than
-    the class's."""
+    """The task an environment of ``env_class`` runs: the ``task`` kwarg, else its class's (a
+    shipped task's class; ``RotorDropEnv`` alone runs the passive drop); ValueError for a
+    non-task, or another task than the class's."""
     own = getattr(env_class, "task", None)
-    if task is None and own is None:
-        raise ValueError("RotorDropEnv needs task=Task(...) (rotordrop_env.tasks), or use "
-                         "a task's class or id (gym.make('RotorDrop-Damping-v1'))")
     if task is not None and not isinstance(task, Task):
         raise ValueError(f"task = {task!r} must be a rotordrop_env.tasks.Task")
     if task is not None and own is not None and task != own:
         raise ValueError(f"{env_class.__name__} runs the {own.name} task, not task={task!r}")
-    return own if task is None else task
+    return task or own or PASSIVE

@@ -110,8 +110,11 @@ def test_a_task_is_checked_where_it_is_declared_and_where_it_is_made():
     with pytest.raises(ValueError, match="already a task"):
         TASKS.register(TASKS["RotorDrop-Damping-v1"])
     from rotordrop_env.env import DampingEnv, RotorDropEnv
-    with pytest.raises(ValueError, match="needs task="):
-        RotorDropEnv()
+    assert RotorDropEnv().task == TASKS["RotorDrop-Passive-v1"]        # the base class: passive
+    with pytest.raises(ValueError, match="must be a rotordrop_env.tasks.Task"):
+        RotorDropEnv(task="Damping")
+    with pytest.raises(TypeError, match="register"):
+        TASKS["RotorDrop-Spin-v0"] = Task("Spin", version=0)
     with pytest.raises(ValueError, match="runs the Damping task"):
         DampingEnv(task=TASKS["RotorDrop-Full-v1"])
 
