@@ -241,7 +241,8 @@ def cmd_dataset(args) -> int:
     return 0
 
 
-def register(sub) -> None:
+def _register_train(sub) -> None:
+    """``rotordrop train``."""
     p = sub.add_parser("train", help="train an SB3 agent on a rotor-drop environment")
     p.add_argument("--env", required=True, help="environment id, e.g. RotorDrop-Damping-v1")
     p.add_argument("--algo", required=True, choices=ALGOS)
@@ -281,6 +282,9 @@ def register(sub) -> None:
                         "evaluate, keep best/ and save the model as at the end of a run")
     p.set_defaults(func=cmd_train)
 
+
+def _register_export_policy(sub) -> None:
+    """``rotordrop export-policy``."""
     p = sub.add_parser("export-policy", help="a trained policy as one zip that plain SB3 "
                                              "(PPO.load / SAC.load / TD3.load / TQC.load) runs as rotordrop does")
     p.add_argument("source", help="run directory, its best/, a model or checkpoint zip, or a "
@@ -293,6 +297,9 @@ def register(sub) -> None:
                         "rotordrop train record theirs")
     p.set_defaults(func=cmd_export_policy)
 
+
+def _register_evaluate(sub) -> None:
+    """``rotordrop evaluate``."""
     p = sub.add_parser("evaluate", help="KPIs and plots of a policy or baseline controller")
     p.add_argument("--policy", required=True,
                    help="baseline name (passive, max-damping, whirl-switch, pid-relevitate, ...), shipped "
@@ -321,6 +328,9 @@ def register(sub) -> None:
                    help="the first episode as episode.mp4 (episode.gif without ffmpeg)")
     p.set_defaults(func=cmd_evaluate)
 
+
+def _register_dataset(sub) -> None:
+    """``rotordrop dataset``."""
     p = sub.add_parser("dataset", help="seeded episodes of a controller or policy as a Minari "
                                        "data set (offline RL, behaviour cloning)")
     p.add_argument("--policy", required=True,
@@ -344,8 +354,9 @@ def register(sub) -> None:
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_dataset)
 
-    imitation.register(sub)
 
+def _register_benchmark(sub) -> None:
+    """``rotordrop benchmark``."""
     p = sub.add_parser("benchmark", help="every baseline and shipped policy on a fixed scenario suite")
     p.add_argument("--quick", action="store_true",
                    help="a reduced suite: 5 scenarios x 2 phases (about 15 s); with --suite "
@@ -378,6 +389,9 @@ def register(sub) -> None:
     p.add_argument("--episodes", type=int, default=None, help=argparse.SUPPRESS)
     p.set_defaults(func=cmd_benchmark)
 
+
+def _register_oracle(sub) -> None:
+    """``rotordrop oracle``."""
     p = sub.add_parser("oracle", help="per-scenario searched open-loop command sequences of the "
                                       "supervisor interface: a score reachable on each drop (a "
                                       "lower bound, not a ceiling)")
@@ -421,6 +435,9 @@ def register(sub) -> None:
     _output_args(p, "out/oracle")
     p.set_defaults(func=cmd_oracle)
 
+
+def _register_tune(sub) -> None:
+    """``rotordrop tune``."""
     p = sub.add_parser("tune", help="tune a controller's gains for the benchmark score on the "
                                     "validation suite (scenarios the benchmark does not use)")
     p.add_argument("--policy", required=True,
@@ -441,6 +458,9 @@ def register(sub) -> None:
     _output_args(p, "out/tune")
     p.set_defaults(func=cmd_tune)
 
+
+def _register_ride_through(sub) -> None:
+    """``rotordrop ride-through``."""
     p = sub.add_parser("ride-through", help="how late the AMB power may return for a controller "
                                             "to stop the whirl: friction x power-return map")
     p.add_argument("--env", default="RotorDrop-Relevitate-v1",
@@ -459,6 +479,18 @@ def register(sub) -> None:
     p.add_argument("--quick", action="store_true", help="3 frictions x 3 delays x 2 phases")
     _output_args(p, "out/ride_through")
     p.set_defaults(func=cmd_ride_through)
+
+
+#: agents' commands, each registering its own parser (``imitation`` registers ``bc``)
+COMMANDS = (_register_train, _register_export_policy, _register_evaluate, _register_dataset,
+            imitation.register, _register_benchmark, _register_oracle, _register_tune,
+            _register_ride_through)
+
+
+def register(sub) -> None:
+    """Agents' commands (:data:`COMMANDS`), in the order of ``rotordrop --help``."""
+    for register_command in COMMANDS:
+        register_command(sub)
 
 
 def cmd_results(args) -> int:

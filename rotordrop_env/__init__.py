@@ -5,32 +5,17 @@
     envs = gym.make_vec("RotorDrop-Damping-v1", num_envs=16, vectorization_mode="vector_entry_point")
 
 Ids: ``RotorDrop-Passive-v1``, ``RotorDrop-Damping-v1``, ``RotorDrop-Relevitate-v1``,
-``RotorDrop-Full-v1`` (see docs/environments.md). Each id's ``vector_entry_point`` is the
+``RotorDrop-Full-v1`` (see docs/environments.md), one declaration each in
+:mod:`rotordrop_env.tasks` (``TASKS``, where a new task is registered). Each id's ``vector_entry_point`` is the
 batched Gymnasium vector environment (:mod:`rotordrop_env.vector`); ``BatchedRotorDropVecEnv`` /
 ``make_batched`` are the same batch as a Stable-Baselines3 ``VecEnv``. In a process that has not
 imported ``rotordrop_env`` (e.g. a spawned worker) write the id as
 ``"rotordrop_env:RotorDrop-Damping-v1"``: Gymnasium imports the module first.
 """
-from gymnasium.envs.registration import register, registry
+from .tasks import TASKS
 
-ENV_IDS = {
-    "RotorDrop-Passive-v1": "rotordrop_env.env:PassiveEnv",
-    "RotorDrop-Damping-v1": "rotordrop_env.env:DampingEnv",
-    "RotorDrop-Relevitate-v1": "rotordrop_env.env:RelevitateEnv",
-    "RotorDrop-Full-v1": "rotordrop_env.env:FullEnv",
-}
-
-
-
-def vector_entry_point(entry_point: str) -> str:
-    """The vector environment of a single environment's entry point
-    (``rotordrop_env.env:DampingEnv`` -> ``rotordrop_env.vector:DampingVectorEnv``)."""
-    return "rotordrop_env.vector:" + entry_point.rsplit(":", 1)[1].replace("Env", "VectorEnv")
-
-
-for _id, _entry in ENV_IDS.items():
-    if _id not in registry:
-        register(id=_id, entry_point=_entry, vector_entry_point=vector_entry_point(_entry))
+#: id -> entry point of every registered task (``rotordrop_env.tasks.TASKS``, kept in step)
+ENV_IDS = TASKS.entry_points
 
 
 def __getattr__(name):

@@ -35,7 +35,6 @@ from . import kernels as K
 from .buffers import Buffers
 from .env import RotorDropEnv, real_action
 from .info import info_dict
-from .reward import kpi_step
 
 
 ENVS_PER_THREAD = 4      # fewer environments per thread than this never pay the parallel launch
@@ -105,7 +104,7 @@ class Batch:
         self._args = self.stack.args()
         self.discrete = first._discrete
         self.relevitate = first._relevitate
-        self.kpi_weights = first._kpi_weights
+        self.reward = first.reward_function
         self.sensed = any(env._sensing.active for env in envs)
         self.rendering = first.render_mode is not None
         self.latency = np.zeros(n, dtype=np.int64)        # each env's observation latency
@@ -171,10 +170,7 @@ class Batch:
         if self.sensed:                           # noise / latency (rotordrop_env.sensors)
             for e in rows:
                 obs[e] = self.envs[e].observed()
-        if self.kpi_weights is None:
-            rewards = out[:, K.O_REWARD].copy()
-        else:
-            rewards = kpi_step(out, stack.M, stack.C, self.kpi_weights, self.relevitate)
+        rewards = self.reward.step(out, stack.M, stack.C, self.relevitate)
         if active is not None:
             rewards[~active] = 0.0
         terminated = out[:, K.O_TERM] > 0.0

@@ -1,4 +1,6 @@
-"""The KPI reward (env kwarg ``reward="kpi"``): a reward aligned with the benchmark's KPIs.
+"""The rewards an environment is given (env kwarg ``reward``: an object, or its shorthand name
+with ``reward_kwargs``): :class:`TermReward` (``"default"``) and :class:`KpiPotentialReward`
+(``"kpi"``), looked up in :data:`REWARDS`.
 
 The default reward sums per-step penalties (whirl revolutions, contact force, displacement,
 effort). The benchmark scores episode *maxima* instead: the whirl verdict, the peak contact
@@ -29,6 +31,8 @@ from __future__ import annotations
 import difflib
 import math
 import numbers
+from dataclasses import dataclass, field
+from typing import Mapping
 
 import numpy as np
 
@@ -42,7 +46,6 @@ KPI_WEIGHTS = dict(w_whirl=0.5, w_verdict=0.0, w_severity=0.5, w_force=0.5, w_di
                    force_ref=1e4, disp_ref_um=800.0, whirl_ref_revs=20.0, w_relevitate=1.0,
                    w_time=1.0)
 REFERENCES = ("force_ref", "disp_ref_um", "whirl_ref_revs")
-REWARDS = ("default", "kpi")
 
 
 def check_kpi_weights(kwargs: dict | None) -> dict:
@@ -97,3 +100,88 @@ def kpi_step(out: np.ndarray, M: np.ndarray, C: np.ndarray, weights: dict, relev
     time_cost = weights["w_time"] * C[..., K.C_DT] / horizon
     return kpi_reward(before, phi, out[..., K.O_RELEV] > 0.0, M[..., K.M_RELEV] == 0.0,
                       weights["w_relevitate"], time_cost)
+
+
+# ------------------------------------------------------------------ the reward objects --
+class Reward:
+    """A reward of the environments: ``name`` (its shorthand for ``gym.make(id, reward=name)``)
+    and :meth:`step`, the rewards of the step just taken from the kernel arrays of a batch
+    (2-D, a row per environment; :meth:`one`: of one environment, 1-D). The per-step terms of
+    ``info`` (``reward_whirl``...) are the kernel's, whatever the reward."""
+    name = ""
+
+    def step(self, out: np.ndarray, M: np.ndarray, C: np.ndarray, relevitate: bool) -> np.ndarray:
+        raise NotImplementedError
+
+    def one(self, out: np.ndarray, M: np.ndarray, C: np.ndarray, relevitate: bool) -> float:
+        return float(self.step(out, M, C, relevitate))
+
+
+@dataclass(frozen=True)
+class TermReward(Reward):
+    """``reward="default"``: the sum of the per-step terms the kernel computes with the
+    environment's weights ``w_whirl``... (settable on the environment at any time).
+
+    The terms (each also in ``info["reward_<term>"]``, whatever the reward):
+
+    =============  ========================================================================
+    term           value per control step
+    =============  ========================================================================
+    whirl          -w_whirl x backward orbit revolutions in the step (rotor relative to the
+                   sleeve, counted beyond half the clearance; mean of the two planes)
+    contact        -w_contact x peak contact force in the step / static weight share [N/N]
+    displacement   -w_displacement x peak radial displacement at the retainer planes / clearance
+    effort         -w_effort x mean squared normalised command (damper (C-C_min)/(C_max-C_min),
+                   AMB control currents / current limit)
+    success        +w_success once, when re-levitation is achieved (re-levitation envs)
+    failure        -w_failure x remaining control steps, on termination (failing never pays:
+                   10 per step is above the per-step cost of riding out a whirl, about 3)
+    =============  ========================================================================
+    """
+    name = "default"
+
+    def step(self, out, M, C, relevitate):
+        return out[..., K.O_REWARD].copy()
+
+    def one(self, out, M, C, relevitate):
+        return float(out[K.O_REWARD])
+
+
+@dataclass(frozen=True)
+class KpiPotentialReward(Reward):
+    """``reward="kpi"``: the decrease of the KPI potential (module docstring); ``weights``
+    over ``KPI_WEIGHTS`` (``reward_kwargs``), checked by :func:`check_kpi_weights`."""
+    weights: Mapping[str, float] = field(default_factory=dict)
+    name = "kpi"
+
+    def __post_init__(self):
+        object.__setattr__(self, "weights", check_kpi_weights(self.weights))
+
+    def step(self, out, M, C, relevitate):
+        return kpi_step(out, M, C, self.weights, relevitate)
+
+
+#: the rewards by shorthand name (``gym.make(id, reward="kpi", reward_kwargs={...})``)
+REWARDS: dict[str, type[Reward]] = {"default": TermReward, "kpi": KpiPotentialReward}
+
+
+def make_reward(reward: str | Reward, reward_kwargs: Mapping | None) -> Reward:
+    """The reward object of the env kwargs ``reward`` (a :class:`Reward`, or a name of
+    :data:`REWARDS`) and ``reward_kwargs`` (the named reward's weights); ValueError naming the
+    rewards for an unknown name, and for ``reward_kwargs`` that would be dropped."""
+    if reward_kwargs is not None and not isinstance(reward_kwargs, Mapping):
+        raise ValueError(f"reward_kwargs = {reward_kwargs!r} must be a dict")
+    if isinstance(reward, Reward):
+        if reward_kwargs:
+            raise ValueError(f"reward_kwargs are the weights of a reward given by name; the "
+                             f"reward object {reward!r} has its own")
+        return reward
+    if not isinstance(reward, str) or reward not in REWARDS:
+        raise ValueError(f"reward = {reward!r} is not a reward; the rewards are "
+                         + ", ".join(repr(r) for r in REWARDS) + " or a rotordrop_env.reward.Reward")
+    if reward == "kpi":
+        return KpiPotentialReward(dict(reward_kwargs or {}))
+    if reward_kwargs:
+        raise ValueError(f"reward_kwargs are the weights of reward='kpi'; pass reward='kpi' "
+                         f"or leave them out (reward={reward!r})")
+    return REWARDS[reward]()

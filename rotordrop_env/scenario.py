@@ -33,10 +33,12 @@ DEFAULT_RANGES: dict[str, tuple[str, float, float]] = {
 
 
 def resolve_ranges(custom: Mapping[str, Any] | None, relevitate: bool,
-                   env_name: str) -> tuple[dict, frozenset]:
-    """The defaults updated by the user's ``randomization``: (ranges drawn at every reset, keys
-    it fixes). A value is ``(low, high)`` (uniform), ``(law, low, high)``, or ``None``: fix the
-    key at the scene's value (it is still drawn, see :func:`sample`)."""
+                   env_name: str, task_ranges: Mapping[str, Any] | None = None
+                   ) -> tuple[dict, frozenset]:
+    """The defaults, updated by a task's ``task_ranges`` (its scenario draw: a range, or None
+    to leave a default key out) and by the user's ``randomization``: (ranges drawn at every
+    reset, keys it fixes). A value is ``(low, high)`` (uniform), ``(law, low, high)``, or
+    ``None``: fix the key at the scene's value (it is still drawn, see :func:`sample`)."""
     if custom is None:
         custom = {}
     if not isinstance(custom, Mapping):
@@ -46,6 +48,11 @@ def resolve_ranges(custom: Mapping[str, Any] | None, relevitate: bool,
         raise ValueError(f"randomization[{POWER_RETURN!r}] applies to the re-levitation "
                          f"environments only, not {env_name}")
     ranges = {k: v for k, v in DEFAULT_RANGES.items() if relevitate or k != POWER_RETURN}
+    for key, spec in (task_ranges or {}).items():
+        if spec is None:
+            ranges.pop(key, None)
+        else:
+            ranges[key] = parse_range(key, spec)
     fixed = set()
     for key, spec in custom.items():
         if spec is None:
@@ -183,3 +190,29 @@ def layout_base(base: Scene, ranges: Mapping[str, tuple[str, float, float]],
         if n_lo != n_base:
             switch[key] = lo
     return base.with_overrides(switch) if switch else base
+
+
+def reset_options(options: Mapping | None, relevitate: bool) -> dict:
+    """The scenario keys that ``reset(options={"scenario": {...}})`` fixes for one episode."""
+    fixed = (options or {}).get("scenario") or {}
+    unknown = set(options or {}) - {"scenario"}
+    if unknown or not isinstance(fixed, Mapping):
+        what = f"unknown reset option(s) {sorted(unknown)}" if unknown else \
+            f"reset option scenario = {fixed!r} is not a dict"
+        raise ValueError(f"{what}; use options="
+                         "{'scenario': {dotted_key: value, 'power_return_time': s}}")
+    if POWER_RETURN in fixed and not relevitate:
+        raise ValueError(f"{POWER_RETURN} applies to the re-levitation environments only")
+    return dict(fixed)
+
+
+def scenario_report(ranges: Mapping, values: Mapping, scene: Scene,
+                    power_return: float | None) -> dict:
+    """The machine of an episode: the value of every randomisation key (drawn, fixed by the
+    user, or the scene's without ``randomize``) and of every key fixed by ``reset`` options;
+    the power return as applied (``power_return``: on the control-step grid, None without)."""
+    keys = sorted((set(ranges) | set(values)) - {POWER_RETURN})
+    out = {k: scene.get(k) for k in keys}
+    if power_return is not None:             # without the subtraction's round-off
+        out[POWER_RETURN] = round(float(power_return), 12)
+    return out

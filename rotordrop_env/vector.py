@@ -38,7 +38,8 @@ from .batch import Batch
 
 
 class RotorDropVectorEnv(VectorEnv):
-    """``num_envs`` environments of ``env_class`` (with the environment kwargs) stepped together.
+    """``num_envs`` environments of ``env_class`` (with the environment kwargs; for a task
+    registered by :mod:`rotordrop_env.tasks`, ``RotorDropEnv`` with its ``task``) stepped together.
     ``n_threads``: numba threads of the batched step (default: chosen as it runs, see
     :class:`rotordrop_env.batch.ThreadChoice`)."""
 

@@ -60,16 +60,11 @@ class ControllerError(ValueError):
 
 def task_flags(env_id: str) -> tuple[bool, bool]:
     """(damping, relevitate): what the environment of ``env_id`` lets a controller command, as
-    its class declares it (``_damping``, ``_relevitate``; read through the id's registered entry
-    point). (False, False) for an id that is not a rotor-drop environment."""
-    from importlib import import_module
-
-    from rotordrop_env import ENV_IDS
-    if env_id not in ENV_IDS:
-        return False, False
-    module, name = ENV_IDS[env_id].split(":")
-    cls = getattr(import_module(module), name)
-    return bool(cls._damping), bool(cls._relevitate)
+    its task declares it (the damper and AMB command interfaces of
+    :class:`rotordrop_env.tasks.Task`). (False, False) for an id that is not a rotor-drop task."""
+    from rotordrop_env.tasks import TASKS
+    task = TASKS.get(env_id)
+    return (task.damper, task.amb) if task is not None else (False, False)
 
 
 def make_env(env_id: str, **kwargs):
