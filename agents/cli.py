@@ -145,7 +145,7 @@ def cmd_export_policy(args) -> int:
 
 def cmd_benchmark(args) -> int:
     from physics.runs.backend import Backend
-    from .benchmarking.robust import run_suite
+    from .benchmarking.suites import run_suite
     try:
         run_suite(args.suite, args.out, quick=args.quick, policies=args.policy,
                   max_scenarios=args.scenarios, episodes=args.episodes, progress=not args.quiet,
