@@ -188,10 +188,16 @@ class Entry:
     make: object
     env_kwargs: dict
     seat: str | None = None
+    strict: bool = True             # False: a row no seat admits runs unseated (model selection)
 
     def __post_init__(self):
         from ..control.seats import check_seat, seat_for_kwargs
-        want = seat_for_kwargs(self.env_kwargs)
+        try:
+            want = seat_for_kwargs(self.env_kwargs)
+        except ValueError:
+            if self.strict or self.seat is not None:
+                raise
+            return
         if self.seat is None:
             self.seat = want.name
         elif check_seat(self.seat) is not want:
@@ -336,7 +342,7 @@ def episode_kwargs(entry: Entry, scenario: Scenario, phase: float) -> dict:
         kw.update(scenario.env_kwargs)
     if scenario.sensor_noise:
         kw["sensor_noise"] = scenario.sensor_noise
-    if scenario.latency_s and check_seat(entry.seat).transport_latency:
+    if scenario.latency_s and (entry.seat is None or check_seat(entry.seat).transport_latency):
         kw["obs_latency_steps"] = latency_steps(scenario.latency_s, kw.get("control_dt", 1e-3))
     return kw
 
@@ -464,8 +470,8 @@ class Validator:
                                   self.phases)
 
     def score(self, make_actor, env_kwargs: dict) -> tuple[float, list[dict]]:
-        rows = suite_rows(Entry("candidate", self.task, make_actor, env_kwargs), self.scenarios,
-                          self.phases)
+        rows = suite_rows(Entry("candidate", self.task, make_actor, env_kwargs, strict=False),
+                          self.scenarios, self.phases)
         board = leaderboard(self.passive + rows, self.scenarios, None)
         return next(e["score"] for e in board if e["controller"] == "candidate"), rows
 

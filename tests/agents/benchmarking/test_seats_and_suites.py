@@ -49,6 +49,10 @@ def test_a_row_declared_in_the_wrong_seat_is_refused():
     with pytest.raises(ValueError, match="outside the controller seat's 0.1-0.2 ms"):
         CONTROLLER.env_kwargs(1e-3)
     assert not CONTROLLER.admits({"command": "supervisor", "control_dt": 2e-4})
+    # model selection during training scores a run at any step: unseated, with the latency
+    odd = Entry("x", "full", None, {"command": "continuous", "control_dt": 5e-4}, strict=False)
+    late = Scenario("s", 0.4, latency_s=1e-3, sensor_noise=1e-6)
+    assert odd.seat is None and episode_kwargs(odd, late, 0.0)["obs_latency_steps"] == 2
 
 
 def test_seats_follow_the_channels_a_law_commands():
