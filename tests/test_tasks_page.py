@@ -28,10 +28,12 @@ def test_every_quoted_row_score_is_the_committed_one():
         rows = {e["controller"]: e for e in _load(f"leaderboard-{suite}")["leaderboard"]
                 if e["task"] == task}
         status = sections[title].split("**Status", 1)[1]
-        for name, score, se in re.findall(r"`([\w-]+)` (-?\d+\.\d\d)\b(?: ± (\d+\.\d\d))?", status):
+        for name, score, se in re.findall(r"`([\w-]+)`(?: \((?:controller|supervisor) seat\))? (-?\d+\.\d\d)\b(?: ± (\d+\.\d\d))?", status):
             assert name in rows, (title, name)
             assert f"{rows[name]['score']:.2f}" == score, (title, name, rows[name]["score"], score)
             assert se == f"{rows[name]['score_se']:.2f}", (title, name, "SE", se)   # quoted with it
+            if "seat)" in status and rows[name].get("seat"):
+                assert f"`{name}` ({rows[name]['seat']} seat)" in status, (title, name)
             checked += 1
     assert checked >= 8
 
