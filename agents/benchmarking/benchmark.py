@@ -191,7 +191,7 @@ class Entry:
     strict: bool = True             # False: a row no seat admits runs unseated (model selection)
 
     def __post_init__(self):
-        from ..control.seats import check_seat, seat_for_kwargs
+        from ..control.seats import seat_for_kwargs
         try:
             want = seat_for_kwargs(self.env_kwargs)
         except ValueError:
@@ -230,8 +230,8 @@ def _entries(policies: list[LearnedPolicy], controllers=(), tasks=None, suite=No
 def robust_entries(policies: list[str] | None, env_id: str | None = None,
                    names: list[str] | None = None, suite=None,
                    quick: bool = False) -> tuple[list[Entry], dict]:
-    """The Full-task entries of a drawn suite (default the robust one): every baseline with
-    channels there (with its constants tuned on the suite, if any), the shipped Full policies
+    """The Full-task entries of a drawn suite: every baseline with channels there (with its
+    constants tuned on ``suite``, if it has a record; none without a suite), the shipped Full policies
     (with ``quick`` and ``policies`` given: only those asked for), the ``--policy`` extras (see
     :func:`extras` for ``env_id`` and ``names``); and the learned ones by name."""
     extra, custom = extras(policies or [], env_id, names)

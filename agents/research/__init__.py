@@ -40,7 +40,7 @@ def register(subparsers) -> None:
     q.add_argument("--out", default="out/whirl_bound")
     q.set_defaults(func=cmd_whirl_bound)
 
-    from agents.benchmarking.tuned import DESIGNED, LEARNED_SELECTION_EPISODES
+    from agents.benchmarking.tune_designed import DESIGNED, LEARNED_SELECTION_EPISODES
     q = sub.add_parser("tune-designed", help="tune every designed law with constants on a suite's "
                                              "validation drops, in its seat, and store the "
                                              "constants with what they were tuned under")
@@ -73,7 +73,7 @@ def register(subparsers) -> None:
 
 def cmd_tune_designed(args) -> int:
     from agents.benchmarking.suites import SUITES
-    from agents.benchmarking.tuned import tune_designed
+    from agents.benchmarking.tune_designed import tune_designed
 
     def run(a):
         tune_designed(SUITES.get(a.suite, "tune"), a.law, a.episodes, a.seed, not a.quiet, a.out)

@@ -178,7 +178,7 @@ def test_learned_selection_budget_is_the_configs():
 
     import yaml
 
-    from agents.benchmarking.tuned import LEARNED_SELECTION_EPISODES
+    from agents.benchmarking.tune_designed import LEARNED_SELECTION_EPISODES
     from agents.training import train
     cfg = yaml.safe_load((ROOT / "agents" / "configs" / "ppo.yaml").read_text())
     steps = float(cfg["ppo-robust-full-scratch"]["n_timesteps"])
@@ -191,7 +191,7 @@ def test_shipped_tuned_records_match_the_current_environment_and_sensing():
     """A designed row's constants were tuned on validation under the environment and sensing
     it is scored under; a changed sensing model or plant (the fingerprint of a short validation
     drop), env id, seat or step makes this fail: re-run `rotordrop research tune-designed`."""
-    from agents.benchmarking.tuned import DESIGNED, load_records, stale
+    from agents.benchmarking.tune_designed import DESIGNED, load_records, stale
     suite = SUITES.get("robust", "tune")
     records = load_records(suite)
     assert set(records) == set(DESIGNED)
