@@ -173,8 +173,8 @@ def robust_section(report: dict, source: str) -> list[str]:
            f"sensor noise, "
            + (f"{'–'.join(f'{1e3 * v:g}' for v in d['sensor_delay_s'])} ms sensor delay (every "
               "controller), " if d.get("sensor_delay_s") else "")
-           + f"{'–'.join(str(x) for x in d.get('latency_ms', []))} ms observation "
-           "latency, actuator spread and plant variation "
+           + f"{'–'.join(str(x) for x in d.get('latency_ms', []))} ms transport "
+           "latency (rows in the supervisor seat), actuator spread and plant variation "
            "([what is perturbed](agents.md#robust-suite))."
            + (f" {score_words(report)}" if report.get("score") else ""), ""]
     out += leaderboard_table(report["leaderboard"], kind=True, in_out=False) + [""]
