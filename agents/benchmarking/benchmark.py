@@ -38,7 +38,8 @@ import numpy as np
 
 from ..control.controllers import BASELINES, Passive, controller_class, controller_env_kwargs, make_controller
 from ..control.plant import task_flags
-from ..learning.policies import LearnedPolicy, load_shipped, policy_label, shipped_names
+from ..control.seats import check_seat
+from ..learning.policies import LearnedPolicy, load_shipped, policy_label
 from .rollout import check_actor, monitor_kwargs, run_episodes
 from .score import (BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, DEFAULT_SCORE, attach_bootstrap,
                     check_score, drop_costs, fmt_or_dash, overall_score, row_cost, summarize,
@@ -66,31 +67,10 @@ def _env_tasks() -> tuple[dict[str, str], tuple[str, ...]]:
 TASKS, RELEVITATION_ENVS = _env_tasks()
 
 
-@dataclass(frozen=True)
-class Suite:
-    """A named set of scenarios, the ``--suite`` of ``rotordrop benchmark``, ``tune`` and
-    ``oracle``: the fixed nominal suite, or drops drawn one per seed from ``seed`` on."""
-    name: str
-    about: str
-    seed: int | None = None         # the first drawn scenario's seed (None: the fixed suite)
-
-
-#: every suite; each command accepts those it can run (:func:`check_suite`)
-SUITES = {s.name: s for s in (
-    Suite("nominal", "the fixed scenario suite around the passive threshold (module doc)"),
-    Suite("robust", "the robust suite's test drops of the Full task (agents.benchmarking.robust)",
-          50_000),                  # fresh: no choice was made on them
-    Suite("robust-legacy", "the robust suite's earlier test drops", 30_000),
-    Suite("full", "drops of the Full task drawn by its own sampler from the oracle's ranges "
-                  "(agents.research.oracle)", 10_000),
-)}
-
-
-def check_suite(suite: str, accepted: tuple[str, ...] = ("nominal", "robust", "robust-legacy")) -> Suite:
-    """The :class:`Suite` named ``suite``; a ValueError unless a command ``accepted`` it."""
-    if suite not in accepted:
-        raise ValueError(f"--suite = {suite!r} must be one of {', '.join(accepted)}")
-    return SUITES[suite]
+def round_up(t: float, grid: float) -> float:
+    """``t`` [s] rounded up to the ``grid`` [s] (so that every row sees the power return at
+    the same control instant), to 12 decimals: a suite's power-return rounding."""
+    return round(math.ceil(t / grid - 1e-9) * grid, 12)
 
 
 def task_of(env_id: str) -> str:
@@ -201,22 +181,43 @@ def _group(sc: Scenario, task: str | None = None) -> str:
 
 @dataclass
 class Entry:
-    """A controller in the benchmark: display name, task, how to build it, env kwargs."""
+    """A controller in the benchmark: display name, task, how to build it, env kwargs, and
+    its seat (:data:`agents.control.seats.SEATS`; default: the one its env kwargs put it in)."""
     name: str
     task: str
     make: object
     env_kwargs: dict
+    seat: str | None = None
+    strict: bool = True             # False: a row no seat admits runs unseated (model selection)
+
+    def __post_init__(self):
+        from ..control.seats import seat_for_kwargs
+        try:
+            want = seat_for_kwargs(self.env_kwargs)
+        except ValueError:
+            if self.strict or self.seat is not None:
+                raise
+            return
+        if self.seat is None:
+            self.seat = want.name
+        elif check_seat(self.seat) is not want:
+            raise ValueError(f"{self.name}: its env kwargs (control_dt, command) run it in the "
+                             f"{want.name} seat, not in the {self.seat} seat it declares")
 
 
-def _entries(policies: list[LearnedPolicy], controllers=()) -> list[Entry]:
-    """Every controller class (the baselines, then ``controllers``) in each task that has its
-    channels, and every policy in the task it was trained for."""
+def _entries(policies: list[LearnedPolicy], controllers=(), tasks=None, suite=None) -> list[Entry]:
+    """Every controller class (the baselines, then ``controllers``) in each task (of ``tasks``,
+    default all) that has its channels, with the constants tuned for ``suite``
+    (:mod:`agents.benchmarking.tuned`) where it has them, and every policy in the task it was
+    trained for."""
     from ..control.plant import plant_of
     out = []
     for task, env_id in TASKS.items():
+        if tasks is not None and task not in tasks:
+            continue
         plants = {}                                  # per re-levitation command
         for cls in [*BASELINES.values(), *controllers]:
-            entry = controller_entry(cls, env_id)
+            entry = controller_entry(cls, env_id, suite)
             command = entry.env_kwargs.get("command")
             if command not in plants:
                 plants[command] = plant_of(env_id, **entry.env_kwargs)
@@ -227,23 +228,41 @@ def _entries(policies: list[LearnedPolicy], controllers=()) -> list[Entry]:
 
 
 def robust_entries(policies: list[str] | None, env_id: str | None = None,
-                   names: list[str] | None = None) -> tuple[list[Entry], dict]:
-    """The Full-task entries of the robust suite (every baseline with channels there, the
-    shipped Full policies, the ``--policy`` extras, see :func:`extras` for ``env_id`` and
-    ``names``) and the learned ones by name."""
+                   names: list[str] | None = None, suite=None,
+                   quick: bool = False) -> tuple[list[Entry], dict]:
+    """The Full-task entries of a drawn suite: every baseline with channels there (with its
+    constants tuned on ``suite``, if it has a record; none without a suite), the shipped Full policies
+    (with ``quick`` and ``policies`` given: only those asked for), the ``--policy`` extras (see
+    :func:`extras` for ``env_id`` and ``names``); and the learned ones by name."""
     extra, custom = extras(policies or [], env_id, names)
-    loaded = [p for p in [load_shipped(n) for n in shipped_names()] + extra
+    loaded = [p for p in [load_shipped(n) for n in shipped_names(policies, quick)] + extra
               if p.env_id == TASKS["full"]]
-    entries = check_unique_names([e for e in _entries(loaded, custom) if e.task == "full"])
+    entries = check_unique_names([e for e in _entries(loaded, custom, ("full",), suite)
+                                  if e.task == "full"])
     for e in [e for e in entries if e.name in {c.name for c in custom}]:
         check_actor(TASKS[e.task], e.make, e.env_kwargs)
     return entries, {p.name: p for p in loaded}
 
 
-def controller_entry(cls, env_id: str) -> Entry:
-    """The benchmark entry of a controller class in the task of ``env_id``."""
-    return Entry(cls.name, task_of(env_id), lambda plant: make_controller(cls, plant),
-                 controller_env_kwargs(cls, env_id))
+def controller_entry(cls, env_id: str, suite=None) -> Entry:
+    """The benchmark entry of a controller class in the task of ``env_id``, in its seat, with
+    the constants tuned for ``suite`` where a record has them (:func:`agents.benchmarking.tuned.tuned_gains`)."""
+    from ..control.seats import seat_of
+    from .tuned import tuned_gains
+    gains = tuned_gains(suite, cls.name, env_id) if suite is not None else None
+    make = ((lambda plant: make_controller(cls, plant)) if not gains else
+            (lambda plant: cls(plant, **gains)))
+    return Entry(cls.name, task_of(env_id), make, controller_env_kwargs(cls, env_id),
+                 seat_of(cls).name)
+
+
+def shipped_names(policies: list[str] | None = None, quick: bool = False) -> list[str]:
+    """The shipped policies a benchmark runs: all of them, or with ``quick`` and ``policies``
+    given, only the shipped ones among ``policies`` (``--quick --policy NAME``)."""
+    from ..learning.policies import shipped_names as every
+    if quick and policies:
+        return [n for n in every() if n in policies]
+    return every()
 
 
 def extras(specs: list[str], env_id: str | None = None,
@@ -272,6 +291,21 @@ def extras(specs: list[str], env_id: str | None = None,
                 raise ValueError(f"--name {name!r}: a leaderboard name without spaces, '|' or '`'")
             policy.name = name
     return policies, classes
+
+
+def quick_tasks(policies, quick: bool, loaded, custom, env_id=None) -> tuple[str, ...] | None:
+    """The tasks a ``--quick`` benchmark with ``--policy`` runs: those of the given policies and
+    controllers (with their references, the baselines of the task); None (every task) else."""
+    if not (quick and policies):
+        return None
+    from ..control.plant import plant_of
+    tasks = {task_of(p.env_id) for p in loaded}
+    for cls in custom:
+        tasks |= {t for t, e in TASKS.items()
+                  if cls.supports(plant_of(e, **controller_env_kwargs(cls, e)))}
+    tasks |= {t for t, e in TASKS.items() for n in policies
+              if n in BASELINES and BASELINES[n].supports(plant_of(e, **controller_env_kwargs(BASELINES[n], e)))}
+    return tuple(t for t in TASKS if t in tasks)
 
 
 def check_power_return(seconds: float, flag: str, episode_time: float = EPISODE_TIME) -> None:
@@ -308,7 +342,7 @@ def episode_kwargs(entry: Entry, scenario: Scenario, phase: float) -> dict:
         kw.update(scenario.env_kwargs)
     if scenario.sensor_noise:
         kw["sensor_noise"] = scenario.sensor_noise
-    if scenario.latency_s:
+    if scenario.latency_s and (entry.seat is None or check_seat(entry.seat).transport_latency):
         kw["obs_latency_steps"] = latency_steps(scenario.latency_s, kw.get("control_dt", 1e-3))
     return kw
 
@@ -341,8 +375,9 @@ def benchmark(out: str | Path, quick: bool = False, policies: list[str] | None =
     if episodes is not None:
         phases = PHASES[:max(1, min(episodes, len(PHASES)))]
     extra, custom = extras(policies or [], env_id, names)
-    loaded = [load_shipped(n) for n in shipped_names()] + extra
-    entries = check_unique_names(_entries(loaded, custom))
+    loaded = [load_shipped(n) for n in shipped_names(policies, quick)] + extra
+    entries = check_unique_names(_entries(loaded, custom, quick_tasks(policies, quick, loaded,
+                                                                      custom, env_id)))
     users = {c.name for c in custom}
     for e in [e for e in entries if e.name in users]:       # fail fast, before the sweep
         check_actor(TASKS[e.task], e.make, e.env_kwargs)
@@ -367,7 +402,8 @@ def benchmark(out: str | Path, quick: bool = False, policies: list[str] | None =
         e["kind"] = "learned" if e["controller"] in learned else "designed"
     from .score import seed_groups
     from rotordrop_env.env import DEFAULT_POWER_RETURN
-    report = dict(quick=quick, score=score, bootstrap=bootstrap_record(),
+    report = dict(quick=quick, partial=max_scenarios is not None or episodes is not None,
+                  score=score, bootstrap=bootstrap_record(),
                   seed_groups=seed_groups(board, learned),
                   episode_time_s=EPISODE_TIME, phases_deg=list(phases),
                   power_return_s=DEFAULT_POWER_RETURN if power_return is None else power_return,
@@ -434,8 +470,8 @@ class Validator:
                                   self.phases)
 
     def score(self, make_actor, env_kwargs: dict) -> tuple[float, list[dict]]:
-        rows = suite_rows(Entry("candidate", self.task, make_actor, env_kwargs), self.scenarios,
-                          self.phases)
+        rows = suite_rows(Entry("candidate", self.task, make_actor, env_kwargs, strict=False),
+                          self.scenarios, self.phases)
         board = leaderboard(self.passive + rows, self.scenarios, None)
         return next(e["score"] for e in board if e["controller"] == "candidate"), rows
 
@@ -443,7 +479,8 @@ class Validator:
 def _row(entry: Entry, sc: Scenario, eps) -> dict:
     s = summarize(eps)
     k = [e.kpis for e in eps]
-    return dict(controller=entry.name, task=entry.task, env_id=TASKS[entry.task], scenario=sc.name,
+    return dict(controller=entry.name, seat=entry.seat, task=entry.task, env_id=TASKS[entry.task],
+                scenario=sc.name,
                 group=_group(sc, entry.task), friction=sc.friction,
                 backward_whirl=s["backward_whirl_rate"],
                 whirl_revolutions=float(np.mean([d["whirl_revolutions"] for d in k])),
@@ -475,7 +512,8 @@ def _plain(v):
 
 def bootstrap_record() -> dict:
     """How the leaderboard's uncertainties were computed (recorded in benchmark.json)."""
-    return dict(method="paired bootstrap over drops (scenario x phase episodes)",
+    return dict(method="paired bootstrap over scenarios (all unbalance phases of a drawn "
+                       "scenario together)",
                 resamples=BOOTSTRAP_RESAMPLES, seed=BOOTSTRAP_SEED, interval="95 % percentile",
                 reference="the best designed row (baseline controller, not passive) of the task "
                           "by point score")
@@ -502,7 +540,7 @@ def leaderboard(rows: list[dict], scenarios: list[Scenario], threshold,
             whirl_sc = [r for r in mine if passive[r["scenario"]]["backward_whirl"] >= 0.5
                         and (any_friction or threshold is not None
                              and r["friction"] >= threshold + 0.05 - 1e-9)]
-            entry = dict(task=task, controller=name,
+            entry = dict(task=task, controller=name, seat=mine[0].get("seat"),
                          score=overall_score(list(costs.values()), [p_costs[n] for n in costs]),
                          in_distribution_score=_group_score(mine, costs, p_costs, "in-distribution"),
                          out_of_distribution_score=_group_score(mine, costs, p_costs,
@@ -554,7 +592,10 @@ def add_uncertainty(entries: list[dict], rows: list[dict], passive: dict, relev:
     pool = designed if designed else ([names.index("passive")] if "passive" in names else [])
     if not pool:
         return
-    attach_bootstrap(entries, costs, p_cost, max(pool, key=lambda i: entries[i]["score"]))
+    clusters = np.concatenate([np.full(len(passive[s]["drops"]["backward_whirl"]), i)
+                               for i, s in enumerate(order)])       # the scenario of each drop
+    attach_bootstrap(entries, costs, p_cost, max(pool, key=lambda i: entries[i]["score"]),
+                     clusters)
 
 
 def _group_score(mine, costs, p_costs, group):
@@ -582,7 +623,7 @@ def score_sentence(report: dict) -> str:
     text = (f"Score ({report.get('score', 'legacy')}): 100 (1 - sum J / sum J_passive), see "
             "docs/agents.md.")
     if b:
-        text += (f" SE: paired bootstrap over the drops ({b['resamples']} resamples, seed "
+        text += (f" SE: {b.get('method', 'paired bootstrap over the drops')} ({b['resamples']} resamples, seed "
                  f"{b['seed']}); Δ: score minus the best designed row's of the task, with its SE "
                  "and 95 % interval.")
     return text
@@ -604,13 +645,13 @@ def leaderboard_tables(report: dict, scenario_rows: bool = True) -> list[str]:
         ref = next((e.get("reference") for e in report["leaderboard"]
                     if e["task"] == task and e.get("reference")), None)
         lines += [f"## {task}", "",
-                  f"| rank | controller | score | SE | Δ vs {ref or 'best designed'} ± SE [95 %] | "
+                  f"| rank | controller | seat | score | SE | Δ vs {ref or 'best designed'} ± SE [95 %] | "
                   "in-dist. | out-of-dist. | whirl rate | whirl where "
                   "passive whirls | peak F / passive (mean, max) | disp. / passive | relevitated | "
                   "stator contact |",
-                  "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+                  "|---:|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
         for i, e in enumerate([e for e in report["leaderboard"] if e["task"] == task], 1):
-            lines.append(f"| {i} | {e['controller']} | {e['score']:.2f} | "
+            lines.append(f"| {i} | {e['controller']} | {e.get('seat') or '-'} | {e['score']:.2f} | "
                          f"{' | '.join(uncertainty_cells(e))} | "
                          f"{fmt_or_dash(e['in_distribution_score'], '.2f')} | "
                          f"{fmt_or_dash(e['out_of_distribution_score'], '.2f')} | {e['whirl_rate']:.2f} | "

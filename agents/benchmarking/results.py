@@ -54,6 +54,7 @@ DATA = Path("docs/data")
 IMG = Path("docs/img")
 RESULTS = Path("docs/results.md")
 README = Path("README.md")
+TASKS = Path("docs/tasks.md")
 START, END = "<!-- leaderboard:start -->", "<!-- leaderboard:end -->"
 #: the benchmark.json keys kept in docs/data (the per-episode ``rows`` are left out)
 DROPPED_KEYS = ("rows",)
@@ -83,15 +84,17 @@ def leaderboard_table(entries: list[dict], kind: bool = False, in_out: bool = Tr
     interval) where the data have them."""
     se = any(e.get("score_se") is not None for e in entries)
     ref = next((e["reference"] for e in entries if e.get("reference")), None)
-    head = ["rank", "controller"] + (["kind"] if kind else []) + ["score"]
+    seat = any(e.get("seat") for e in entries)
+    head = ["rank", "controller"] + (["kind"] if kind else []) + (["seat"] if seat else []) + ["score"]
     head += ["SE", f"Δ vs `{ref}` ± SE [95 %]"] if se else []
     head += (["in-dist.", "out-of-dist."] if in_out else [])
     head += ["whirl rate", "whirl where passive whirls", "peak F / passive (mean, max)",
              "disp. / passive", "relevitated", "stator contact"]
-    align = ["---:", "---"] + (["---"] if kind else []) + ["---:"] * (len(head) - 2 - kind)
+    align = ["---:", "---"] + (["---"] * (kind + seat)) + ["---:"] * (len(head) - 2 - kind - seat)
     lines = ["| " + " | ".join(head) + " |", "|" + "|".join(align) + "|"]
     for i, e in enumerate(entries, 1):
         cells = [str(i), f"`{e['controller']}`"] + ([e.get("kind", "")] if kind else [])
+        cells += [e.get("seat") or "–"] if seat else []
         cells.append(_f(e["score"]))
         if se:
             cells += se_cells(e)
@@ -193,10 +196,12 @@ def draw_figures(root: Path, csvs: list[Path]) -> list[Path]:
 
 def se_cells(e: dict) -> list[str]:
     """The SE of a row's score and its difference to the reference row (± SE, [95 %])."""
+    seeds = (f" (seeds {e['seed_mean']:.2f} ± {e['seed_std']:.2f}, n={e['seeds']})"
+             if e.get("seed_std") is not None else "")
     if e.get("diff_se") is None:
-        return [_f(e.get("score_se")), "–"]
+        return [_f(e.get("score_se")) + seeds, "–"]
     lo, hi = e["diff_ci95"]
-    return [_f(e.get("score_se")),
+    return [_f(e.get("score_se")) + seeds,
             f"{e['diff_vs_reference']:+.2f} ± {e['diff_se']:.2f} [{lo:+.2f}, {hi:+.2f}]"]
 
 
@@ -230,7 +235,7 @@ def score_words(report: dict) -> str:
             "([how it is scored](agents.md#benchmark-rotordrop-benchmark)).")
     b = report.get("bootstrap")
     if b:
-        text += (f" SE: paired bootstrap over the drops ({b['resamples']} resamples, seed "
+        text += (f" SE: {b.get('method', 'paired bootstrap over the drops')} ({b['resamples']} resamples, seed "
                  f"{b['seed']}); Δ: the score minus the best designed row's, with its SE and 95 % "
                  "interval.")
     return text
@@ -259,8 +264,8 @@ def robust_section(report: dict, source: str) -> list[str]:
            f"sensor noise, "
            + (f"{'–'.join(f'{1e3 * v:g}' for v in d['sensor_delay_s'])} ms sensor delay (every "
               "controller), " if d.get("sensor_delay_s") else "")
-           + f"{'–'.join(str(x) for x in d.get('latency_ms', []))} ms observation "
-           "latency, actuator spread and plant variation "
+           + f"{'–'.join(str(x) for x in d.get('latency_ms', []))} ms transport "
+           "latency (rows in the supervisor seat), actuator spread and plant variation "
            "([what is perturbed](agents.md#robust-suite))."
            + (f" {score_words(report)}" if report.get("score") else ""), ""]
     out += leaderboard_view(report["leaderboard"], "robust-full", kind=True, in_out=False)
@@ -534,6 +539,43 @@ def hard_algorithm_rows(table: dict, variant: str) -> list[dict]:
     return rows
 
 
+#: the hard benchmark's ranking rule: every run trains for this many environment steps (the
+#: same for every algorithm, ``rotordrop train --timesteps``; wall time on shared cores is no
+#: budget), at least ``HARD_MIN_SEEDS`` seeds per algorithm, ranked by the mean − std of the
+#: re-levitation rate over the seeds
+HARD_STEP_BUDGET = 500_000
+HARD_MIN_SEEDS = 3
+#: a run may overshoot the budget by one rollout / batch (SB3 stops at a whole rollout)
+HARD_STEP_SLACK = 0.02
+
+
+def hard_ranking(table: dict, variant: str) -> list[dict]:
+    """The algorithms of ``variant`` ranked by mean − std of the re-levitation rate over their
+    seeds (best first); ValueError naming what breaks the rule (:data:`HARD_STEP_BUDGET`:
+    runs whose step budgets differ or were cut by wall time, fewer than
+    :data:`HARD_MIN_SEEDS` seeds)."""
+    rows = [r for r in hard_algorithm_rows(table, variant) if r["kind"] == "learned"]
+    problems = []
+    for r in rows:
+        off = [s for s, run in zip(r["steps"], r["runs"])
+               if not HARD_STEP_BUDGET <= s <= HARD_STEP_BUDGET * (1 + HARD_STEP_SLACK)
+               or run.get("time_limit_s")]
+        if off:
+            problems.append(f"{r['name']}: {', '.join(f'{s // 1000} k' for s in off)} steps"
+                            + (" under a wall-time limit" if any(run.get("time_limit_s")
+                                                                for run in r["runs"]) else ""))
+        if len(r["runs"]) < HARD_MIN_SEEDS:
+            problems.append(f"{r['name']}: {len(r['runs'])} seed(s)")
+    if problems:
+        raise ValueError(f"the {variant} table ranks nothing: every run must train "
+                         f"{HARD_STEP_BUDGET // 1000} k environment steps with no wall-time limit, "
+                         f"at least {HARD_MIN_SEEDS} seeds per algorithm; "
+                         + "; ".join(problems))
+    for r in rows:
+        r["mean_minus_std"] = r["rate_mean"] - (r["rate_std"] or 0.0)
+    return sorted(rows, key=lambda r: -r["mean_minus_std"])
+
+
 def hard_table_section(table: dict, source: str) -> list[str]:
     """The algorithm table of each variant: learned rows (mean ± std over seeds, per seed with its
     SE over the drops) and the designed references on the same drops and sensing."""
@@ -566,7 +608,13 @@ def hard_table_section(table: dict, source: str) -> list[str]:
         rows = hard_algorithm_rows(table, variant)
         if not rows:
             continue
-        out += [f"**{variant.capitalize()}**: {title}.", "",
+        try:
+            ranked = [r["name"] for r in hard_ranking(table, variant)]
+            verdict = ("Ranking (mean − std over the seeds, the same step budget for every "
+                       f"algorithm): {', '.join(f'`{n}`' for n in ranked)}.")
+        except ValueError as exc:
+            verdict = f"Not a ranking: {exc}."
+        out += [f"**{variant.capitalize()}**: {title}. {verdict}", "",
                 "| algorithm | kind | re-levitation rate (mean ± std) | per seed (± SE over the "
                 f"{drops} drops) | after the power return, median [ms] | whirl rate (mean ± std) | "
                 "stator contact | steps per seed |",
@@ -704,9 +752,91 @@ def store(src: str | Path, dest: Path, keep=None, drop=()) -> Path:
     return dest
 
 
+#: docs/tasks.md's generated blocks: key -> (leaderboard file, task)
+STANDINGS = {"damping": ("leaderboard-nominal.json", "damping"),
+             "relevitate": ("leaderboard-nominal.json", "relevitate"),
+             "full": ("leaderboard-nominal.json", "full"),
+             "robust": ("leaderboard-robust.json", "full")}
+
+
+def _cited(e: dict) -> str:
+    """`` `name` (seat seat) score ± SE``: a row as tasks.md quotes it."""
+    seat = f" ({e['seat']} seat)" if e.get("seat") else ""
+    return f"`{e['controller']}`{seat} {e['score']:.2f}" + (
+        f" ± {e['score_se']:.2f}" if e.get("score_se") is not None else "")
+
+
+def standing(report: dict, task: str) -> str:
+    """A task's standing from its leaderboard: the best designed row of any seat and the best
+    learned row, its difference to it (paired bootstrap), its seeds (mean ± std, or one seed:
+    reported, not judged) and, for a suite with a target, the target line."""
+    rows = [e for e in report["leaderboard"] if e["task"] == task]
+    designed = [e for e in rows if e.get("kind", "designed") == "designed" and e["controller"] != "passive"]
+    learned = [e for e in rows if e.get("kind") == "learned"]
+    if not designed:
+        return "No designed row in the data."
+    d = max(designed, key=lambda e: e["score"])
+    out = [f"Best designed row (any seat): {_cited(d)}."]
+    if learned:
+        e = max(learned, key=lambda e: e["score"])
+        rel = (f", {e['diff_vs_reference']:+.2f} ± {e['diff_se']:.2f} "
+               f"[{e['diff_ci95'][0]:+.2f}, {e['diff_ci95'][1]:+.2f}] against "
+               f"`{e['reference']}`" if e.get("diff_se") is not None else "")
+        seeds = (f"; over its configuration's {e['seeds']} seeds {e['seed_mean']:.2f} ± "
+                 f"{e['seed_std']:.2f} (mean ± std)" if e.get("seed_std") is not None else
+                 "; one seed: reported, not judged")
+        out.append(f"Best learned row: {_cited(e)}{rel}{seeds}.")
+    t = report.get("target")
+    if t:
+        if t.get("met") is None:
+            out.append(f"Target (mean − std over ≥ {t.get('min_seeds', 3)} seeds ≥ best designed "
+                       f"+{t['margin']:g}): not judged, no learned configuration with "
+                       f"{t.get('min_seeds', 3)} seeds in the data.")
+        else:
+            out.append(f"Target (mean − std over ≥ {t.get('min_seeds', 3)} seeds ≥ best designed "
+                       f"+{t['margin']:g}): {t['best_learned_score']:.2f} against "
+                       f"{t['best_designed_score'] + t['margin']:.2f}: "
+                       f"{'met' if t['met'] else 'not met'}.")
+    how = (report.get("bootstrap") or {}).get("method")
+    if how:
+        out.append(f"(± SE: {how}.)")
+    return " ".join(out)
+
+
+def tasks_text(root: Path = ROOT) -> str:
+    """docs/tasks.md with each ``<!-- standing:KEY:start -->`` ... ``end`` block regenerated
+    from the committed leaderboards (:data:`STANDINGS`)."""
+    text = (root / TASKS).read_text()
+    for key, (name, task) in STANDINGS.items():
+        report = _load(root / DATA / name)
+        start, end = f"<!-- standing:{key}:start -->", f"<!-- standing:{key}:end -->"
+        pattern = re.compile(re.escape(start) + r".*?" + re.escape(end), flags=re.S)
+        if report is None or not pattern.search(text):
+            continue
+        block = standing(report, task)
+        text = pattern.sub(lambda _: f"{start}\n{block}\n{end}", text)
+    return text
+
+
 def generated(root: Path = ROOT) -> dict[Path, str]:
-    return {root / RESULTS: results_page(root), root / README: readme_text(root),
-            **figure_data(root)}
+    pages = {root / RESULTS: results_page(root), root / README: readme_text(root),
+             **figure_data(root)}
+    if (root / TASKS).exists():
+        pages[root / TASKS] = tasks_text(root)
+    return pages
+
+
+def check_complete(path: str, force: bool) -> None:
+    """Refuse to store a ``--quick`` or partial benchmark (``--scenarios``, ``--episodes``)
+    over the committed data unless ``force``: the pages would quote a reduced suite."""
+    report = json.loads(Path(path).read_text())
+    reduced = [w for w, flag in (("--quick", report.get("quick")),
+                                 ("partial (--scenarios/--episodes)", report.get("partial")))
+               if flag]
+    if reduced and not force:
+        raise ValueError(f"{path} is a {' and '.join(reduced)} benchmark: storing it would replace "
+                         "the committed full-suite leaderboard, README and results and tasks "
+                         "pages; re-run the full benchmark, or pass --force")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -740,6 +870,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--root", default=str(ROOT), help="the project folder (default: this checkout)")
     p.add_argument("--check", action="store_true",
                    help="write nothing; exit 1 if the committed pages differ from the data")
+    p.add_argument("--force", action="store_true",
+                   help="store a --quick or partial benchmark over the committed one anyway")
 
 
 def run(args) -> int:
@@ -751,6 +883,13 @@ def run(args) -> int:
         print("results: error: --check takes no data files", file=sys.stderr)
         return 2
     stored = []
+    try:
+        for src in (args.nominal, args.robust):
+            if src:
+                check_complete(src, getattr(args, "force", False))
+    except ValueError as exc:
+        print(f"results: error: {exc}", file=sys.stderr)
+        return 2
     if args.nominal:
         stored.append(store(args.nominal, root / DATA / "leaderboard-nominal.json", drop=DROPPED_KEYS))
     if args.robust:
@@ -792,7 +931,7 @@ def run(args) -> int:
             print("out of date (run `python -m agents.benchmarking.results`): "
                   + ", ".join(str(s.relative_to(root)) for s in stale), file=sys.stderr)
             return 1
-        print("docs/results.md and the README leaderboard match docs/data")
+        print("docs/results.md, docs/tasks.md and the README leaderboard match docs/data")
         return 0
     print("wrote " + ", ".join(str(s.relative_to(root)) for s in stored + stale) if stored + stale
           else "nothing to change")

@@ -186,26 +186,34 @@ BOOTSTRAP_SEED = 20_261_127
 
 
 def bootstrap_scores(costs: np.ndarray, passive: np.ndarray, reference: int,
-                     resamples: int = BOOTSTRAP_RESAMPLES, seed: int = BOOTSTRAP_SEED) -> dict:
-    """Paired bootstrap over drops of the scores of K rows that ran the same n drops.
+                     resamples: int = BOOTSTRAP_RESAMPLES, seed: int = BOOTSTRAP_SEED,
+                     clusters=None) -> dict:
+    """Paired bootstrap over scenarios of the scores of K rows that ran the same n drops.
 
     ``costs`` (K, n): each row's cost per drop; ``passive`` (n,): the passive drop's; the score
-    of a row is 100 (1 − Σ costs / Σ passive). Every resample draws n drops with replacement,
-    the same drops for every row (paired), and recomputes every score; ``reference`` is the
-    row the others are compared with. Returns per row (arrays of K): ``score``, ``score_se``,
-    ``diff`` (score − the reference's), ``diff_se`` and the 95 % percentile interval
-    ``diff_ci_low``, ``diff_ci_high`` of the difference. Vectorised: the resamples are a
-    (resamples, n) matrix of drop counts."""
+    of a row is 100 (1 − Σ costs / Σ passive). ``clusters`` (n,): the scenario of each drop
+    (default: every drop its own): the drops of one scenario (its unbalance phases) are not
+    independent, so a resample draws the G scenarios with replacement, all drops of a drawn
+    scenario together, the same scenarios for every row (paired), and recomputes every score;
+    ``reference`` is the row the others are compared with. Returns per row (arrays of K):
+    ``score``, ``score_se``, ``diff`` (score − the reference's), ``diff_se`` and the 95 %
+    percentile interval ``diff_ci_low``, ``diff_ci_high`` of the difference. Vectorised: the
+    resamples are a (resamples, G) matrix of scenario counts."""
     costs = np.atleast_2d(np.asarray(costs, dtype=float))
     passive = np.asarray(passive, dtype=float)
     k, n = costs.shape
     if passive.shape != (n,):
         raise ValueError(f"passive has {passive.shape} costs, the rows {n} drops")
+    _, cluster = np.unique(np.arange(n) if clusters is None else np.asarray(clusters),
+                           return_inverse=True)
+    if cluster.shape != (n,):
+        raise ValueError(f"clusters has {np.shape(clusters)} entries, the rows {n} drops")
+    g = int(cluster.max()) + 1
     score = 100.0 * (1.0 - costs.sum(axis=1) / passive.sum())
     rng = np.random.default_rng(seed)
-    idx = rng.integers(0, n, size=(resamples, n))
-    counts = np.bincount((np.arange(resamples)[:, None] * n + idx).ravel(),
-                         minlength=resamples * n).reshape(resamples, n).astype(float)
+    idx = rng.integers(0, g, size=(resamples, g))
+    counts = np.bincount((np.arange(resamples)[:, None] * g + idx).ravel(),
+                         minlength=resamples * g).reshape(resamples, g).astype(float)[:, cluster]
     boot = 100.0 * (1.0 - (counts @ costs.T) / (counts @ passive)[:, None])      # (B, K)
     diff = boot - boot[:, [reference]]
     lo, hi = np.percentile(diff, [2.5, 97.5], axis=0)
@@ -214,11 +222,12 @@ def bootstrap_scores(costs: np.ndarray, passive: np.ndarray, reference: int,
                 diff_ci_low=lo, diff_ci_high=hi)
 
 
-def attach_bootstrap(entries: list[dict], costs, passive, reference: int) -> None:
+def attach_bootstrap(entries: list[dict], costs, passive, reference: int, clusters=None) -> None:
     """Add to each entry (the rows of ``costs``, in order) its paired-bootstrap uncertainty
-    against the entry ``reference`` (:func:`bootstrap_scores`): ``score_se``, ``reference``
-    (its name), ``diff_vs_reference``, ``diff_se``, ``diff_ci95`` and ``drops``."""
-    b = bootstrap_scores(costs, passive, reference)
+    against the entry ``reference`` (:func:`bootstrap_scores`, resampling the scenarios
+    ``clusters``): ``score_se``, ``reference`` (its name), ``diff_vs_reference``, ``diff_se``,
+    ``diff_ci95`` and ``drops``."""
+    b = bootstrap_scores(costs, passive, reference, clusters=clusters)
     name = entries[reference]["controller"]
     for i, e in enumerate(entries):
         e.update(score_se=float(b["score_se"][i]), reference=name,
@@ -255,4 +264,52 @@ def seed_groups(board: list[dict], learned: dict) -> list[dict]:
                         mean=float(s.mean()),
                         std=float(s.std(ddof=1)), mean_minus_std=float(s.mean() - s.std(ddof=1))))
     out.sort(key=lambda g: -g["mean_minus_std"])
+    for g in out:                                 # each member row shows its seeds' spread
+        for e in board:
+            if e["controller"] in g["members"] + g["repeats"]:
+                e.update(seeds=len(g["members"]), seed_mean=g["mean"], seed_std=g["std"])
     return out
+
+
+#: a target is judged on a configuration of at least this many seeds (mean − std over them)
+MIN_SEEDS = 3
+
+
+def target(board: list[dict], groups: list[dict], margin: float = 2.0) -> dict:
+    """The target: the best learned configuration, mean − std over its seeds, ≥ the best
+    designed row of any seat + ``margin``. Judged on seed groups of at least :data:`MIN_SEEDS`
+    seeds only: a learned row without them is reported (``best_single_seed``), never judged;
+    ``met`` is None (not judged) when no configuration has the seeds."""
+    designed = [e for e in board if e["kind"] == "designed"]
+    best_d = max(designed, key=lambda e: e["score"]) if designed else None
+    judged = [g for g in groups if len(g["members"]) >= MIN_SEEDS]
+    best_g = max(judged, key=lambda g: g["mean_minus_std"]) if judged else None
+    single = [e for e in board if e["kind"] == "learned"]
+    best_s = max(single, key=lambda e: e["score"]) if single else None
+    met = None if best_g is None or best_d is None else \
+        bool(best_g["mean_minus_std"] >= best_d["score"] + margin)
+    return dict(margin=margin, min_seeds=MIN_SEEDS,
+                best_designed=best_d["controller"] if best_d else None,
+                best_designed_seat=best_d.get("seat") if best_d else None,
+                best_designed_score=best_d["score"] if best_d else None,
+                best_learned=" + ".join(best_g["members"]) if best_g else None,
+                best_learned_score=best_g["mean_minus_std"] if best_g else None,
+                best_learned_seeds=len(best_g["members"]) if best_g else 0,
+                best_single_seed=best_s["controller"] if best_s else None,
+                best_single_seed_score=best_s["score"] if best_s else None,
+                met=met)
+
+
+def target_sentence(t: dict) -> str:
+    """The target line of a leaderboard: met / not met on a seed group, or why it is not judged."""
+    head = (f"Target (best learned configuration, mean − std over ≥ {t.get('min_seeds', MIN_SEEDS)} "
+            f"seeds, ≥ best designed row of any seat + {t['margin']:g}): best designed "
+            f"{t['best_designed']} ({t.get('best_designed_seat') or '-'} seat) "
+            f"{fmt_or_dash(t['best_designed_score'], '.2f')}")
+    if t.get("met") is None:
+        single = (f"; the best single learned row, {t['best_single_seed']} "
+                  f"{fmt_or_dash(t.get('best_single_seed_score'), '.2f')}, is one seed: reported, "
+                  "not judged" if t.get("best_single_seed") else "")
+        return head + f"; not judged: no learned configuration with ≥ {t.get('min_seeds', MIN_SEEDS)} seeds{single}."
+    return head + (f", best learned {t['best_learned']} {t['best_learned_score']:.2f} "
+                   f"({t['best_learned_seeds']} seeds): {'met' if t['met'] else 'not met'}.")

@@ -26,7 +26,7 @@ import numpy as np
 
 from physics.runs.backend import Backend
 
-from .benchmark import TASKS, Validator, check_suite
+from .benchmark import TASKS, Validator
 from ..control.controllers import (BASELINES, Controller, controller_class, controller_env_kwargs,
                                    make_controller)
 from .rollout import check_actor
@@ -116,12 +116,16 @@ class GainObjective:
 
 def tune(spec: str, env_id: str, gains: list[str], out, iterations: int = 12,
          population: int = 24, elite: int = 6, seed: int = 0, progress: bool = True,
-         plots: bool = True, backend: Backend = Backend(), suite: str = "nominal") -> dict:
+         plots: bool = True, backend: Backend = Backend(), suite: str = "nominal",
+         registry=None) -> dict:
     """Run the search (module doc) and write ``tune.json`` / ``tune.png`` into ``out``; on
     ``--backend ray`` Ray Tune evaluates the candidates (:mod:`agents.benchmarking.ray_search`, its trials
     under ``out/ray_tune``), with the same result. ``suite="robust"``: on the robust
-    validation set (:func:`agents.benchmarking.robust.robust_validator`, Full task only) instead."""
-    check_suite(suite, ("nominal", "robust"))
+    validation set (:func:`agents.benchmarking.robust.robust_validator`, Full task only) instead:
+    the suite named ``suite`` in ``registry`` (default :data:`agents.benchmarking.suites.SUITES`)
+    gives the validation set (:meth:`~agents.benchmarking.suites.Suite.validator`)."""
+    from .suites import SUITES
+    chosen = (registry or SUITES).get(suite, "tune")
     if not gains:
         raise ValueError("--gain is required (NAME=LO:HI, repeatable)")
     ranges = [parse_gain(g) for g in gains]
@@ -140,11 +144,7 @@ def tune(spec: str, env_id: str, gains: list[str], out, iterations: int = 12,
     defaults = getattr(cls, "GAINS", {})
     start = np.clip([defaults.get(n, 0.5 * (lo + hi)) for n, lo, hi in ranges], low, high)
     env_kwargs = _check_gains(cls, env_id, dict(zip(names, start.tolist())))
-    if suite == "robust":
-        from .robust import robust_validator
-        validator = robust_validator(env_id)
-    else:
-        validator = Validator(env_id)
+    validator = chosen.validator(env_id)
     objective = GainObjective(_portable(spec), env_id, env_kwargs, names, validator)
     score = objective.score
 

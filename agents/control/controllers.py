@@ -71,8 +71,11 @@ class Controller:
     #: damper channel set): a residual policy on it runs under plain SB3 (agents.sb3_policy)
     memoryless: bool = False
     #: the control step it runs at in the benchmark, evaluate, tune and ride-through [s]
-    #: (env kwarg ``control_dt``; None: the environment's default, 1 ms)
+    #: (env kwarg ``control_dt``; None: its seat's default, :mod:`agents.control.seats`)
     control_dt: float | None = None
+    #: where it runs (:data:`agents.control.seats.SEATS`: ``controller`` or ``supervisor``;
+    #: None: from its channels, :func:`agents.control.seats.seat_of`)
+    seat: str | None = None
 
     def __init__(self, plant: Plant):
         if self.sensors:
@@ -174,6 +177,9 @@ class Passive(Controller):
 
     name = "passive"
     sensors = False
+    #: it commands and reads nothing, so no seat is its own: it runs at the supervisor seat's
+    #: 1 ms step, so that every score is normalised by the same passive drops as before
+    seat = "supervisor"
 
 
 class MaxDamping(Controller):
@@ -476,11 +482,13 @@ def command_for(cls: type[Controller]) -> str | None:
 def controller_env_kwargs(cls, env_id: str) -> dict:
     """The env kwargs a controller class needs in ``env_id``: the re-levitation command of its
     channels (``controllers.command_for``) in the re-levitation environments (the passive
-    reference keeps the AMBs off), and its ``control_dt`` where it sets one."""
+    reference keeps the AMBs off), and the control step of its seat
+    (:func:`agents.control.seats.seat_of`: its own ``control_dt``, checked against the seat's
+    range, else the seat's default)."""
+    from .seats import seat_of
     command = command_for(cls)
     kw = {"command": command} if command and task_flags(env_id)[1] else {}
-    if getattr(cls, "control_dt", None) is not None:
-        kw["control_dt"] = cls.control_dt
+    kw.update(seat_of(cls).env_kwargs(getattr(cls, "control_dt", None)))
     return kw
 
 

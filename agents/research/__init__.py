@@ -1,4 +1,4 @@
-"""``rotordrop research whirl-bound | tune-whirl-brake``: research probes of the re-levitation
+"""``rotordrop research whirl-bound | tune-whirl-brake | tune-designed``: research probes of the re-levitation
 task (docs/agents.md), kept apart from the speed scripts in ``benchmarks/``.
 
 ``whirl-bound`` (:mod:`agents.research.whirl_bound`) searches the AMB current sequence with the
@@ -40,6 +40,24 @@ def register(subparsers) -> None:
     q.add_argument("--out", default="out/whirl_bound")
     q.set_defaults(func=cmd_whirl_bound)
 
+    from agents.benchmarking.tune_designed import DESIGNED, LEARNED_SELECTION_EPISODES
+    q = sub.add_parser("tune-designed", help="tune every designed law with constants on a suite's "
+                                             "validation drops, in its seat, and store the "
+                                             "constants with what they were tuned under")
+    q.add_argument("--suite", default="robust", help="the suite whose validation drops tune "
+                                                     "(default robust)")
+    q.add_argument("--law", action="append", default=None,
+                   help=f"a designed law to tune (repeatable; default all: {', '.join(DESIGNED)})")
+    q.add_argument("--episodes", type=at_least(LEARNED_SELECTION_EPISODES),
+                   default=LEARNED_SELECTION_EPISODES,
+                   help=f"validation episodes per law, at least (and by default) "
+                        f"{LEARNED_SELECTION_EPISODES}: one learned configuration's model "
+                        "selection (1e6 steps scored every 10 000 on the 20 validation drops)")
+    q.add_argument("--seed", type=at_least(0), default=0, help="search seed")
+    q.add_argument("--out", default=None, help="also write the records here")
+    q.add_argument("--quiet", action="store_true", help="no progress bar")
+    q.set_defaults(func=cmd_tune_designed)
+
     q = sub.add_parser("tune-whirl-brake", help="tune the whirl-brake baseline's gains by "
                                                 "cross-entropy search on a tuning set (tune.json)")
     q.add_argument("--env", default="RotorDrop-Relevitate-v1",
@@ -51,6 +69,15 @@ def register(subparsers) -> None:
     q.add_argument("--out", default="out/tune_whirl_brake")
     add_backend_args(q, resume=False)
     q.set_defaults(func=cmd_tune_whirl_brake)
+
+
+def cmd_tune_designed(args) -> int:
+    from agents.benchmarking.suites import SUITES
+    from agents.benchmarking.tune_designed import tune_designed
+
+    def run(a):
+        tune_designed(SUITES.get(a.suite, "tune"), a.law, a.episodes, a.seed, not a.quiet, a.out)
+    return _usage_errors(run, args)
 
 
 def cmd_whirl_bound(args) -> int:

@@ -53,11 +53,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..benchmarking.benchmark import (EPISODE_TIME, SUITES, TASKS, Entry, Scenario, check_suite,
-                                      controller_entry, episode_kwargs, extras)
+from ..benchmarking.suites import SUITES
+from ..benchmarking.benchmark import (EPISODE_TIME, TASKS, Entry, Scenario,
+                                      controller_entry, episode_kwargs)
 from ..control.controllers import BASELINES, Passive
 from ..control.plant import plant_of
-from ..learning.policies import load_shipped, shipped_names
 from ..benchmarking.rollout import final_kpis, run_episodes
 from ..benchmarking.score import DEFAULT_SCORE, attach_bootstrap, overall_score, row_cost, write_json
 
@@ -65,7 +65,7 @@ ENV_ID = TASKS["full"]
 COMMAND = "supervisor"
 ORACLE_RANGES = {"contact.friction": (0.38, 0.6), "power_return_time": (0.03, 0.07),
                  "unbalance.angle_deg": (0.0, 360.0)}
-SCENARIO_SEED = SUITES["full"].seed
+SCENARIO_SEED = SUITES.get("full", "oracle").seed
 SEGMENT_EDGES_MS = (0, 10, 20, 30, 45, 60, 90, 300)
 SEGMENT_ACTIONS = ("damping1", "damping2", "gain", "offset_r1", "offset_t1", "offset_r2",
                    "offset_t2")
@@ -73,9 +73,6 @@ MAX_DELAY = 0.04            # switch-on delay after the power return: (theta + 1
 CONTROL_DT = 0.005          # the commands are piecewise constant over >= 10 ms segments
 SHAPING = 0.25
 WHIRL_REVOLUTIONS = 3.0
-#: ``--suite`` (:data:`agents.benchmarking.benchmark.SUITES`): drops drawn from ``ORACLE_RANGES``
-#: (full) or the robust suite's (robust)
-ORACLE_SUITES = ("full", "robust")
 #: ``--interface``: what the search commands (supervisor sequences, or raw-current corrections)
 INTERFACES = ("supervisor", "currents")
 #: the raw-current search: open-loop corrections of ``CURRENT_BASELINE``'s coil currents,
@@ -97,10 +94,11 @@ def suite_scenarios(suite: str, n: int, seed: int,
     """The first ``n`` scenarios of ``suite`` from ``seed``: (benchmark :class:`Scenario`,
     unbalance phase, the record written to oracle.json). ``robust``: the robust suite's own
     scenarios (:func:`agents.benchmarking.robust.robust_scenarios`; their unbalance phase is in the scene
-    overrides, the phase argument is the benchmark's 0)."""
-    if check_suite(suite, ORACLE_SUITES).name == "robust":
-        from ..benchmarking.robust import robust_scenarios
-        return [(sc, 0.0, robust_record(sc)) for sc in robust_scenarios(n, seed)]
+    overrides, the phase argument is the benchmark's 0). A suite without its own draw (``full``)
+    draws from ``ORACLE_RANGES``."""
+    chosen = SUITES.get(suite, "oracle")
+    if chosen.draw is not None:
+        return [(sc, 0.0, robust_record(sc)) for sc in chosen.scenarios(n, seed)]
     return [(*as_benchmark(v, f"#{i}"), v) for i, v in enumerate(draw_scenarios(n, seed, friction))]
 
 
@@ -176,9 +174,9 @@ def as_benchmark(values: dict, name: str) -> tuple[Scenario, float]:
 def on_grid(values: dict) -> dict:
     """``values`` with the power return rounded up to the oracle's control grid (``CONTROL_DT``),
     as the environment rounds it: every row then sees the power at the same instant, whatever
-    its control step."""
-    steps = np.ceil(values["power_return_time"] / CONTROL_DT - 1e-9)
-    return {**values, "power_return_time": round(float(steps * CONTROL_DT), 12)}
+    its control step (the ``full`` suite's rounding, :meth:`agents.benchmarking.suites.Suite.round_power`)."""
+    return {**values, "power_return_time": SUITES.get("full", "oracle").round_power(
+        values["power_return_time"])}
 
 
 def n_params() -> int:
@@ -387,13 +385,10 @@ def search_currents(sc: Scenario, phase: float, passive: dict, population: int, 
 def row_entries(policies: list[str] | None, suite: str = "full") -> list[Entry]:
     """Every baseline with channels in the Full task, the shipped Full policies and the
     ``--policy`` extras (paths or controller classes), as the benchmark builds them (with
-    ``suite`` robust: as the robust suite does, :func:`agents.benchmarking.benchmark.robust_entries`)."""
-    from ..benchmarking.benchmark import _entries, check_unique_names, robust_entries
-    if suite == "robust":
-        return robust_entries(policies)[0]
-    extra, custom = extras(policies or [])
-    loaded = [load_shipped(n) for n in shipped_names()] + extra
-    return check_unique_names([e for e in _entries(loaded, custom) if e.task == "full"])
+    as the benchmark's drawn suites do, :func:`agents.benchmarking.benchmark.robust_entries`: each
+    in its seat, with the constants tuned for ``suite``)."""
+    from ..benchmarking.benchmark import robust_entries
+    return robust_entries(policies, suite=SUITES.get(suite, "oracle"))[0]
 
 
 def score_rows(per_scenario: list[dict], names: list[str]) -> list[dict]:
@@ -504,8 +499,7 @@ def oracle(out: str | Path, scenarios: int = 20, population: int = 24, iteration
                              plot_whirl_by_friction(report, out / "whirl_by_friction.png").name]
     write_json(out / "oracle.json", report)
     lo, hi = ranges["contact.friction"]
-    where = ("the robust suite's first, sensor noise and latency" if suite == "robust" else
-             "power back 30-70 ms")
+    where = SUITES.get(suite, "oracle").about
     print(f"{f'oracle (searched {interface} plans)' if search else 'rows'}, {ENV_ID}, {scenarios} scenarios "
           f"({where}, friction {lo:g}-{hi:g}, seeds from {settings['scenario_seed']}):")
     print("| controller | score | whirl rate | whirl where passive whirls | re-levitated |")
@@ -541,8 +535,8 @@ def suite_settings(suite: str, friction, scenario_seed: int | None) -> tuple[dic
                     segment_actions=list(SEGMENT_ACTIONS), max_delay_s=MAX_DELAY,
                     control_dt=CONTROL_DT, shaping=SHAPING, episode_time_s=EPISODE_TIME,
                     score=DEFAULT_SCORE)
-    chosen = check_suite(suite, ORACLE_SUITES)
-    if chosen.name == "robust":
+    chosen = SUITES.get(suite, "oracle")
+    if chosen.draw is not None:                     # drawn with its sensing (robust)
         from ..benchmarking.robust import LATENCY_MS, ROBUST_RANGES, SENSOR_NOISE
         if friction is not None:
             raise ValueError("--friction does not apply to --suite robust (its scenarios are the "
@@ -630,7 +624,7 @@ def plot_oracle(report: dict, path: Path) -> Path:
     suite = report["settings"].get("suite", "full")
     axes[0].set(yticks=y, yticklabels=names, xlabel="score (benchmark formula)",
                 title=f"{len(report['per_scenario'])} scenarios, RotorDrop-Full-v1"
-                      + (", robust suite" if suite == "robust" else ""))
+                      + (f", {suite} suite" if "suite" in report["settings"] else ""))
     axes[1].barh(y, [e["whirl_rate"] for e in summary], color=colors)
     axes[1].set(yticks=y, yticklabels=[], xlabel="backward-whirl rate", xlim=(0, 1))
     idx = np.arange(len(report["per_scenario"]))

@@ -21,7 +21,8 @@ import json
 import numpy as np
 
 from agents.benchmarking.benchmark import Validator
-from agents.benchmarking.robust import ENV_ID, robust_validator, training_env_kwargs
+from agents.benchmarking.robust import ENV_ID, training_env_kwargs
+from agents.benchmarking.suites import SUITES
 
 #: the probes' control step [s]
 CONTROL_DT = 0.005
@@ -44,12 +45,10 @@ class ConstantCommands:
 
 
 def suite_validator(suite: str) -> tuple[Validator, dict]:
-    """The validation set of ``suite`` (robust or nominal) and its env kwargs at 5 ms."""
-    if suite == "robust":
-        return robust_validator(), training_env_kwargs(CONTROL_DT)
-    if suite == "nominal":
-        return Validator(ENV_ID), dict(control_dt=CONTROL_DT)
-    raise ValueError(f"--suite = {suite!r} must be one of nominal, robust")
+    """The validation set of ``suite`` (robust or nominal) and its training env kwargs at 5 ms
+    (:meth:`agents.benchmarking.suites.Suite.training_env_kwargs`)."""
+    chosen = SUITES.get(suite, "tune")
+    return chosen.validator(ENV_ID), chosen.training_env_kwargs(CONTROL_DT)
 
 
 def probe(validator, make, authority: float = 1.0, env_kwargs: dict | None = None) -> dict:
@@ -67,7 +66,7 @@ def floats(text: str) -> list[float]:
 
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--suite", default="robust", choices=("robust", "nominal"),
+    ap.add_argument("--suite", default="robust", choices=SUITES.names("tune"),
                     help="validation set: the robust one (default) or the Full task's nominal one")
     ap.add_argument("--random", action="store_true", help="random commands at each --authority")
     ap.add_argument("--authority", type=floats, default=[1.0])

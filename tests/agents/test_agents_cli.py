@@ -287,9 +287,11 @@ def test_tune_moves_a_damper_level_towards_more_damping(tmp_path, capsys):
     assert r["start"] == {"level": 0.0}
     assert r["gains"]["level"] > 0.1
     assert r["validation_score"] > r["start_validation_score"]
-    cls = load_controller(spec)
+    from agents.control.controllers import controller_env_kwargs
+    cls = load_controller(spec)                                     # in its seat (0.2 ms)
     again, _ = Validator("RotorDrop-Damping-v1").score(
-        lambda plant: cls(plant, level=r["gains"]["level"]), {})
+        lambda plant: cls(plant, level=r["gains"]["level"]),
+        controller_env_kwargs(cls, "RotorDrop-Damping-v1"))
     assert again == pytest.approx(r["validation_score"], rel=1e-12)
     assert (out / "tune.png").is_file()
     # a gain without a default starts mid-range (and the checks build it with that value)

@@ -117,7 +117,8 @@ def test_latency_breaks_a_fast_current_loop_but_not_the_builtin_pid():
     relev = {}
     for name in ("pid-relevitate", "builtin-relevitate"):
         cls = BASELINES[name]
-        kw = dict(controller_env_kwargs(cls, FULL), terminate_on_failure=False)
+        kw = dict(controller_env_kwargs(cls, FULL), terminate_on_failure=False,
+                  control_dt=1e-3)                  # a 1 kHz loop (pid-relevitate's seat: 0.2 ms)
         relev[name] = [run_episodes(FULL, cls, [0], dict(kw, obs_latency_steps=k))[0].kpis["relevitated"]
                        for k in (0, 3)]
     assert relev["pid-relevitate"] == [True, False]

@@ -7,12 +7,12 @@ import numpy as np
 import pytest
 
 from agents.benchmarking.benchmark import Entry, Scenario, episode_kwargs, latency_steps
-from agents.benchmarking.score import seed_groups
+from agents.benchmarking.score import seed_groups, target
 from agents.benchmarking.robust import (LATENCY_MS, ROBUST_RANGES, SENSOR_DELAY_S, SENSOR_NOISE, SUITE_SEED,
                            VALIDATION_SEED,
-                           draw_scenario, robust_benchmark, robust_scenarios, run_suite,
-                           target,
+                           draw_scenario, robust_benchmark, robust_scenarios,
                            training_env_kwargs)
+from agents.benchmarking.suites import SUITES, run_suite
 
 
 def test_scenarios_are_reproducible_inside_the_ranges_and_disjoint_from_validation():
@@ -51,7 +51,11 @@ def test_episode_kwargs_take_the_scenarios_sensing_not_the_training_one():
     nominal = episode_kwargs(entry, Scenario("n", 0.4), 0.0)          # the nominal suite
     assert "sensor_noise" not in nominal and "obs_latency_steps" not in nominal
     designed = episode_kwargs(Entry("pid", "full", None, {"command": "continuous"}), robust, 0.0)
-    assert designed["obs_latency_steps"] == 3                          # 1 ms control step
+    assert designed["obs_latency_steps"] == 3                          # 1 ms step: supervisor seat
+    inside = Entry("pid", "full", None, {"command": "continuous", "control_dt": 2e-4})
+    assert inside.seat == "controller"                                 # inside the AMB controller:
+    kw = episode_kwargs(inside, robust, 0.0)                           # the sensor's noise and
+    assert "obs_latency_steps" not in kw and kw["sensor_noise"] == 2e-6  # delay, no transport
 
 
 def test_training_kwargs_match_the_suite():
@@ -109,7 +113,8 @@ def test_cli_refuses_a_bad_suite_in_one_line(capsys):
 
 
 def test_a_small_robust_suite_scores_every_full_row(tmp_path):
-    report = robust_benchmark(tmp_path, max_scenarios=2, progress=False, plots=False)
+    report = robust_benchmark(tmp_path, max_scenarios=2, progress=False, plots=False,
+                              suite=SUITES.get("robust"))
     board = {e["controller"]: e for e in report["leaderboard"]}
     assert board["passive"]["score"] == pytest.approx(0.0) and board["passive"]["kind"] == "designed"
     assert {"inner-loop", "whirl-brake", "pid-relevitate", "whirl-brake-sup"} <= set(board)

@@ -15,7 +15,7 @@ KW = dict(command="supervisor", episode_time=0.15, terminate_on_failure=False,
 def test_rows_are_baselines_in_the_supervisor_mode():
     for cls in (InnerLoop, WhirlBrakeSupervisor):
         assert BASELINES[cls.name] is cls and command_for(cls) == "supervisor"
-        assert controller_env_kwargs(cls, FULL) == {"command": "supervisor"}
+        assert controller_env_kwargs(cls, FULL) == {"command": "supervisor", "control_dt": 1e-3}
 
 
 def test_inner_loop_is_the_builtin_pid_with_c_max():

@@ -188,7 +188,7 @@ def test_robust_suite_searches_the_robust_scenario_with_its_sensing(tmp_path):
         Entry("inner-loop", "full", InnerLoop, {"command": "supervisor"}), [sc], (0.0,))
     leaderboard(bench, [sc], None, any_friction=True)
     assert bench[1]["cost"] == pytest.approx(rows["inner-loop"]["J"], rel=1e-9)
-    with pytest.raises(ValueError, match="--suite = 'nominal' must be one of full, robust"):
+    with pytest.raises(ValueError, match="--suite = 'nominal' must be one of robust, full"):
         oracle(tmp_path / "bad", scenarios=1, suite="nominal")
     with pytest.raises(ValueError, match=r"--constant GAIN:OFFSET_R must have both in \[-1, 1\]"):
         oracle(tmp_path / "bad", scenarios=1, suite="robust", constants=[(0.0, -1.5)])
@@ -198,17 +198,21 @@ def test_robust_suite_searches_the_robust_scenario_with_its_sensing(tmp_path):
 
 
 def test_inner_loop_lift_is_the_oracles_constant_row(tmp_path):
-    """On a robust drop: the oracle's --constant 0.5:-0.5 row is inner-loop-lift (same J), and
-    the same law as the search's command sequence (constant_theta, batched rollout at 5 ms)
-    runs the same drop to the last digit."""
+    """On a robust drop: the oracle's --constant row with inner-loop-lift's constants tuned on
+    the robust validation drops is inner-loop-lift there (same J), and the same law as the
+    search's command sequence (constant_theta, batched rollout at 5 ms) runs the same drop to
+    the last digit."""
     from agents.benchmarking.benchmark import controller_entry
+    from agents.benchmarking.suites import SUITES
+    from agents.benchmarking.tuned import tuned_gains
     from agents.control.controllers import InnerLoopLift
-    from agents.research.oracle import constant_theta, search_kwargs, suite_scenarios
+    from agents.research.oracle import constant_name, constant_theta, search_kwargs, suite_scenarios
     from rotordrop_env import BatchedRotorDropVecEnv
-    rep = oracle(tmp_path, scenarios=1, search=False, suite="robust", constants=[(0.5, -0.5)],
-                 progress=False, plots=False)
+    g = tuned_gains(SUITES.get("robust"), "inner-loop-lift", ENV_ID)
+    rep = oracle(tmp_path, scenarios=1, search=False, suite="robust",
+                 constants=[(g["gain"], g["offset_r"])], progress=False, plots=False)
     rows = rep["per_scenario"][0]["rows"]
-    assert rows["constant g=0.5 r=-0.5"] == rows["inner-loop-lift"]
+    assert rows[constant_name(g["gain"], g["offset_r"])] == rows["inner-loop-lift"]
     assert rows["inner-loop-lift"]["J"] < rows["inner-loop"]["J"]      # re-levitates sooner
     sc, phase, _ = suite_scenarios("robust", 1, 30_000)[0]
     venv = BatchedRotorDropVecEnv(ENV_ID, 1, seed=0, **search_kwargs(sc, phase))
