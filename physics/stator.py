@@ -35,12 +35,12 @@ def declare(layout) -> None:
     radius, threshold speed; mount stiffness, damping, mass per AMB plane), flag, state slot and
     per-AMB-plane diagnostics: the stator's normal force (zero without stator contact), the
     contact's dashpot and friction powers, its mount's dashpot power."""
+    layout.params.add_each("stator.gap", "stator.stiffness", consts=("P_ST_GAP", "P_ST_K"))
+    layout.params.add("stator.damping", 2, "P_ST_C")         # per AMB plane: its mass share
     layout.params.add_each(
-        "stator.gap", "stator.stiffness", "stator.damping", "stator.friction",
-        "stator.rotor_radius", "stator.threshold_velocity", "stator.mount_stiffness",
-        "stator.mount_damping", "stator.mount_mass",
-        consts=("P_ST_GAP", "P_ST_K", "P_ST_C", "P_ST_MU", "P_ST_R", "P_ST_VL", "P_STM_K",
-                "P_STM_C", "P_STM_M"))
+        "stator.friction", "stator.rotor_radius", "stator.threshold_velocity",
+        "stator.mount_stiffness", "stator.mount_damping", "stator.mount_mass",
+        consts=("P_ST_MU", "P_ST_R", "P_ST_VL", "P_STM_K", "P_STM_C", "P_STM_M"))
     layout.index.add("flag.stator", const="F_STATOR")
     layout.index.add("state.stator_mount", const="I_STM")
     for name, const in (("stator.normal_force", "A_STATOR"), ("stator.damping_power", "A_ST_PDAMP"),
@@ -50,14 +50,17 @@ def declare(layout) -> None:
 
 
 def pack(scene, P, I, layout) -> None:
-    """The stator contact's parameters and flag."""
+    """The stator contact's parameters and flag; the dashpot of each AMB plane for the rotor's
+    mass share there (lever rule)."""
     s, p = scene, layout.params
     I[layout.index["flag.stator"]] = s.effects.stator_contact
     st = s.stator
-    share = abs(weight_shares(s.rotor.mass, s.positions.amb1, s.positions.amb2)[0])
+    shares = weight_shares(s.rotor.mass, s.positions.amb1, s.positions.amb2)
     P[p["stator.gap"]], P[p["stator.stiffness"]] = s.amb.air_gap, st.stiffness
     P[p["stator.friction"]], P[p["stator.rotor_radius"]] = st.friction, st.rotor_radius
-    P[p["stator.damping"]] = damping_coefficient(st.stiffness, max(share, 1e-3), st.restitution)
+    for k, share in enumerate(shares):
+        P[p["stator.damping"] + k] = damping_coefficient(st.stiffness, max(abs(share), 1e-3),
+                                                         st.restitution)
     P[p["stator.threshold_velocity"]] = s.contact.threshold_rpm * math.pi / 30.0 * st.rotor_radius
     P[p["stator.mount_stiffness"]], P[p["stator.mount_mass"]] = st.mount_stiffness, st.mount_mass
     P[p["stator.mount_damping"]] = 2.0 * st.mount_damping_ratio * math.sqrt(st.mount_stiffness
@@ -188,7 +191,7 @@ def contact(y, P, I, dy, aux, load):
         px, py, pvx, pvy = axis_motion(y, P, I, ST_AMB1 + k)
         qx, qy, qvx, qvy = stator_motion(y, I, k)
         sfx, sfy, torque, f_n, _, p_sd, p_sf = stator_force(
-            px - qx, py - qy, pvx - qvx, pvy - qvy, W, P[P_ST_GAP], P[P_ST_K], P[P_ST_C],
+            px - qx, py - qy, pvx - qvx, pvy - qvy, W, P[P_ST_GAP], P[P_ST_K], P[P_ST_C + k],
             P[P_ST_MU], P[P_ST_R], P[P_ST_VL])
         p_mount = 0.0
         i_q = I[I_STM]
