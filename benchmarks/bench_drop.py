@@ -33,7 +33,10 @@ EFFECTS_OFF = [("full model (paper)", {}), *REDUCED,
                ("kinematic slip", {"effects.friction": "kinematic"}),
                ("no friction", {"effects.friction": "none"})]
 # effects beyond the paper, off by default: what switching them on costs
-EFFECTS_ON = [("sleeve heating (thermal)", {"effects.thermal": True})]
+EFFECTS_ON = [("sleeve heating (thermal)", {"effects.thermal": True}),
+              ("base excitation (5 g, 11 ms pulse at 50 ms)",
+               {"effects.base_excitation": True, "ground.pulse_peak_g": 5.0,
+                "ground.pulse_start": 0.05})]
 
 
 def _rhs_timer(result, samples=400, clock=time.perf_counter):

@@ -25,7 +25,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from ._jit import njit
+from ._jit import njit, njit_borrow, njit_inline
+from .rotor import ST_AMB1, add_external, add_station_force, axis_motion
+from .sensor import sensed_motion
 
 MU_0 = 4e-7 * math.pi
 
@@ -50,23 +52,26 @@ def declare(layout) -> None:
     ``amb.reference_offset`` + 2k (radial) and + 2k + 1 (tangential, along a forward orbit) [m]
     in the frame of the sensed orbit and scales the three PID gains by ``amb.gain``."""
     p = layout.params
-    p.add("amb.stiffness")
-    p.add("amb.damping")
-    p.block("amb1.bias", "amb2.bias")
-    for name in ACTUATOR_PARAMS:
-        p.add(name)
-    p.block("amb1.feedforward_current", "amb2.feedforward_current")    # gravity feed-forward
-    layout.index.add("flag.amb")
-    for name in ("integral", "filter", "current"):   # first state of each per-axis block
-        layout.index.add("state.amb_" + name)
+    p.add("amb.stiffness", const="P_K_AMB")
+    p.add("amb.damping", const="P_C_AMB")
+    p.block("amb1.bias", "amb2.bias", consts=("P_AMB_BIAS1", "P_AMB_BIAS2"))
+    p.add_each(*ACTUATOR_PARAMS, consts=(
+        "P_AMB_KMAG", "P_AMB_G0", "P_AMB_I0", "P_AMB_ILIM", "P_AMB_RMAX", "P_AMB_KP", "P_AMB_KI",
+        "P_AMB_KD", "P_AMB_TD", "P_AMB_TL", "P_AMB_RAMP"))
+    p.block("amb1.feedforward_current", "amb2.feedforward_current",     # gravity feed-forward
+            consts=("P_AMB_IFF1", "P_AMB_IFF2"))
+    layout.index.add("flag.amb", const="F_AMB")
+    # first state of each per-axis block
+    layout.index.add_each("state.amb_integral", "state.amb_filter", "state.amb_current",
+                          consts=("I_AMB_INT", "I_AMB_FILT", "I_AMB_COIL"))
     u = layout.controls
-    u.add("amb.power")
-    u.add("amb.direct")
-    u.add("amb.current_command", len(AMB_AXES))
-    u.add("amb.t_on")
-    u.add("amb.reference0", len(AMB_AXES))
-    u.add("amb.reference_offset", len(AMB_AXES))
-    u.add("amb.gain")
+    u.add("amb.power", const="U_AMB_POWER")
+    u.add("amb.direct", const="U_AMB_DIRECT")
+    u.add("amb.current_command", len(AMB_AXES), const="U_ICMD")
+    u.add("amb.t_on", const="U_T_ON")
+    u.add("amb.reference0", len(AMB_AXES), const="U_REF0")
+    u.add("amb.reference_offset", len(AMB_AXES), const="U_REF_OFF")
+    u.add("amb.gain", const="U_AMB_GAIN")
 
 
 def pack(scene, P, I, layout) -> None:
@@ -245,3 +250,107 @@ def pid_steady_states(amb, X: complex, omega: float) -> tuple[complex, complex, 
     Q = X / (1.0 + s * amb.derivative_filter)
     I_cmd = -(amb.kp * X + amb.ki * Z + amb.kd * (X - Q) / amb.derivative_filter)
     return Z, Q, I_cmd / (1.0 + s * amb.coil_time_constant)
+
+
+# ----------------------------------------------------------------------------- kernels --
+#: the orbit frame's unit vectors are regularised within this fraction of the clearance of the
+#: centre (an offset fades out there instead of jumping with the direction of a tiny orbit)
+ORBIT_FRAME_CORE = 0.05
+
+
+@njit
+def orbit_offset(dx, dy, radial, tangential, spin, clearance):
+    """(x, y) reference offset [m] of ``radial`` along the sensed displacement (dx, dy) and
+    ``tangential`` perpendicular to it along a forward orbit (the direction of ``spin``), with
+    unit vectors (dx, dy) / sqrt(r^2 + r_0^2), r_0 = ``ORBIT_FRAME_CORE`` x clearance."""
+    if radial == 0.0 and tangential == 0.0:
+        return 0.0, 0.0
+    n = math.sqrt(dx * dx + dy * dy + (ORBIT_FRAME_CORE * clearance) ** 2)
+    ux, uy = dx / n, dy / n
+    s = 1.0 if spin >= 0.0 else -1.0
+    return radial * ux - tangential * s * uy, radial * uy + tangential * s * ux
+
+
+@njit_borrow
+def amb_currents(t, y, P, I, U, out):
+    """Control currents of the 4 actuator axes (AMB1 x, AMB1 y, AMB2 x, AMB2 y) now [A]: the coil
+    currents when they lag, else the command of the law :func:`force` applies."""
+    for j in range(4):
+        if I[I_AMB_COIL] >= 0:
+            out[j] = y[I[I_AMB_COIL] + j]
+            continue
+        k = j // 2
+        dx, dyy, ddx, ddy = axis_motion(y, P, I, ST_AMB1 + k)
+        if I[F_SENSOR]:
+            dx, dyy, _, _ = sensed_motion(y, P, I, U, k, dx, dyy, ddx, ddy)
+        ox, oy = orbit_offset(dx, dyy, U[U_REF_OFF + 2 * k], U[U_REF_OFF + 2 * k + 1], y[I[S_W]],
+                              P[P_CLR])
+        out[j] = actuator_command(
+            t, dyy if j % 2 == 1 else dx, y[I[I_AMB_INT] + j], y[I[I_AMB_FILT] + j],
+            U[U_AMB_DIRECT], U[U_AMB_POWER], U[U_ICMD + j], U[U_T_ON], U[U_REF0 + j],
+            oy if j % 2 == 1 else ox, P[P_AMB_ILIM], P[P_AMB_RAMP],
+            P[P_AMB_IFF1 + k] if j % 2 == 1 else 0.0,
+            U[U_AMB_GAIN] * P[P_AMB_KP], U[U_AMB_GAIN] * P[P_AMB_KI], U[U_AMB_GAIN] * P[P_AMB_KD],
+            P[P_AMB_TD])[0]
+
+
+@njit_inline
+def acting(I, U):
+    """The AMBs apply forces or run states now: the actuator always (its PID states), the
+    linear law while powered."""
+    amb = I[F_AMB]
+    return amb == AMB_ACTUATOR or (amb == AMB_LINEAR and U[U_AMB_POWER] > 0.0)
+
+
+@njit_inline
+def force(t, y, P, I, U, dy, aux, load):
+    """The AMBs' forces at their stations into the load, their power as external work, and the
+    actuator's PID, filter and coil rates (spec §5)."""
+    # actuator: the PID states evolve only under the built-in controller; the magnets pull while
+    # powered or driven directly. The per-axis law takes scalars so that it compiles inline here
+    # (as an array-taking call it cost ~90 ns per axis)
+    amb = I[F_AMB]
+    pid_on = U[U_AMB_POWER] > 0.0 and U[U_AMB_DIRECT] <= 0.0
+    pulls = U[U_AMB_POWER] > 0.0 or U[U_AMB_DIRECT] > 0.0
+    for k in range(2):
+        dx, dyy, ddx, ddy = axis_motion(y, P, I, ST_AMB1 + k)
+        # the controller's view (physics/sensor.py): the true motion without sensing
+        sx, sy, svx, svy = dx, dyy, ddx, ddy
+        if I[F_SENSOR]:
+            sx, sy, svx, svy = sensed_motion(y, P, I, U, k, dx, dyy, ddx, ddy)
+        ox, oy = orbit_offset(sx, sy, U[U_REF_OFF + 2 * k], U[U_REF_OFF + 2 * k + 1],
+                              y[I[S_W]], P[P_CLR])
+        if amb == AMB_LINEAR:
+            fx = linear_force(sx, svx, P[P_K_AMB], P[P_C_AMB], 0.0)
+            fy = linear_force(sy, svy, P[P_K_AMB], P[P_C_AMB], P[P_AMB_BIAS1 + k])
+        else:
+            fx = fy = 0.0
+            for a in range(2):                      # x, then y axis of AMB k
+                j = 2 * k + a
+                d = dyy if a == 1 else dx
+                i_int, i_q = I[I_AMB_INT] + j, I[I_AMB_FILT] + j
+                i_cmd, e, de_int = actuator_command(
+                    t, sy if a == 1 else sx, y[i_int], y[i_q], U[U_AMB_DIRECT],
+                    U[U_AMB_POWER], U[U_ICMD + j],
+                    U[U_T_ON], U[U_REF0 + j], oy if a == 1 else ox, P[P_AMB_ILIM],
+                    P[P_AMB_RAMP], P[P_AMB_IFF1 + k] if a == 1 else 0.0,
+                    U[U_AMB_GAIN] * P[P_AMB_KP],
+                    U[U_AMB_GAIN] * P[P_AMB_KI], U[U_AMB_GAIN] * P[P_AMB_KD], P[P_AMB_TD])
+                i_act = i_cmd
+                if I[I_AMB_COIL] >= 0:               # first-order coil lag
+                    ic = I[I_AMB_COIL] + j
+                    i_act = y[ic]
+                    dy[ic] = (i_cmd - i_act) / P[P_AMB_TL]
+                if pid_on:
+                    dy[i_int] = de_int
+                    dy[i_q] = (e - y[i_q]) / P[P_AMB_TD]
+                if pulls:
+                    f = magnet_pair_force(i_act, d, P[P_AMB_KMAG], P[P_AMB_G0],
+                                          P[P_AMB_I0], P[P_AMB_RMAX])
+                    if a == 1:
+                        fy = f
+                    else:
+                        fx = f
+        load = add_external(add_station_force(load, P, I, aux, ST_AMB1 + k, fx, fy),
+                            fx * ddx + fy * ddy)
+    return load

@@ -13,8 +13,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._jit import njit
+from ._jit import njit, njit_borrow, njit_inline
 from .amb import static_weight_share
+from .laws.step import smooth_sign
+from .rotor import add_dissipated, add_external
+from .support import body_energy, spin_energy, spring_energy
 
 SCENE_KEYS = ("sleeve.mass", "sleeve.spin_inertia", "bearing.*", "effects.retainer_bearing",
               "effects.ehl_film", "effects.bearing_friction", "effects.sleeve_inertia")
@@ -25,15 +28,16 @@ PLANE_STATES = ("sx", "sy", "svx", "svy", "theta", "omega_s")
 
 def declare(layout) -> None:
     """The sleeve's and the bearing's parameters, flags and per-plane state slots."""
-    for name in ("sleeve.mass", "sleeve.spin_inertia", "bearing.balls", "bearing.half_play",
-                 "bearing.stiffness", "bearing.film_coef", "bearing.damping",
-                 "bearing.linear_stiffness", "bearing.cage_ratio", "bearing.m0_low",
-                 "bearing.m0_coef", "bearing.m1_coef", "bearing.seal_torque"):
-        layout.params.add(name)
-    for name in ("retainer_bearing", "ehl_film", "bearing_friction", "sleeve_inertia"):
-        layout.index.add("flag." + name)
-    for name in PLANE_STATES:
-        layout.plane.add(name)
+    layout.params.add_each(
+        "sleeve.mass", "sleeve.spin_inertia", "bearing.balls", "bearing.half_play",
+        "bearing.stiffness", "bearing.film_coef", "bearing.damping", "bearing.linear_stiffness",
+        "bearing.cage_ratio", "bearing.m0_low", "bearing.m0_coef", "bearing.m1_coef",
+        "bearing.seal_torque",
+        consts=("P_MS", "P_JS", "P_NB", "P_HALF_PLAY", "P_KTOT", "P_FILM", "P_CB", "P_KLIN",
+                "P_CAGE", "P_M0_LOW", "P_M0_COEF", "P_M1_COEF", "P_MSEAL"))
+    layout.index.add_each("flag.retainer_bearing", "flag.ehl_film", "flag.bearing_friction",
+                          "flag.sleeve_inertia", consts=("F_RB", "F_FILM", "F_BFRIC", "F_SLEEVE_J"))
+    layout.plane.add_each(*PLANE_STATES, consts=("J_SX", "J_SY", "J_SVX", "J_SVY", "J_TH", "J_WS"))
 
 
 def pack(scene, P, I, layout) -> None:
@@ -275,3 +279,132 @@ def drag_torque_magnitude(omega_rel, load, m0_low, m0_coef, m1_coef, seal):
     if m0 < m0_low:
         m0 = m0_low
     return m0 + m1_coef * load * math.sqrt(load) + seal
+
+
+# ------------------------------------------------------------------ the retainer plane's kernel --
+@njit_inline
+def sleeve_motion(y, I, k):
+    """Sleeve centre position and velocity at plane k (the housing's when rigidly mounted)."""
+    base = I_PLANES + k * N_PLANE_IDX
+    i, j = I[base + J_SX], I[base + J_SVX]
+    if i < 0:
+        i, j = I[base + J_HX], I[base + J_HVX]
+        if i < 0:
+            return 0.0, 0.0, 0.0, 0.0
+    return y[i], y[i + 1], y[j], y[j + 1]
+
+
+@njit_inline
+def sleeve_on_bearing(y, P, I, dy, aux, k, load, f_r, f_mu, cfx, cfy, ws, p_drag, sx, sy, svx,
+                      svy, hx, hy, hvx, hvy):
+    """Retainer plane k's bearing between the sleeve (inner ring, at (sx, sy) moving at (svx,
+    svy)) and the housing (outer ring, at (hx, hy) moving at (hvx, hvy)) under the contact's
+    normal and friction forces f_r, f_mu and its force (cfx, cfy) on the sleeve: the bearing's
+    dissipated and non-potential powers into the load, the sleeve's and the cage's rates, the
+    plane's bearing diagnostics. Returns (load, rx, ry): the force on the housing (the bearing's
+    reaction, or the contact's through a sleeve rigidly mounted in it)."""
+    base = I_PLANES + k * N_PLANE_IDX
+    i_ws = I[base + J_WS]
+    bfx = 0.0                                # bearing force on the sleeve
+    bfy = 0.0
+    p_bdamp = 0.0                            # power of the bearing's dashpot c_b
+    bload = f_r
+    qsum = 0.0
+    qmax = 0.0                               # most heavily loaded ball (SM bearing only)
+    dh_dw = 0.0
+    ux, uy = sx - hx, sy - hy
+    uvx, uvy = svx - hvx, svy - hvy
+    i_th = I[base + J_TH]
+    if I[F_RB] == RB_SM:
+        h = 0.0
+        if I[F_FILM]:
+            h, dh_dw = film_thickness(ws, P[P_FILM])
+        cage = P[P_CAGE] * y[i_th]
+        if I[F_FILM] and i_ws < 0:
+            # massless sleeve: the film follows the algebraic rolling speed, so the audit
+            # keeps the ball potential at zero film (mechanical_energy) and counts the
+            # film's share of the ball forces as a non-potential force (dV: the zero-film
+            # cage derivative, to match); one pass over the balls gives both
+            qx, qy, _, _, qsum, qmax, qx0, qy0, dV = ball_forces_with_dry(
+                ux, uy, cage, int(P[P_NB]), P[P_HALF_PLAY], h, P[P_KTOT])
+            load = add_external(load, (qx0 - qx) * uvx + (qy0 - qy) * uvy)
+        else:
+            qx, qy, _, dV, qsum, qmax = ball_forces(ux, uy, cage, int(P[P_NB]),
+                                                    P[P_HALF_PLAY], h, P[P_KTOT])
+        bfx = -qx - P[P_CB] * uvx
+        bfy = -qy - P[P_CB] * uvy
+        bload = math.sqrt(qx * qx + qy * qy)
+        p_bdamp = P[P_CB] * (uvx * uvx + uvy * uvy)
+        load = add_external(add_dissipated(load, p_bdamp), dV * P[P_CAGE] * ws)
+        if dy is not None:                   # cage rotation under load (no torque in the model)
+            dy[i_th] = ws
+    elif I[F_RB] == RB_LINEAR:
+        bfx = -P[P_KLIN] * ux - P[P_CB] * uvx
+        bfy = -P[P_KLIN] * uy - P[P_CB] * uvy
+        bload = P[P_KLIN] * math.sqrt(ux * ux + uy * uy)
+        p_bdamp = P[P_CB] * (uvx * uvx + uvy * uvy)
+        load = add_dissipated(load, p_bdamp)
+
+    # --- sleeve spin ---
+    drag_t = 0.0
+    if i_ws >= 0:
+        if I[F_BFRIC]:
+            drag_t = drag_torque_magnitude(ws, bload, P[P_M0_LOW], P[P_M0_COEF], P[P_M1_COEF],
+                                           P[P_MSEAL]) * smooth_sign(ws, P[P_WL])
+            p_drag = drag_t * ws
+            load = add_dissipated(load, p_drag)
+        if dy is not None:
+            dws = (P[P_RS] * f_mu - drag_t) / P[P_JS]
+            dy[i_ws] = dws
+            if I[F_RB] == RB_SM and I[F_FILM]:
+                # film growth changes the ball potential without a force doing work
+                load = add_external(load, qsum * dh_dw * dws)
+
+    # --- sleeve translation ---
+    i_sx = I[base + J_SX]
+    if dy is not None and i_sx >= 0:
+        ms = P[P_MS]
+        dy[i_sx] = svx
+        dy[I[base + J_SY]] = svy
+        dy[I[base + J_SVX]] = (cfx + bfx) / ms
+        dy[I[base + J_SVY]] = (cfy + bfy) / ms - P[P_G]
+    o = k * N_AUX_PLANE
+    aux[o + A_LOAD] = bload
+    aux[o + A_WS] = ws
+    aux[o + A_DRAG] = drag_t
+    aux[o + A_QMAX] = qmax
+    aux[o + A_PBDAMP] = p_bdamp
+    aux[o + A_PDRAG] = p_drag
+    if i_sx >= 0:
+        return load, -bfx, -bfy
+    return load, cfx, cfy
+
+
+@njit_borrow
+def sleeve_energy(y, P, I, k, E, sx, sy, svx, svy):
+    """E plus the kinetic and gravitational energy of retainer plane k's sleeve."""
+    base = I_PLANES + k * N_PLANE_IDX
+    if I[base + J_SX] >= 0:
+        E += body_energy(P[P_MS], svx, svy, P[P_G], sy)
+    i_ws = I[base + J_WS]
+    if i_ws >= 0:
+        E += spin_energy(P[P_JS], y[i_ws])
+    return E
+
+
+@njit_borrow
+def bearing_energy(y, P, I, k, E, sx, sy, hx, hy):
+    """E plus the elastic energy of retainer plane k's bearing (the balls' at zero film without
+    sleeve inertia, see :func:`sleeve_on_bearing`)."""
+    base = I_PLANES + k * N_PLANE_IDX
+    i_ws = I[base + J_WS]
+    ux, uy = sx - hx, sy - hy
+    if I[F_RB] == RB_SM:
+        ws = y[i_ws] if i_ws >= 0 else 0.0
+        h = film_thickness(ws, P[P_FILM])[0] if I[F_FILM] and i_ws >= 0 else 0.0
+        _, _, V, _, _, _ = ball_forces(ux, uy, P[P_CAGE] * y[I[base + J_TH]], int(P[P_NB]),
+                                       P[P_HALF_PLAY], h, P[P_KTOT])
+        E += V
+    elif I[F_RB] == RB_LINEAR:
+        E += spring_energy(P[P_KLIN], ux, uy)
+    return E

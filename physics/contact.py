@@ -6,14 +6,22 @@ diagnostics table (its own entries and the retainer bearing's, in the order of `
 """
 import math
 
-from ._jit import njit
+from ._jit import njit, njit_borrow, njit_inline
+from . import ball_bearing, laws
+from .laws.hertz_line import (HALF_WIDTH_LIMIT, LINE_U_MAX, conforming_radius,  # noqa: F401
+                              effective_modulus, half_width_approach, half_width_load,
+                              hunt_crossley, hysteresis_factor, line_continuation,
+                              line_deflection, line_elastic_force, line_half_width,
+                              line_potential)
+from .laws.power_law import contact_potential, normal_force, power_law_approach  # noqa: F401
+from .laws.step import smooth_sign, step  # noqa: F401
+from .rotor import ST_RB1, add_dissipated, add_station_force, add_torque
+from .thermal import contact_friction
 
 SCENE_KEYS = ("contact.clearance", "contact.stiffness", "contact.exponent", "contact.damping",
               "contact.damping_depth", "contact.friction", "contact.threshold_rpm",
               "contact.law", "contact.length", "contact.restitution", "rotor.journal_radius",
               "bearing.youngs_modulus", "bearing.poisson", "effects.friction")
-FRIC_NONE, FRIC_PAPER, FRIC_KINEMATIC = 0, 1, 2
-LAW_PAPER, LAW_HERTZ_LINE = 0, 1
 STANDARD_GRAVITY = 9.80665  # m/s^2: sets the hertz_line reference impact speed sqrt(2 g c)
 #: the per-plane diagnostics (Result.aux columns): contact normal force, friction force,
 #: penetration, bearing load, sleeve speed, bearing drag torque, then the powers [W] each
@@ -28,15 +36,17 @@ PLANE_DIAGNOSTICS = ("contact_force", "friction_force", "penetration", "bearing_
 
 def declare(layout) -> None:
     """The contact's parameters and flags, and the retainer plane's diagnostics."""
-    for name in ("contact.clearance", "sleeve.radius", "contact.stiffness", "contact.exponent",
-                 "contact.damping", "contact.damping_depth", "contact.friction",
-                 "contact.threshold_speed", "contact.threshold_velocity",
-                 "contact.line_coefficient", "contact.hysteresis"):
-        layout.params.add(name)
-    layout.index.add("flag.friction")
-    layout.index.add("flag.law")
-    for name in PLANE_DIAGNOSTICS:
-        layout.plane_aux.add(name)
+    layout.params.add_each(
+        "contact.clearance", "sleeve.radius", "contact.stiffness", "contact.exponent",
+        "contact.damping", "contact.damping_depth", "contact.friction", "contact.threshold_speed",
+        "contact.threshold_velocity", "contact.line_coefficient", "contact.hysteresis",
+        consts=("P_CLR", "P_RS", "P_KC", "P_EC", "P_CMAX", "P_DC", "P_MU", "P_WL", "P_VL",
+                "P_HL_A", "P_HL_CHI"))
+    layout.index.add("flag.friction", const="F_FRIC")
+    layout.index.add("flag.law", const="F_LAW")
+    layout.plane_aux.add_each(*PLANE_DIAGNOSTICS, consts=(
+        "A_FR", "A_FMU", "A_DELTA", "A_LOAD", "A_WS", "A_DRAG", "A_PFRIC", "A_QMAX", "A_PCDAMP",
+        "A_PBDAMP", "A_PDRAG", "A_PSUPPORT"))
 
 
 def pack(scene, P, I, layout) -> None:
@@ -44,9 +54,8 @@ def pack(scene, P, I, layout) -> None:
     flags (friction slip law, normal-force law)."""
     s, p, i = scene, layout.params, layout.index
     c = s.contact.clearance
-    I[i["flag.friction"]] = {"none": FRIC_NONE, "paper": FRIC_PAPER,
-                             "kinematic": FRIC_KINEMATIC}[s.effects.friction]
-    I[i["flag.law"]] = {"paper": LAW_PAPER, "hertz_line": LAW_HERTZ_LINE}[s.contact.law]
+    I[i["flag.friction"]] = laws.slip_law_flag(s.effects.friction)
+    I[i["flag.law"]] = laws.contact_law_flag(s.contact.law)
     P[p["contact.clearance"]] = c
     P[p["sleeve.radius"]] = s.rotor.journal_radius + c
     P[p["contact.stiffness"]], P[p["contact.exponent"]] = s.contact.stiffness, s.contact.exponent
@@ -60,45 +69,6 @@ def pack(scene, P, I, layout) -> None:
     P[p["contact.line_coefficient"]] = math.pi * ct.length * e_star
     P[p["contact.hysteresis"]] = hysteresis_factor(ct.restitution,
                                                    math.sqrt(2.0 * STANDARD_GRAVITY * ct.clearance))
-
-
-@njit
-def step(g, g0, h0, g1, h1):
-    """Cubic STEP polynomial, eq. 18: h0 below g0, h1 above g1, C1-smooth in between."""
-    if g <= g0:
-        return h0
-    if g >= g1:
-        return h1
-    s = (g - g0) / (g1 - g0)
-    return h0 + (h1 - h0) * s * s * (3.0 - 2.0 * s)
-
-
-@njit
-def normal_force(delta, delta_dot, K, e, c_max, d):
-    """Radial contact force F_r >= 0 for penetration delta and its rate, eq. 14.
-
-    Returns (F_r, K delta^e): the force and its elastic part (the energy audit needs both).
-    """
-    if delta <= 0.0:
-        return 0.0, 0.0
-    elastic = K * delta ** e
-    f = elastic + step(delta, 0.0, 0.0, d, c_max) * delta_dot
-    return (f if f > 0.0 else 0.0), elastic
-
-
-@njit
-def contact_potential(delta, K, e):
-    """Elastic energy K delta^(e+1)/(e+1) stored in the contact (energy audit)."""
-    if delta <= 0.0:
-        return 0.0
-    return K * delta ** (e + 1.0) / (e + 1.0)
-
-
-@njit
-def smooth_sign(slip, threshold):
-    """sign(slip) * STEP(|slip|, 0, 0, threshold, 1): the regularised friction direction (eq. 19)."""
-    a = step(abs(slip), 0.0, 0.0, threshold, 1.0)
-    return a if slip >= 0.0 else -a
 
 
 @njit
@@ -120,134 +90,71 @@ def geometry(ex, ey):
     return 0.0, 1.0, 0.0
 
 
-# --------------------------------------------------------------- hertz_line law (contact.law) --
-# Johnson's internal line contact: a journal in a conforming bore of radial clearance c, contact
-# length L, effective modulus E* (1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2), approach
-#     delta(F) = F / (pi L E*) [ln(4 pi L E* c / F) - 1]
-# (Johnson, Contact Mechanics, 1985, §5.6; the internal form as compared by Pereira, Ramalho &
-# Ambrosio, Nonlinear Dyn. 63, 2011). With a = pi L E*, u = F / (4 a c): delta / (4 c) = u (-ln u - 1).
-# The formula rests on Hertz's half-space assumption (contact half-width b << the radii), which
-# :func:`half_width_approach` bounds at b = HALF_WIDTH_LIMIT r, far below u = e^-3; the kernel
-# still needs a force at any penetration, so past u = e^-3 (:func:`line_continuation`, where the
-# tangent stiffness has risen to a) the law is continued linearly with stiffness a.
-LINE_U_MAX = math.exp(-3.0)
-HALF_WIDTH_LIMIT = 0.3      # b / r: the contact arc within ±17.5°, see half_width_load
 
 
-@njit
-def line_continuation(clearance):
-    """delta_c = 8 c / e^3 [m]: where the kernel continues the line-contact law linearly (a
-    numerical continuation, far past the law's validity bound :func:`half_width_approach`)."""
-    return 8.0 * clearance * LINE_U_MAX
+# ------------------------------------------------------------------ the retainer plane's kernel --
+@njit_inline
+def sleeve_contact(y, P, I, aux, k, load, px, py, pvx, pvy, sx, sy, svx, svy, ws):
+    """Retainer plane k's rotor-sleeve contact (eqs. 14-19): the rotor axis at (px, py) moving at
+    (pvx, pvy), the sleeve at (sx, sy) moving at (svx, svy) spinning at ws. Adds the contact's
+    force and torque on the rotor and its dissipated power to the load and writes the plane's
+    contact diagnostics. Returns (load, f_r, f_mu, cfx, cfy, ws, p_drag): the normal and friction
+    forces, the force on the sleeve, the sleeve speed (a massless sleeve rolls at the algebraic
+    speed w*) and the drag power a massless sleeve passes on."""
+    W = y[I[S_W]]
+    mu = contact_friction(y, P, I, k)
+    er, nx, ny = geometry(px - sx, py - sy)
+    tx, ty = -ny, nx
+    delta = er - P[P_CLR]
+    rel_vx, rel_vy = pvx - svx, pvy - svy
+    f_r = 0.0
+    f_mu = 0.0
+    p_fric = 0.0                             # power dissipated by the contact friction
+    p_cdamp = 0.0                            # ... by the contact's normal damping
+    p_drag = 0.0                             # ... by the retainer bearing's drag torque
+    if delta > 0.0:
+        ddelta = nx * rel_vx + ny * rel_vy
+        f_r, f_el = laws.normal_force(I[F_LAW], delta, ddelta, P)    # the contact law
+        p_cdamp = (f_r - f_el) * ddelta
+        load = add_dissipated(load, p_cdamp)
+    et = tx * rel_vx + ty * rel_vy           # whirl velocity along t
+    fric = I[F_FRIC]                         # the slip law
+    if laws.has_friction(fric) and f_r > 0.0:
+        if I[F_SLEEVE_J]:
+            slip, threshold = laws.slip_velocity(fric, et, W, ws, P)
+            f_mu = friction_force(mu, f_r, slip, threshold)
+            p_fric = f_mu * (et + W * P[P_RJ] - ws * P[P_RS])
+            load = add_dissipated(load, p_fric)
+        else:
+            # massless-sleeve limit: the sleeve rolls at w* and passes on only the drag torque
+            w_roll, v_sign, threshold = laws.rolling(fric, et, W, P)
+            sgn = smooth_sign(v_sign, threshold)
+            drag = 0.0
+            if I[F_BFRIC]:
+                drag = ball_bearing.drag_torque_magnitude(w_roll, f_r, P[P_M0_LOW], P[P_M0_COEF],
+                                                         P[P_M1_COEF], P[P_MSEAL]) / P[P_RS]
+            f_mu = sgn * min(mu * f_r, drag)
+            ws = w_roll * min(1.0, mu * f_r / drag) if drag > 0.0 else w_roll
+            p_fric = f_mu * (et + W * P[P_RJ] - ws * P[P_RS])
+            # all the rotor loses: p_fric plus the bearing drag f_mu ws R the sleeve passes on
+            p_drag = f_mu * P[P_RS] * ws      # the drag F_mu R the sleeve passes on
+            load = add_dissipated(load, f_mu * (et + W * P[P_RJ]))
+    # forces on the rotor at this plane: -F_r n - F_mu t, spin torque -r F_mu
+    cfx = f_r * nx + f_mu * tx               # force on the sleeve side
+    cfy = f_r * ny + f_mu * ty
+    load = add_torque(add_station_force(load, P, I, aux, ST_RB1 + k, -cfx, -cfy),
+                      -(P[P_RJ] * f_mu))
+    o = k * N_AUX_PLANE
+    aux[o + A_FR] = f_r
+    aux[o + A_FMU] = f_mu
+    aux[o + A_DELTA] = delta
+    aux[o + A_PFRIC] = p_fric
+    aux[o + A_PCDAMP] = p_cdamp
+    return load, f_r, f_mu, cfx, cfy, ws, p_drag
 
 
-def effective_modulus(youngs_modulus: float, poisson: float) -> float:
-    """E* = E / (2 (1 - nu^2)) [Pa] of two bodies of the same material
-    (1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2)."""
-    return youngs_modulus / (2.0 * (1.0 - poisson ** 2))
-
-
-def conforming_radius(r: float, clearance: float) -> float:
-    """R_eff = r R / (R - r) [m] of a journal of radius r in a bore of radius R = r + c
-    (1/R_eff = 1/r - 1/R: the concave bore counts negative, Johnson §4.3)."""
-    return r * (r + clearance) / clearance
-
-
-def line_half_width(force: float, r: float, clearance: float, a: float) -> float:
-    """Hertz half-width b = sqrt(4 F R_eff / (pi L E*)) [m] of the internal line contact carrying
-    ``force`` F (Johnson §4.3, two cylinders in line contact, load per length F / L), a = pi L E*."""
-    return math.sqrt(4.0 * force * conforming_radius(r, clearance) / a)
-
-
-def half_width_load(r: float, clearance: float, a: float,
-                    limit: float = HALF_WIDTH_LIMIT) -> float:
-    """F_b = a (limit r)^2 / (4 R_eff) [N]: the load at which :func:`line_half_width` reaches
-    ``limit`` times the journal radius r.
-
-    Why b <= 0.3 r (a chosen limit, stated by its geometry): Hertz's solution treats each body as an elastic half-space, valid while the
-    contact is small against the radii. At b = 0.3 r the contact arc spans ±17.5° of the journal,
-    the surface normal at its edges has turned by 17.5° (its radial share cos 17.5° = 0.954) and
-    the arc is 1.6 % longer than its chord: still a nearly flat contact. Beyond it the conforming
-    contact's pressure spreads over an arc that Hertz's flat-strip pressure no longer describes."""
-    if not 0.0 < limit < 1.0:
-        raise ValueError(f"limit (half-width / radius) must be in (0, 1); got {limit!r}")
-    b = limit * r
-    return a * b * b / (4.0 * conforming_radius(r, clearance))
-
-
-def half_width_approach(r: float, clearance: float, limit: float = HALF_WIDTH_LIMIT) -> float:
-    """Approach delta_b [m] of Johnson's internal line contact when its half-width reaches
-    ``limit`` r: delta_b = 4 c u_b (-ln u_b - 1) with u_b = F_b / (4 a c) = limit^2 r / (16 (r + c)).
-
-    a = pi L E* cancels, so delta_b depends on the geometry (r, c) only: 28.0 µm = 0.093 c for the
-    paper's journal (r = 30 mm, c = 300 µm); 55.9 µm for the stator (R_a = 45 mm, g_0 = 600 µm)."""
-    if r <= 0.0 or clearance <= 0.0:
-        raise ValueError(f"r and clearance must be > 0; got r = {r!r}, clearance = {clearance!r}")
-    u = limit * limit * r / (16.0 * (r + clearance))
-    return 4.0 * clearance * u * (-math.log(u) - 1.0)
-
-
-def power_law_approach(load: float, K: float, e: float) -> float:
-    """delta = (F / K)^(1/e) [m]: the penetration at which the paper's law K delta^e (eq. 14)
-    carries ``load``."""
-    if load < 0.0 or K <= 0.0 or e <= 0.0:
-        raise ValueError(f"load >= 0, K > 0, e > 0 required; got {load!r}, {K!r}, {e!r}")
-    return (load / K) ** (1.0 / e)
-
-
-@njit
-def line_deflection(F, a, c):
-    """Approach delta(F) of Johnson's internal line contact, a = pi L E*, clearance c [m]."""
-    if F <= 0.0:
-        return 0.0
-    return F / a * (math.log(4.0 * a * c / F) - 1.0)
-
-
-@njit
-def line_elastic_force(delta, a, c):
-    """F(delta) inverting :func:`line_deflection` (Newton on ln F; quadratic convergence from
-    the fixed-point start), continued linearly with slope a past :func:`line_continuation`."""
-    if delta <= 0.0:
-        return 0.0
-    f_v = 4.0 * a * c * LINE_U_MAX
-    d_v = line_continuation(c)
-    if delta >= d_v:
-        return f_v + a * (delta - d_v)
-    F = a * delta / max(math.log(4.0 * c / delta), 2.0)    # ln(4ac/F) - 1 ~ ln(4c/delta)
-    for _ in range(50):
-        lg = math.log(4.0 * a * c / F)
-        g = F / a * (lg - 1.0) - delta
-        step = g / ((lg - 2.0) / a * F)                     # d(delta)/d(ln F) = F (lg - 2) / a
-        F *= math.exp(-step)
-        if abs(step) < 1e-15:
-            break
-    return F
-
-
-@njit
-def line_potential(delta, a, c):
-    """Elastic energy of the line contact, ∫ F d delta = F^2 / (2a) [ln(4ac/F) - 3/2] (from
-    F delta - ∫ delta dF), plus the linear continuation's share past :func:`line_continuation`."""
-    if delta <= 0.0:
-        return 0.0
-    d_v = line_continuation(c)
-    F = line_elastic_force(min(delta, d_v), a, c)
-    V = F * F / (2.0 * a) * (math.log(4.0 * a * c / F) - 1.5)
-    if delta > d_v:
-        x = delta - d_v
-        V += F * x + 0.5 * a * x * x
-    return V
-
-
-@njit
-def hunt_crossley(elastic, delta_dot, chi):
-    """Hunt-Crossley force F = F_el (1 + chi delta_dot) >= 0: hysteresis damping that vanishes
-    with the elastic force (no jump at first touch); chi = 3 (1 - e^2) / (4 v_ref) of
-    Lankarani & Nikravesh (J. Mech. Des. 112, 1990) gives restitution ~e at impact speed v_ref."""
-    f = elastic * (1.0 + chi * delta_dot)
-    return f if f > 0.0 else 0.0
-
-
-def hysteresis_factor(restitution: float, v_ref: float) -> float:
-    """chi [s/m] of :func:`hunt_crossley` for restitution e at impact speed v_ref."""
-    return 3.0 * (1.0 - restitution ** 2) / (4.0 * v_ref)
+@njit_borrow
+def energy(y, P, I, k, E, px, py, sx, sy):
+    """E plus the elastic energy stored in retainer plane k's contact."""
+    er, _, _ = geometry(px - sx, py - sy)
+    return E + laws.potential(I[F_LAW], er - P[P_CLR], P)

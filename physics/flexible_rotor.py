@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._jit import njit_borrow
+from ._jit import njit_borrow, njit_inline
 from .flexible.floating import MAX_MODES, STATIONS
 
 #: the scene keys this effect reads
@@ -30,15 +30,15 @@ def declare(layout) -> None:
     """The modal frequencies, damping, station shapes and gyroscopic couplings; the mode count
     (0: rigid) and first elastic state; the station forces and the damping power."""
     p = layout.params
-    p.add("flex.omega2", MAX_MODES)
-    p.add("flex.damping", MAX_MODES)
-    p.add("flex.shape", N_STATIONS * MAX_MODES)
-    p.add("flex.gyro_rigid", MAX_MODES)
-    p.add("flex.gyro", MAX_MODES * MAX_MODES)
-    layout.index.add("flex.modes")
-    layout.index.add("state.elastic")
-    layout.aux.add("rotor.station_force", 2 * N_STATIONS)
-    layout.aux.add("rotor.damping_power")
+    p.add("flex.omega2", MAX_MODES, "P_FX_W2")
+    p.add("flex.damping", MAX_MODES, "P_FX_DAMP")
+    p.add("flex.shape", N_STATIONS * MAX_MODES, "P_FX_SHAPE")
+    p.add("flex.gyro_rigid", MAX_MODES, "P_FX_G1")
+    p.add("flex.gyro", MAX_MODES * MAX_MODES, "P_FX_G")
+    layout.index.add("flex.modes", const="I_FX_N")
+    layout.index.add("state.elastic", const="I_FX")
+    layout.aux.add("rotor.station_force", 2 * N_STATIONS, "A_STF")
+    layout.aux.add("rotor.damping_power", const="A_FX_PDAMP")
 
 
 def pack(scene, P, I, layout) -> None:
@@ -165,3 +165,18 @@ def strain_energy(model, y: np.ndarray) -> np.ndarray | float:
     w2 = model.P[model.param_index("flex.omega2"):][:n]
     eta = y[..., i0:i0 + 2 * n]
     return 0.5 * np.sum(np.concatenate([w2, w2]) * eta * eta, axis=-1)
+
+
+@njit_inline
+def clear_station_forces(aux):
+    """Zero the station forces and the damping power before the effects add theirs."""
+    for j in range(A_STF, A_FX_PDAMP + 1):
+        aux[j] = 0.0
+
+
+@njit_inline
+def modal_damping(y, P, I, aux):
+    """The modal damping's power [W] (also into aux ``rotor.damping_power``)."""
+    p = damping_power(y, P, I[I_FX], I[I_FX_N], P_FX_DAMP)
+    aux[A_FX_PDAMP] = p
+    return p

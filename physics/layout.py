@@ -28,33 +28,45 @@ class Slots:
         self.what = what
         self._start: dict[str, int] = {}
         self._width: dict[str, int] = {}
+        self._const: dict[str, str] = {}
         self.size = 0
         self._frozen = False
 
-    def add(self, name: str, width: int = 1) -> int:
-        """Declare ``name`` as the next ``width`` entries; returns its first index."""
+    def add(self, name: str, width: int = 1, const: str | None = None) -> int:
+        """Declare ``name`` as the next ``width`` entries; returns its first index. ``const``:
+        the kernels' constant for its first index (``"P_M"``), see :meth:`Layout.constants`."""
         if self._frozen:
             raise RuntimeError(f"the {self.what} slots are complete; {name!r} comes too late")
         if name in self._start:
             raise ValueError(f"{self.what} {name!r} is declared twice")
         if not (isinstance(width, int) and width >= 1):
             raise ValueError(f"{self.what} {name!r}: width must be a positive int, not {width!r}")
+        if const is not None:
+            if const in self._const.values():
+                raise ValueError(f"{self.what} constant {const!r} is declared twice")
+            self._const[name] = const
         self._start[name] = self.size
         self._width[name] = width
         self.size += width
         return self._start[name]
 
-    def block(self, *names: str) -> int:
-        """Declare ``names`` as consecutive single entries; returns the first one's index (the
-        kernels address the others as first + k)."""
+    def block(self, *names: str, consts: tuple[str, ...] = ()) -> int:
+        """Declare ``names`` as consecutive single entries (with the constants ``consts``, one
+        per name, when given); returns the first one's index (the kernels address the others as
+        first + k)."""
         first = self.size
-        for name in names:
-            self.add(name)
+        for name, const in zip(names, consts or (None,) * len(names)):
+            self.add(name, const=const)
         return first
 
-    def add_each(self, *names: str) -> tuple[int, ...]:
+    def add_each(self, *names: str, consts: tuple[str, ...] = ()) -> tuple[int, ...]:
         """Declare ``names`` as consecutive single entries; returns each one's index."""
-        return tuple(self.add(name) for name in names)
+        return tuple(self.add(name, const=const)
+                     for name, const in zip(names, consts or (None,) * len(names)))
+
+    def constants(self) -> dict[str, int]:
+        """The declared constants: constant name -> first index of its slot."""
+        return {c: self._start[n] for n, c in self._const.items()}
 
     def freeze(self) -> "Slots":
         """No more declarations (the size is final)."""
@@ -124,6 +136,32 @@ class Layout:
     def tables(self) -> tuple[Slots, ...]:
         return self.params, self.index, self.plane, self.controls, self.aux, self.plane_aux
 
+    def constants(self) -> dict[str, int]:
+        """Every constant the kernels index with, generated from the declarations: each slot
+        declared with ``const=`` (``P_M``: the first index of ``rotor.mass`` in ``P``) and the
+        arrays' sizes (``N_P``, ``N_I``, ``N_U``, ``N_AUX``; ``N_PLANE_IDX`` and ``N_AUX_PLANE``
+        of the per-plane blocks; ``I_PLANES``, the first plane's block in ``I``). A name
+        declared twice is an error naming it."""
+        out: dict[str, int] = {}
+        for table in self.tables():
+            for name, value in table.constants().items():
+                if name in out:
+                    raise ValueError(f"constant {name!r} is declared twice")
+                out[name] = value
+        out.update(N_P=self.params.size, N_I=self.index.size, N_U=self.controls.size,
+                   N_AUX=self.aux.size, N_PLANE_IDX=self.plane.size,
+                   N_AUX_PLANE=self.plane_aux.size, I_PLANES=self.index["planes"])
+        return out
+
+    def bind(self, module) -> None:
+        """Make :meth:`constants` module-level names of ``module`` (an effect module whose
+        kernels index the packed arrays, or its ``globals()``). numba reads a kernel's globals
+        when it first compiles it and compiles module-level ints in as constants, so a bound name
+        costs nothing at run time; :mod:`physics.model` binds every registered effect when it
+        builds the layout, before any kernel compiles."""
+        names = module if isinstance(module, dict) else vars(module)
+        names.update(self.constants())
+
     @classmethod
     def build(cls, effects: Iterable, planes: int = 2) -> "Layout":
         """Ask each effect (a module or object with ``declare(layout)``) for its slots, in order,
@@ -139,7 +177,7 @@ class Layout:
         declared, layout.aux = layout.aux, Slots("diagnostic")
         layout.aux.add("planes", planes * layout.plane_aux.size)
         for name, _, width in declared.spans():
-            layout.aux.add(name, width)
+            layout.aux.add(name, width, declared._const.get(name))
         for table in layout.tables():
             table.freeze().check()
         return layout

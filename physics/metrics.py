@@ -15,7 +15,7 @@ import numpy as np
 
 from .amb import weight_shares
 from .ball_bearing import film_thickness, max_contact_pressure, static_max_ball_load
-from .contact import effective_modulus
+from .laws import contact_law, slip_law
 from .dissipation import created_energy, dissipation_check
 from .flexible_rotor import strain_energy
 from .integrate import P_FR, P_LOAD, P_QMAX
@@ -193,12 +193,7 @@ def contact_period(scene, plane: str, load: float) -> float | None:
     c = scene.contact
     m = abs(weight_shares(scene.rotor.mass, scene.positions.rb1, scene.positions.rb2)[
         PLANES.index(plane)])
-    if c.law == "hertz_line":
-        a = math.pi * c.length * effective_modulus(scene.bearing.youngs_modulus, scene.bearing.poisson)
-        lg = math.log(4.0 * a * c.clearance / load) if load > 0.0 else math.inf
-        k = a / (lg - 2.0) if lg > 3.0 else a
-    else:
-        k = c.exponent * c.stiffness * (load / c.stiffness) ** ((c.exponent - 1.0) / c.exponent)
+    k = contact_law(c.law).tangent_stiffness(scene, load)      # the law's own
     return 2.0 * math.pi * math.sqrt(m / k) if k > 0.0 and m > 0.0 else None
 
 
@@ -430,10 +425,7 @@ def warnings_of(m: dict, scene) -> list[str]:
         d = m["dissipation"]
         out.append(f"{', '.join(d['negative'])} created {d['created_energy_J']:.3g} J (negative "
                    "dissipated power): "
-                   + ("effects.friction = 'paper' drives the friction by Omega - omega_s, not by "
-                      "the contact's sliding velocity; its heat and energy figures are not "
-                      "physical (effects.friction = 'kinematic' dissipates)"
-                      if scene.effects.friction == "paper" else
+                   + (getattr(slip_law(scene.effects.friction), "NEGATIVE_POWER", None) or
                       "an element does positive work on the motion; please report this scene"))
     if m["output_rate_too_coarse"]:
         out.append(f"solver.output_rate = {m['output_rate_hz']:g} Hz is below "

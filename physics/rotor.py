@@ -2,10 +2,20 @@
 
 An effect of the drop model (docs/architecture.md "Adding an effect"): its scene keys, packed
 slots, states and parameter packing are declared here; :mod:`physics.model` composes them.
+
+The rotor also owns the interface every force effect goes through: the **load** (Fx, Fy, Ma,
+Mb, T, p_diss, p_ext), a tuple of the forces, moments about the centre of mass and spin torque
+on the rotor and the audit's dissipated and external powers, which :func:`physics.model.rhs`
+threads through the effects' kernels in a fixed order; :func:`add_station_force` adds a force
+at a force station (also to the station forces a flexible rotor's modes are driven by), and
+:func:`axis_motion` reads the rotor axis at a station (the rigid body's motion plus the elastic
+modes'). The slot constants (``P_M`` ...) are the layout's, bound by :mod:`physics.model`.
 """
 import math
 
-from ._jit import njit
+from ._jit import njit, njit_borrow, njit_inline
+from .flexible.floating import MAX_MODES as FX_ROW          # a station's row of mode shapes
+from .flexible_rotor import elastic_energy, elastic_motion, elastic_rates, tilt_coupling
 
 #: the scene keys this effect reads
 SCENE_KEYS = ("rotor.mass", "rotor.polar_inertia", "rotor.diametral_inertia",
@@ -15,23 +25,26 @@ SCENE_KEYS = ("rotor.mass", "rotor.polar_inertia", "rotor.diametral_inertia",
               "effects.unbalance", "effects.gyroscopic")
 #: the rotor's states (positions, then velocities) and their index slots
 STATE_NAMES = ("x", "y", "a", "b", "vx", "vy", "va", "vb", "Omega")
+#: the force stations, in the order of their axial positions' block in P (ST_*: station index)
+STATIONS = ("rb1.z", "rb2.z", "amb1.z", "amb2.z", "unbalance.z")
+ST_RB1, ST_AMB1, ST_UB = (STATIONS.index(n) for n in ("rb1.z", "amb1.z", "unbalance.z"))
 
 
 def declare(layout) -> None:
     """The rotor's slots: mass properties, the axial stations, unbalance; its flags and states."""
     p = layout.params
-    for name in ("rotor.mass", "rotor.polar_inertia", "rotor.diametral_inertia", "world.gravity",
-                 "rotor.journal_radius"):
-        p.add(name)
-    # the force stations, one block (physics/flexible/floating.py STATIONS order)
-    p.block("rb1.z", "rb2.z", "amb1.z", "amb2.z", "unbalance.z")
-    for name in ("unbalance.me", "unbalance.phase"):
-        p.add(name)
+    p.add_each("rotor.mass", "rotor.polar_inertia", "rotor.diametral_inertia", "world.gravity",
+               "rotor.journal_radius", consts=("P_M", "P_IP", "P_ID", "P_G", "P_RJ"))
+    # the force stations, one block (physics/flexible/floating.py STATIONS order; ST_*)
+    p.block(*STATIONS,
+            consts=("P_Z_RB1", "P_Z_RB2", "P_Z_AMB1", "P_Z_AMB2", "P_Z_UB"))
+    p.add_each("unbalance.me", "unbalance.phase", consts=("P_MUE", "P_UB_PHASE"))
     i = layout.index
-    for name in ("gravity", "unbalance", "gyroscopic"):
-        i.add("flag." + name)
-    for name in STATE_NAMES + ("phi",):
-        i.add("state." + name)
+    i.add_each("flag.gravity", "flag.unbalance", "flag.gyroscopic",
+               consts=("F_GRAV", "F_UNB", "F_GYRO"))
+    i.add_each(*("state." + n for n in STATE_NAMES + ("phi",)),
+               consts=("S_X", "S_Y", "S_A", "S_B", "S_VX", "S_VY", "S_VA", "S_VB", "S_W",
+                       "S_PHI"))
 
 
 def pack(scene, P, I, layout) -> None:
@@ -123,3 +136,117 @@ def steady_unbalance_orbit(m_u_e: float, Omega: float, mass: float, k: float, c:
                          "(amb.stiffness = rotor.mass x Omega^2, amb.damping = 0): no settled "
                          "unbalance orbit; change amb.stiffness, amb.damping or rotor.speed_rpm")
     return force / dyn
+
+
+# ----------------------------------------------------------------------------- kernels --
+@njit_inline
+def axis_motion(y, P, I, s):
+    """Rotor axis position and velocity (px, py, vx, vy) at force station s (``ST_RB1 + k``,
+    ``ST_AMB1 + k``, ``ST_UB``; axial station P[P_Z_RB1 + s]): the rigid body's, plus the elastic
+    modes' of a flexible rotor (physics/flexible_rotor.py)."""
+    z = P[P_Z_RB1 + s]
+    px, py = axis_at(z, y[I[S_X]], y[I[S_Y]], y[I[S_A]], y[I[S_B]])
+    vx, vy = axis_at(z, y[I[S_VX]], y[I[S_VY]], y[I[S_VA]], y[I[S_VB]])
+    if I[I_FX_N] > 0:
+        ex, ey, evx, evy = elastic_motion(y, P, I[I_FX], I[I_FX_N], P_FX_SHAPE + s * FX_ROW)
+        return px + ex, py + ey, vx + evx, vy + evy
+    return px, py, vx, vy
+
+
+@njit_inline
+def add_force_at(load, z, fx, fy):
+    """The load with the force (fx, fy) on the rotor axis at axial position z added (its moments
+    z F about the centre of mass)."""
+    Fx, Fy, Ma, Mb, T, p_diss, p_ext = load
+    return Fx + fx, Fy + fy, Ma + z * fx, Mb + z * fy, T, p_diss, p_ext
+
+
+@njit_inline
+def add_station_force(load, P, I, aux, s, fx, fy):
+    """The load with the force (fx, fy) at force station s added; with a flexible rotor also
+    collected per station (aux ``rotor.station_force``), which drives its elastic modes."""
+    if I[I_FX_N] > 0:
+        aux[A_STF + 2 * s] += fx
+        aux[A_STF + 2 * s + 1] += fy
+    return add_force_at(load, P[P_Z_RB1 + s], fx, fy)
+
+
+@njit_inline
+def add_torque(load, torque):
+    """The load with a spin torque added."""
+    Fx, Fy, Ma, Mb, T, p_diss, p_ext = load
+    return Fx, Fy, Ma, Mb, T + torque, p_diss, p_ext
+
+
+@njit_inline
+def add_dissipated(load, power):
+    """The load with the audit's dissipated power increased by ``power`` [W]."""
+    Fx, Fy, Ma, Mb, T, p_diss, p_ext = load
+    return Fx, Fy, Ma, Mb, T, p_diss + power, p_ext
+
+
+@njit_inline
+def add_external(load, power):
+    """The load with the audit's external (and non-potential) power increased by ``power``."""
+    Fx, Fy, Ma, Mb, T, p_diss, p_ext = load
+    return Fx, Fy, Ma, Mb, T, p_diss, p_ext + power
+
+
+@njit_inline
+def weight(P):
+    """The load of gravity alone: (0, -m g, 0, 0, 0, 0, 0)."""
+    return 0.0, -P[P_M] * P[P_G], 0.0, 0.0, 0.0, 0.0, 0.0
+
+
+@njit_inline
+def unbalance(y, P, I, dy, aux, load):
+    """The unbalance's load (its station's elastic motion included) and the spin angle's rate."""
+    iphi = I[S_PHI]
+    W = y[I[S_W]]
+    ux, uy, _, _, p = unbalance_load(P[P_MUE], W, y[iphi], P[P_UB_PHASE], P[P_Z_UB],
+                                     y[I[S_VX]], y[I[S_VY]], y[I[S_VA]], y[I[S_VB]])
+    load = add_external(add_station_force(load, P, I, aux, ST_UB, ux, uy), p)
+    dy[iphi] = W
+    if I[I_FX_N] > 0:                            # the unbalance station's elastic motion
+        _, _, evx, evy = elastic_motion(y, P, I[I_FX], I[I_FX_N], P_FX_SHAPE + ST_UB * FX_ROW)
+        load = add_external(load, ux * evx + uy * evy)
+    return load
+
+
+@njit_inline
+def equations_of_motion(y, P, I, dy, aux, load):
+    """The rotor's (and its elastic modes') rates under the load."""
+    Fx, Fy, Ma, Mb, T, _, _ = load
+    m = P[P_M]
+    va, vb, W = y[I[S_VA]], y[I[S_VB]], y[I[S_W]]
+    dy[I[S_X]] = y[I[S_VX]]
+    dy[I[S_Y]] = y[I[S_VY]]
+    dy[I[S_A]] = va
+    dy[I[S_B]] = vb
+    dy[I[S_VX]] = Fx / m
+    dy[I[S_VY]] = Fy / m
+    n_fx = I[I_FX_N]
+    if n_fx > 0:                                 # elastic modes (physics/flexible_rotor.py)
+        spin = W if I[F_GYRO] else 0.0
+        if spin != 0.0:
+            cx, cy = tilt_coupling(y, P, I[I_FX], n_fx, P_FX_G1)
+            Ma -= spin * cy
+            Mb += spin * cx
+        elastic_rates(y, P, I[I_FX], n_fx, aux, A_STF, P_FX_W2, P_FX_DAMP, P_FX_SHAPE, P_FX_G1,
+                      P_FX_G, spin, va, vb, dy)
+    aa, ab = tilt_accelerations(Ma, Mb, va, vb, W, P[P_ID], P[P_IP], I[F_GYRO])
+    dy[I[S_VA]] = aa
+    dy[I[S_VB]] = ab
+    dy[I[S_W]] = T / P[P_IP]
+
+
+@njit_borrow
+def energy(y, P, I):
+    """The rotor's kinetic energy (its elastic modes' strain and kinetic energy included) plus
+    its gravitational energy [J]."""
+    m = P[P_M]
+    E = rotor_energy(m, P[P_ID], P[P_IP], y[I[S_VX]], y[I[S_VY]], y[I[S_VA]], y[I[S_VB]],
+                     y[I[S_W]])
+    if I[I_FX_N] > 0:
+        E += elastic_energy(y, P, I[I_FX], I[I_FX_N], P_FX_W2)
+    return E + m * P[P_G] * y[I[S_Y]]

@@ -21,6 +21,8 @@ from importlib import resources
 from pathlib import Path
 from typing import Any, Iterator, Mapping
 
+from .laws import CONTACT_LAWS, SLIP_LAWS
+
 
 class SceneError(ValueError):
     """A scene or parameter value is invalid; the message names the key and what is allowed."""
@@ -114,7 +116,7 @@ class Contact:
     law: str = param("paper", "-", doc="rotor-sleeve normal force law: paper (K delta^e with the STEP"
                      " damping, eq. 14) or hertz_line (Johnson's internal line contact of steel on"
                      " steel over contact.length, Hunt-Crossley damping; docs/physics.md)",
-                     tag="A", choices=("paper", "hertz_line"))
+                     tag="A", choices=tuple(CONTACT_LAWS))
     length: float = param(0.022, "m", 1e-4, 1.0, "hertz_line: axial contact length L of journal and"
                           " sleeve (the 6016's width)", "A")
     restitution: float = param(0.9, "-", 0.05, 1.0, "hertz_line: coefficient of restitution e of a"
@@ -264,6 +266,25 @@ class Seal:
 
 
 @dataclass(frozen=True)
+class Ground:
+    """Base excitation (physics/ground.py; effects.base_excitation): the ground under the
+    housings and the AMB stators accelerates by a half-sine pulse and/or a tabulated record; the
+    model is written in the ground's frame (every body feels -m a_g)."""
+    pulse_peak: float = param(0.0, "m/s^2", 0.0, 1e5, "half-sine pulse's peak acceleration A"
+                              " (or ground.pulse_peak_g; 0: no pulse)", "A")
+    pulse_peak_g: float = param(0.0, "g", 0.0, 1e4, "the pulse's peak in standard gravities"
+                                " (9.80665 m/s^2; instead of ground.pulse_peak)", "A")
+    pulse_duration: float = param(0.011, "s", 1e-4, 10.0, "the pulse's duration T (shock tests:"
+                                  " ~6-18 ms)", "A")
+    pulse_angle_deg: float = param(90.0, "deg", -360.0, 360.0, "direction of the pulse in the x-y"
+                                   " plane, from +x towards +y (90: upward, against gravity)", "A")
+    pulse_start: float = param(0.0, "s", 0.0, 100.0, "time t_0 the pulse starts", "A")
+    record: str = param("", "-", doc="a tabulated acceleration record: the path of a CSV of t [s],"
+                        " a_x, a_y [m/s^2] rows (linear between samples, zero outside; at most"
+                        " 1024 rows); empty: none", tag="A")
+
+
+@dataclass(frozen=True)
 class Flexible:
     """The flexible rotor (rotor.model = "flexible"; physics/flexible_rotor.py, docs/flexible.md):
     Timoshenko shaft elements reduced to the rigid-body motion plus elastic modes. The force
@@ -316,7 +337,7 @@ class Effects:
                               " follows Omega - omega_s, which for r != R pushes along the sliding"
                               " and creates energy; for reproducing the paper, its metrics report"
                               " the energy created)",
-                          choices=("none", "paper", "kinematic"))
+                          choices=tuple(SLIP_LAWS))
     stator_contact: bool = param(False, "-",
                                  doc="rotor-stator contact at the AMB planes once the rotor reaches"
                                      " amb.air_gap (stator.* parameters; no state)", tag="A")
@@ -331,12 +352,17 @@ class Effects:
     seal: bool = param(False, "-",
                        doc="seal cross-coupling: a direct and cross-coupled stiffness load at"
                            " seal.z (seal.* parameters; no state)", tag="A")
+    base_excitation: bool = param(False, "-",
+                                  doc="the ground under the housings and AMB stators accelerates"
+                                      " (ground.* parameters: a half-sine pulse and/or a record;"
+                                      " no state)", tag="A")
 
 
 GROUPS: dict[str, type] = {
     "rotor": Rotor, "positions": Positions, "unbalance": Unbalance, "world": World, "amb": Amb,
     "contact": Contact, "stator": Stator, "sleeve": Sleeve, "thermal": Thermal, "bearing": Bearing,
-    "support": Support, "sensor": Sensor, "seal": Seal, "flexible": Flexible,
+    "support": Support, "sensor": Sensor, "seal": Seal, "ground": Ground,
+    "flexible": Flexible,
     "solver": Solver, "effects": Effects,
 }
 
@@ -358,6 +384,7 @@ class Scene:
     support: Support = field(default_factory=Support)
     sensor: Sensor = field(default_factory=Sensor)
     seal: Seal = field(default_factory=Seal)
+    ground: Ground = field(default_factory=Ground)
     flexible: Flexible = field(default_factory=Flexible)
     solver: Solver = field(default_factory=Solver)
     effects: Effects = field(default_factory=Effects)
@@ -481,10 +508,11 @@ def scene_from_toml(text: str, name: str = "custom", base_dir: Path | None = Non
                          " a TOML file path")
     base = _load_base(base_name, _chain, base_dir) if base_name else Scene()
     flat = _flatten(data, name)
-    shaft = flat.get("flexible.shaft")
-    if isinstance(shaft, str) and shaft.endswith(".toml") and base_dir is not None \
-            and not Path(shaft).is_absolute():
-        flat["flexible.shaft"] = str(base_dir / shaft)       # a rotor file beside the scene's
+    for key, suffix in (("flexible.shaft", ".toml"), ("ground.record", "")):
+        path = flat.get(key)                     # a rotor file or a record beside the scene's
+        if isinstance(path, str) and path and path.endswith(suffix) and base_dir is not None \
+                and not Path(path).is_absolute():
+            flat[key] = str(base_dir / path)
     scene = base.with_overrides(flat)
     return dataclasses.replace(scene, name=name)
 
@@ -622,6 +650,8 @@ def _check_consistency(s: Scene) -> None:
         _check_flexible(s)
     if s.effects.thermal:
         _check_thermal(s)
+    if s.effects.base_excitation:
+        _check_ground(s)
     if s.effects.semi_active_damper:
         sp = s.support
         if not s.effects.housing:
@@ -674,6 +704,23 @@ def _check_bearing_geometry(s: Scene) -> None:
                          f" bore) must be < the inner raceway radius (bearing.pitch_diameter -"
                          f" bearing.ball_diameter) / 2 = {race * 1e3:.4g} mm: the sleeve and the"
                          f" inner ring sit between them")
+
+
+def _check_ground(s: Scene) -> None:
+    """One peak key at most; something to excite with; a readable record."""
+    from .ground import load_record
+    g = s.ground
+    if g.pulse_peak > 0.0 and g.pulse_peak_g > 0.0:
+        raise SceneError(f"ground.pulse_peak = {g.pulse_peak:g} m/s^2 and ground.pulse_peak_g ="
+                         f" {g.pulse_peak_g:g} g: give the pulse's peak once (set the other to 0)")
+    if g.pulse_peak == 0.0 and g.pulse_peak_g == 0.0 and not g.record:
+        raise SceneError("effects.base_excitation = true needs ground.pulse_peak (or"
+                         " ground.pulse_peak_g) > 0 or a ground.record file")
+    if g.record:
+        try:
+            load_record(g.record)
+        except ValueError as exc:
+            raise SceneError(str(exc)) from None
 
 
 MIN_THERMAL_TIME_CONSTANT = 0.1     # s: a lumped sleeve cools no faster (physics/thermal.py)

@@ -11,7 +11,8 @@ a forward whirl, Alford's and Wachel's estimates of aerodynamic cross-coupling h
 K is the seal's direct stiffness. The load is not a potential force for k != 0, so its power
 F · v_s goes into the energy audit's external work. No state.
 """
-from ._jit import njit
+from ._jit import njit, njit_inline
+from .rotor import add_external, add_force_at
 
 #: the scene keys this effect reads
 SCENE_KEYS = ("seal.z", "seal.direct_stiffness", "seal.cross_stiffness", "effects.seal")
@@ -19,10 +20,9 @@ SCENE_KEYS = ("seal.z", "seal.direct_stiffness", "seal.cross_stiffness", "effect
 
 def declare(layout) -> None:
     """The station, the direct and cross-coupled stiffness, and the on/off flag."""
-    layout.params.add("seal.z")
-    layout.params.add("seal.direct_stiffness")
-    layout.params.add("seal.cross_stiffness")
-    layout.index.add("flag.seal")
+    layout.params.add_each("seal.z", "seal.direct_stiffness", "seal.cross_stiffness",
+                           consts=("P_SEAL_Z", "P_SEAL_K", "P_SEAL_KC"))
+    layout.index.add("flag.seal", const="F_SEAL")
 
 
 def pack(scene, P, I, layout) -> None:
@@ -41,3 +41,12 @@ def seal_load(z, K, k, x, y, a, b, vx, vy, va, vb):
     fx = -K * xs - k * ys
     fy = k * xs - K * ys
     return fx, fy, z * fx, z * fy, fx * (vx + z * va) + fy * (vy + z * vb)
+
+
+@njit_inline
+def force(y, P, I, load):
+    """The load with the seal's force, moments and power added."""
+    fx, fy, _, _, p = seal_load(P[P_SEAL_Z], P[P_SEAL_K], P[P_SEAL_KC], y[I[S_X]], y[I[S_Y]],
+                                y[I[S_A]], y[I[S_B]], y[I[S_VX]], y[I[S_VY]], y[I[S_VA]],
+                                y[I[S_VB]])
+    return add_external(add_force_at(load, P[P_SEAL_Z], fx, fy), p)

@@ -31,7 +31,8 @@ from __future__ import annotations
 
 import math
 
-from ._jit import njit
+from ._jit import njit, njit_inline
+from .rotor import ST_AMB1, axis_motion
 
 #: states per AMB plane: q1, q2 of the x axis, then of the y axis (S1)
 STATES_PER_PLANE = 4
@@ -44,10 +45,10 @@ def declare(layout) -> None:
     """The delay tau, the sensing flag (on when sensor.delay or sensor.noise > 0), the first
     delay state's slot, and the held noise samples ``sensor.noise`` + j [m] of AMB axis j that
     the sensed displacement carries until the next sample."""
-    layout.params.add("sensor.delay")
-    layout.index.add("flag.sensor")
-    layout.index.add("state.sensor")
-    layout.controls.add("sensor.noise", len(AXES))
+    layout.params.add("sensor.delay", const="P_SENS_TAU")
+    layout.index.add("flag.sensor", const="F_SENSOR")
+    layout.index.add("state.sensor", const="I_SENS")
+    layout.controls.add("sensor.noise", len(AXES), const="U_SENS_NOISE")
 
 
 def pack(scene, P, I, layout) -> None:
@@ -108,3 +109,36 @@ def pade_phase(omega: float, tau: float) -> float:
     """Phase [rad] of the (2,2) Padé approximant of e^{-s tau} at s = j omega (continuous past
     w tau = sqrt(12), where the denominator's real part changes sign)."""
     return -2.0 * math.atan2(omega * tau / 2.0, 1.0 - (omega * tau) ** 2 / 12.0)
+
+
+# ----------------------------------------------------------------------------- kernels --
+@njit_inline
+def delayed_motion(y, P, I, k, px, py, vx, vy):
+    """The true motion (px, py, vx, vy) of AMB plane k as its sensors' delay passes it on (the
+    Pade states, S1); unchanged without ``sensor.delay``."""
+    i = I[I_SENS]
+    if i >= 0:
+        i += STATES_PER_PLANE * k
+        tau = P[P_SENS_TAU]
+        px, vx = delayed(px, vx, y[i], y[i + 1], tau)
+        py, vy = delayed(py, vy, y[i + 2], y[i + 3], tau)
+    return px, py, vx, vy
+
+
+@njit_inline
+def sensed_motion(y, P, I, U, k, px, py, vx, vy):
+    """What the sensors of AMB plane k report of its true motion (px, py, vx, vy): delayed, plus
+    the held noise samples U_SENS_NOISE. Only called with I[F_SENSOR] set; the velocities carry
+    the delay, not the noise."""
+    px, py, vx, vy = delayed_motion(y, P, I, k, px, py, vx, vy)
+    return px + U[U_SENS_NOISE + 2 * k], py + U[U_SENS_NOISE + 2 * k + 1], vx, vy
+
+
+@njit_inline
+def delay_states(y, P, I, dy):
+    """The Pade delay states' rates (S1) of both AMB planes."""
+    i_sens = I[I_SENS]
+    tau = P[P_SENS_TAU]
+    for k in range(2):
+        dx, dyy, _, _ = axis_motion(y, P, I, ST_AMB1 + k)
+        delay_rates(dx, dyy, y, i_sens + STATES_PER_PLANE * k, tau, dy)

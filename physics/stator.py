@@ -17,8 +17,9 @@ from __future__ import annotations
 
 import math
 
-from ._jit import njit
+from ._jit import njit, njit_borrow, njit_inline
 from .amb import weight_shares
+from .rotor import ST_AMB1, add_dissipated, add_station_force, add_torque, axis_motion
 from .contact import geometry, half_width_approach, smooth_sign
 from .roots import bisect_decreasing
 
@@ -26,6 +27,7 @@ SCENE_KEYS = ("stator.*", "amb.air_gap", "contact.threshold_rpm", "rotor.mass", 
               "positions.amb2", "effects.stator_contact", "effects.stator_mount")
 #: the stator on its mount at each AMB plane (4 states per plane, effects.stator_mount)
 MOUNT_STATES = ("x", "y", "vx", "vy")
+MOUNT_STRIDE = len(MOUNT_STATES)      # the stator-mount states of one AMB plane
 
 
 def declare(layout) -> None:
@@ -33,26 +35,32 @@ def declare(layout) -> None:
     radius, threshold speed; mount stiffness, damping, mass per AMB plane), flag, state slot and
     per-AMB-plane diagnostics: the stator's normal force (zero without stator contact), the
     contact's dashpot and friction powers, its mount's dashpot power."""
-    for name in ("stator.gap", "stator.stiffness", "stator.damping", "stator.friction",
-                 "stator.rotor_radius", "stator.threshold_velocity", "stator.mount_stiffness",
-                 "stator.mount_damping", "stator.mount_mass"):
-        layout.params.add(name)
-    layout.index.add("flag.stator")
-    layout.index.add("state.stator_mount")
-    for name in ("stator.normal_force", "stator.damping_power", "stator.friction_power",
-                 "stator.mount_power"):
-        layout.aux.add(name, 2)
+    layout.params.add_each("stator.gap", "stator.stiffness", consts=("P_ST_GAP", "P_ST_K"))
+    layout.params.add("stator.damping", 2, "P_ST_C")         # per AMB plane: its mass share
+    layout.params.add_each(
+        "stator.friction", "stator.rotor_radius", "stator.threshold_velocity",
+        "stator.mount_stiffness", "stator.mount_damping", "stator.mount_mass",
+        consts=("P_ST_MU", "P_ST_R", "P_ST_VL", "P_STM_K", "P_STM_C", "P_STM_M"))
+    layout.index.add("flag.stator", const="F_STATOR")
+    layout.index.add("state.stator_mount", const="I_STM")
+    for name, const in (("stator.normal_force", "A_STATOR"), ("stator.damping_power", "A_ST_PDAMP"),
+                        ("stator.friction_power", "A_ST_PFRIC"),
+                        ("stator.mount_power", "A_ST_PMOUNT")):
+        layout.aux.add(name, 2, const)
 
 
 def pack(scene, P, I, layout) -> None:
-    """The stator contact's parameters and flag."""
+    """The stator contact's parameters and flag; the dashpot of each AMB plane for the rotor's
+    mass share there (lever rule)."""
     s, p = scene, layout.params
     I[layout.index["flag.stator"]] = s.effects.stator_contact
     st = s.stator
-    share = abs(weight_shares(s.rotor.mass, s.positions.amb1, s.positions.amb2)[0])
+    shares = weight_shares(s.rotor.mass, s.positions.amb1, s.positions.amb2)
     P[p["stator.gap"]], P[p["stator.stiffness"]] = s.amb.air_gap, st.stiffness
     P[p["stator.friction"]], P[p["stator.rotor_radius"]] = st.friction, st.rotor_radius
-    P[p["stator.damping"]] = damping_coefficient(st.stiffness, max(share, 1e-3), st.restitution)
+    for k, share in enumerate(shares):
+        P[p["stator.damping"] + k] = damping_coefficient(st.stiffness, max(abs(share), 1e-3),
+                                                         st.restitution)
     P[p["stator.threshold_velocity"]] = s.contact.threshold_rpm * math.pi / 30.0 * st.rotor_radius
     P[p["stator.mount_stiffness"]], P[p["stator.mount_mass"]] = st.mount_stiffness, st.mount_mass
     P[p["stator.mount_damping"]] = 2.0 * st.mount_damping_ratio * math.sqrt(st.mount_stiffness
@@ -161,3 +169,59 @@ def stator_potential(px, py, gap, k):
     """Elastic energy ½ k δ² stored in the stator contact (energy audit)."""
     delta = math.sqrt(px * px + py * py) - gap
     return 0.5 * k * delta * delta if delta > 0.0 else 0.0
+
+
+# ----------------------------------------------------------------------------- kernels --
+@njit_inline
+def stator_motion(y, I, k):
+    """Stator position and velocity at AMB plane k on its mount; zeros when fixed to ground."""
+    i = I[I_STM]
+    if i < 0:
+        return 0.0, 0.0, 0.0, 0.0
+    i += MOUNT_STRIDE * k
+    return y[i], y[i + 1], y[i + 2], y[i + 3]
+
+
+@njit_inline
+def contact(y, P, I, dy, aux, load):
+    """Rotor-stator contact at both AMB planes: forces and torque into the load, the contact's
+    and the mount's dissipated power, the mounts' rates and the stator diagnostics."""
+    W = y[I[S_W]]
+    for k in range(2):
+        px, py, pvx, pvy = axis_motion(y, P, I, ST_AMB1 + k)
+        qx, qy, qvx, qvy = stator_motion(y, I, k)
+        sfx, sfy, torque, f_n, _, p_sd, p_sf = stator_force(
+            px - qx, py - qy, pvx - qvx, pvy - qvy, W, P[P_ST_GAP], P[P_ST_K], P[P_ST_C + k],
+            P[P_ST_MU], P[P_ST_R], P[P_ST_VL])
+        p_mount = 0.0
+        i_q = I[I_STM]
+        if i_q >= 0:                         # the stator on its mount takes the reaction
+            i_q += MOUNT_STRIDE * k
+            p_mount = mount_power(qvx, qvy, P[P_STM_C])
+            load = add_dissipated(load, p_mount)
+            if dy is not None:
+                dy[i_q], dy[i_q + 1], dy[i_q + 2], dy[i_q + 3] = mount_rates(
+                    sfx, sfy, qx, qy, qvx, qvy, P[P_STM_K], P[P_STM_C], P[P_STM_M])
+        load = add_station_force(load, P, I, aux, ST_AMB1 + k, sfx, sfy)
+        load = add_dissipated(add_torque(load, torque), p_sd + p_sf)
+        aux[A_STATOR + k] = f_n
+        aux[A_ST_PDAMP + k] = p_sd
+        aux[A_ST_PFRIC + k] = p_sf
+        aux[A_ST_PMOUNT + k] = p_mount
+    return load
+
+
+@njit_inline
+def clear(aux):
+    """Zero the stator diagnostics (no stator contact)."""
+    for j in range(A_STATOR, A_ST_PMOUNT + 2):
+        aux[j] = 0.0
+
+
+@njit_borrow
+def energy(y, P, I, k, E):
+    """E plus the stator contact's elastic energy at AMB plane k and its mount's energy."""
+    ax, ay, _, _ = axis_motion(y, P, I, ST_AMB1 + k)
+    qx, qy, qvx, qvy = stator_motion(y, I, k)
+    E += stator_potential(ax - qx, ay - qy, P[P_ST_GAP], P[P_ST_K])
+    return E + mount_energy(qx, qy, qvx, qvy, P[P_STM_K], P[P_STM_M])

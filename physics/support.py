@@ -4,8 +4,9 @@ and the semi-active support damper (spec §6): C_s a controlled state lagging it
 An effect of the drop model (docs/architecture.md "Adding an effect"): its scene keys, packed
 slots, states and parameter packing are declared here; :mod:`physics.model` composes them.
 """
-from ._jit import njit
+from ._jit import njit, njit_borrow, njit_inline
 from .amb import clamp
+from .rotor import add_dissipated
 
 SCENE_KEYS = ("support.stiffness", "support.housing_mass", "support.damping",
               "support.damping_min", "support.damping_max", "support.damper_time_constant",
@@ -18,15 +19,13 @@ PLANE_STATES = ("hx", "hy", "hvx", "hvy")
 def declare(layout) -> None:
     """The support's parameters, flag, the damper's state slot and the per-housing damping
     controls ``support.damping`` + k (the damper's command with effects.semi_active_damper)."""
-    p = layout.params
-    for name in ("support.stiffness", "support.housing_mass", "support.damping_min",
-                 "support.damping_max", "support.damper_time_constant"):
-        p.add(name)
-    layout.index.add("flag.housing")
-    layout.index.add("state.damper")
-    for name in PLANE_STATES:
-        layout.plane.add(name)
-    layout.controls.block("rb1.support_damping", "rb2.support_damping")
+    layout.params.add_each("support.stiffness", "support.housing_mass", "support.damping_min",
+                           "support.damping_max", "support.damper_time_constant",
+                           consts=("P_KS", "P_MH", "P_CS_MIN", "P_CS_MAX", "P_CS_TAU"))
+    layout.index.add("flag.housing", const="F_HOUSING")
+    layout.index.add("state.damper", const="I_CS")
+    layout.plane.add_each(*PLANE_STATES, consts=("J_HX", "J_HY", "J_HVX", "J_HVY"))
+    layout.controls.block("rb1.support_damping", "rb2.support_damping", consts=("U_CS1", "U_CS2"))
 
 
 def pack(scene, P, I, layout) -> None:
@@ -110,3 +109,49 @@ def spring_energy(k, x, y):
 def spin_energy(J, w):
     """Kinetic energy of a body of spin inertia J at speed w [J] (a sleeve)."""
     return 0.5 * J * w * w
+
+
+# ------------------------------------------------------------------ the retainer plane's kernel --
+@njit_inline
+def housing_motion(y, I, k):
+    """Housing (outer ring) position and velocity at retainer plane k; zeros when fixed."""
+    base = I_PLANES + k * N_PLANE_IDX
+    i = I[base + J_HX]
+    if i < 0:
+        return 0.0, 0.0, 0.0, 0.0
+    j = I[base + J_HVX]
+    return y[i], y[i + 1], y[j], y[j + 1]
+
+
+@njit_inline
+def housing(y, P, I, U, dy, aux, k, load, rx, ry):
+    """Retainer plane k's housing on its support under the force (rx, ry) of what it carries:
+    the support dashpot's power into the load, the housing's and the damper's rates."""
+    hx, hy, hvx, hvy = housing_motion(y, I, k)
+    i_hx = I[I_PLANES + k * N_PLANE_IDX + J_HX]
+    p_support = 0.0                          # power of the support dashpot C_s
+    if i_hx >= 0:
+        cs = U[U_CS1 + k]
+        if I[I_CS] >= 0:                     # semi-active damper lags its command (spec §6)
+            cs = y[I[I_CS] + k]
+        p_support = support_power(hvx, hvy, cs)
+        load = add_dissipated(load, p_support)
+        if dy is not None:
+            if I[I_CS] >= 0:
+                dy[I[I_CS] + k] = damper_rate(U[U_CS1 + k], cs, P[P_CS_MIN], P[P_CS_MAX],
+                                              P[P_CS_TAU])
+            i_hvx = I[I_PLANES + k * N_PLANE_IDX + J_HVX]
+            dy[i_hx], dy[i_hx + 1], dy[i_hvx], dy[i_hvx + 1] = housing_rates(
+                hx, hy, hvx, hvy, P[P_KS], cs, rx, ry, P[P_MH], P[P_G])
+    aux[k * N_AUX_PLANE + A_PSUPPORT] = p_support
+    return load
+
+
+@njit_borrow
+def energy(y, P, I, k, E):
+    """E plus retainer plane k's housing's kinetic, gravitational and support-spring energy."""
+    if I[I_PLANES + k * N_PLANE_IDX + J_HX] >= 0:
+        hx, hy, hvx, hvy = housing_motion(y, I, k)
+        E += body_energy(P[P_MH], hvx, hvy, P[P_G], hy)
+        E += spring_energy(P[P_KS], hx, hy)
+    return E

@@ -18,7 +18,7 @@ Q_lost = W_fric = integral of sum_k (P_k + D_k), with Q_lost = integral of sum_k
 """
 from __future__ import annotations
 
-from ._jit import njit
+from ._jit import njit, njit_inline
 
 STATE_NAMES = ("RB1.temperature", "RB2.temperature", "heat_lost", "friction_work")
 SCENE_KEYS = ("thermal.*", "effects.thermal", "sleeve.mass", "contact.friction")
@@ -33,8 +33,9 @@ TEMPERATURE_OBS = 100.0          # K: its observation size
 
 def declare(layout) -> None:
     """The thermal parameters (one block, in PARAM_NAMES order) and the first state's slot."""
-    layout.params.block(*PARAM_NAMES)
-    layout.index.add("state.thermal")
+    layout.params.block(*PARAM_NAMES, consts=("P_TH_C", "P_TH_G", "P_TH_A", "P_TH_SLOPE",
+                                              "P_TH_RMIN", "P_TH_RMAX", "P_TH_B"))
+    layout.index.add("state.thermal", const="I_THERM")
 
 
 def pack(scene, P, I, layout) -> None:
@@ -116,3 +117,21 @@ def heat_rates(p_fric, p_drag, theta, C, G, a, b):
     power ``p_fric`` and its ball bearing's friction power ``p_drag``."""
     loss = G * theta
     return (a * p_fric + b * p_drag - loss) / C, (1.0 - a) * p_fric + (1.0 - b) * p_drag + loss
+
+
+@njit_inline
+def contact_friction(y, P, I, k):
+    """The rotor-sleeve friction coefficient at retainer plane k: the scene's, or with
+    effects.thermal its value at the sleeve's temperature (:func:`friction_coefficient`)."""
+    mu = P[P_MU]
+    if I[I_THERM] >= 0:
+        mu = friction_coefficient(mu, y[I[I_THERM] + k], P[P_TH_SLOPE], P[P_TH_RMIN],
+                                  P[P_TH_RMAX])
+    return mu
+
+
+@njit_inline
+def heat(y, P, I, dy, aux):
+    """The thermal states' rates from both planes' friction and drag powers (aux)."""
+    rates(y, dy, I[I_THERM], aux[A_PFRIC], aux[A_PDRAG], aux[N_AUX_PLANE + A_PFRIC],
+          aux[N_AUX_PLANE + A_PDRAG], P[P_TH_C], P[P_TH_G], P[P_TH_A], P[P_TH_B])

@@ -13,11 +13,11 @@ the environments.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
-from .contact import (HALF_WIDTH_LIMIT, effective_modulus, half_width_approach, half_width_load,
-                      line_elastic_force, power_law_approach)
+from .contact import HALF_WIDTH_LIMIT
+from .laws import contact_law
+from .laws.hertz_line import line_stiffness  # noqa: F401  (re-exported)
 from .stator import penetration_bound
 
 WHERE = ("retainer", "stator")
@@ -35,13 +35,6 @@ class Bound:
                     validity_criterion=self.criterion)
 
 
-def line_stiffness(scene) -> float:
-    """a = π L E* [N/m] of the retainer's steel line contact (``contact.length``, the bearing
-    steel's E and ν)."""
-    b = scene.bearing
-    return math.pi * scene.contact.length * effective_modulus(b.youngs_modulus, b.poisson)
-
-
 def validity_bound(scene, where: str = "retainer") -> Bound:
     """The penetration bound of the rotor-sleeve law (``where = "retainer"``) or of the stator
     contact (``"stator"``) in ``scene`` (module docstring)."""
@@ -52,13 +45,4 @@ def validity_bound(scene, where: str = "retainer") -> Bound:
         st, g0 = scene.stator, scene.amb.air_gap
         d = penetration_bound(st.rotor_radius, g0)
         return Bound(d, st.stiffness * d, f"{lim} stator.rotor_radius (line-contact approach)")
-    c, r = scene.contact, scene.rotor.journal_radius
-    if c.law == "hertz_line":
-        d = half_width_approach(r, c.clearance)
-        a = line_stiffness(scene)
-        return Bound(d, float(line_elastic_force(d, a, c.clearance)),
-                     f"{lim} rotor.journal_radius (line-contact approach)")
-    load = half_width_load(r, c.clearance, line_stiffness(scene))
-    return Bound(power_law_approach(load, c.stiffness, c.exponent), load,
-                 f"load at which a steel line contact reaches {lim} rotor.journal_radius, "
-                 "through K delta^e")
+    return Bound(*contact_law(scene.contact.law).validity_bound(scene))    # the law's own

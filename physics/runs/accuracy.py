@@ -28,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..laws import SLIP_LAWS, slip_law
 from ..metrics import worst_plane
 from ..scene import SceneError
 
@@ -98,10 +99,10 @@ def settings(plan: AccuracyPlan, scene) -> list[Setting]:
     out += [Setting(f"fixed dt {dt:g} s", "fixed", {"solver.method": "fixed", "solver.dt": dt})
             for dt in plan.fixed_dts]
     reduced = list(REDUCED)
-    other = "kinematic" if scene.effects.friction == "paper" else "paper"
-    if scene.effects.friction != "none":
-        reduced.append((f"{other} slip instead of {scene.effects.friction}",
-                        {"effects.friction": other}))
+    if slip_law(scene.effects.friction) is not None:        # each other registered slip law
+        reduced += [(f"{other} slip instead of {scene.effects.friction}",
+                     {"effects.friction": other}) for other, law in SLIP_LAWS.items()
+                    if law is not None and law is not slip_law(scene.effects.friction)]
     out += [Setting(label, "reduced", ov) for label, ov in reduced if changes(scene, ov)]
     return out
 

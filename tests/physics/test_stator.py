@@ -8,6 +8,7 @@ import pytest
 from physics import load_scene, simulate
 from physics.contact import line_deflection
 from physics.metrics import compute_metrics
+from physics.model import build_model
 from physics.scene import Scene
 from physics.stator import damping_coefficient, damping_ratio, restitution_of_damping, stator_force
 
@@ -217,3 +218,22 @@ def test_params_lists_the_new_keys_with_unit_range_and_source():
     assert rows["contact.law"]["allowed"] == "paper|hertz_line"
     assert rows["stator.stiffness"]["unit"] == "N/m" and rows["stator.stiffness"]["tag"] == "D"
     assert rows["stator.friction"]["tag"] == "A"
+
+
+def test_each_amb_plane_damps_the_impact_of_its_own_mass_share():
+    """On the asymmetric rotor the AMB planes carry different shares of the mass (lever rule:
+    64 % and 36 %); each plane's stator dashpot is the one that rebounds its own share with
+    stator.restitution, c_k = 2 zeta(e) sqrt(k m_k) (so c_1 / c_2 = sqrt(m_1 / m_2)), and a point
+    mass of that share rebounds from it with e."""
+    from physics.amb import weight_shares
+    s = load_scene("asymmetric", {"effects.stator_contact": True})
+    m = build_model(s)
+    i = m.param_index("stator.damping")
+    k, e = s.stator.stiffness, s.stator.restitution
+    shares = [abs(w) for w in weight_shares(s.rotor.mass, s.positions.amb1, s.positions.amb2)]
+    assert shares[0] != pytest.approx(shares[1], rel=0.1)
+    for plane, mk in enumerate(shares):
+        c = m.P[i + plane]
+        assert c == pytest.approx(2.0 * damping_ratio(e) * math.sqrt(k * mk), rel=1e-12)
+        assert point_mass_rebound(mk, k, c, 600e-6, 0.1) == pytest.approx(e, rel=2e-3)
+    assert m.P[i] / m.P[i + 1] == pytest.approx(math.sqrt(shares[0] / shares[1]), rel=1e-12)

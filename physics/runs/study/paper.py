@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from ...laws import slip_kinematic, slip_paper
 from ...metrics import worst_plane
 from ...results import Result
 from ...scene import Scene, SceneError, load_scene
@@ -24,10 +25,10 @@ from .checks import as_drop, beyond_validity, split_valid, warning_counts
 from .ensemble import ENSEMBLE_KEYS, onset, perturbations, probability_curve
 from .observables import drop_observables
 
-SLIPS = ("paper", "kinematic")
+SLIPS = (slip_paper.NAME, slip_kinematic.NAME)      # the study compares the two slip laws
 #: the slip law the claims, the reproduce commands and the response figures use: the scenes'
 #: default, whose friction only dissipates; the paper's eq. 19 runs beside it for comparison
-PRIMARY_SLIP = "kinematic"
+PRIMARY_SLIP = slip_kinematic.NAME
 STIFFNESS = (5e6, 5e7, 5e8)               # support stiffness study [N/m] (paper §V)
 SOFT, BASE, STIFF = STIFFNESS             # soft (the ~600 µm statement), base case, stiff
 DAMPING = (2790.0, 27900.0)               # support damping study [N s/m] (paper §V): low, high
@@ -266,8 +267,9 @@ def _slip_agreement(outs: list[Outcome]) -> float | None:
     """Fraction of drops (same mu, drag and member) whose whirl decision both slip laws share."""
     dec = {(o.run.label["slip"], o.run.label["drag"], o.run.label["friction"], o.run.label["member"]):
            _whirl(o) for o in outs if o.ok}
-    pairs = [(v, dec[("kinematic",) + k[1:]]) for k, v in dec.items()
-             if k[0] == "paper" and ("kinematic",) + k[1:] in dec]
+    paper, kinematic = SLIPS
+    pairs = [(v, dec[(kinematic,) + k[1:]]) for k, v in dec.items()
+             if k[0] == paper and (kinematic,) + k[1:] in dec]
     return sum(a == b for a, b in pairs) / len(pairs) if pairs else None
 
 
