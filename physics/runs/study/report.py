@@ -250,9 +250,11 @@ def write_report(a: dict, out: Path, figures: dict[str, list[str]], meta: dict) 
           "full friction (slip far above the regularisation threshold), where both laws give the "
           "same force μF_r. They differ once the sleeve approaches the rotor's surface speed "
           "(later forces, spin-down).")
-    w("\nThe threshold is where the whirl probability first reaches 50 % (linear interpolation "
-      "between grid points); the logistic fit uses every drop. More than one 50 % crossing means "
-      "whirling and non-whirling μ interleave below the μ from which every drop whirls.\n")
+    w("\nThe threshold is where the whirl probability reaches 50 % (linear interpolation "
+      "between grid points), named only where the probability never falls along the grid; the "
+      "logistic fit uses every drop. More than one 50 % crossing means whirling and non-whirling "
+      "μ interleave below the μ from which every drop whirls: whirl is then a probability over "
+      "μ, not a threshold (- in the column).\n")
     w(f"![orbits]({figures['friction'][0]})\n")
     w(f"![forces]({figures['friction'][1]})\n")
     w(f"![sleeve speed]({figures['friction'][2]})\n")
