@@ -16,11 +16,14 @@ from physics.contact import smooth_sign
 
 T_END = 0.16          # s: the fault at 0.1 s, the first impacts and the sleeve spin-up
 RATE = 100e3          # Hz: finite differences of the positions to well within the slip
+# a sleeve 10 x lighter than the preset's spins up to rolling within the run: the friction law is
+# then seen on both sides of rolling, sliding and at the rolling speed
+LIGHT_SLEEVE = {"sleeve.spin_inertia": 1.5e-4}
 
 
 @pytest.fixture(scope="module")
 def drop():
-    return simulate(load_scene("paper", {"solver.output_rate": RATE}), t_end=T_END)
+    return simulate(load_scene("paper", {"solver.output_rate": RATE, **LIGHT_SLEEVE}), t_end=T_END)
 
 
 def kinematic_slip(r, plane: str) -> np.ndarray:
@@ -49,7 +52,8 @@ def test_the_friction_force_follows_the_kinematic_slip(drop):
         on = (f_r > 10.0) & (r.t > r.t_fault)
         on[[0, -1]] = False                                  # central differences only
         clear = on & (np.abs(slip) > 5.0 * v_l)
-        assert clear.sum() > 1000                            # sliding contact samples
+        rolling = on & (np.abs(slip) < v_l)
+        assert clear.sum() > 500 and rolling.sum() > 500     # sliding, then rolling
         expect = scene.contact.friction * f_r * np.array([smooth_sign(s, v_l) for s in slip])
         np.testing.assert_allclose(f_mu[clear], expect[clear], rtol=1e-3, atol=1.0)
         assert np.all(np.abs(f_mu[on]) <= scene.contact.friction * f_r[on] * (1 + 1e-9))
@@ -96,12 +100,10 @@ def test_the_support_takes_the_dashpot_and_spring_force(drop):
         vs = np.gradient(s, r.t, axis=0)
         as_ = np.gradient(vs, r.t, axis=0)
         support = m_h * ah + m_s * as_ - f_contact - (m_h + m_s) * g
-        law = -k * h - c * vh
         sel = slice(int(np.searchsorted(r.t, r.t_fault)) + 2, -2)
         for axis in (0, 1):
-            scale = np.abs(law[sel, axis]).max()
-            assert scale > 1.0
-            resid = np.abs(support[sel, axis] - law[sel, axis])
-            assert np.median(resid) < 0.02 * scale, axis
-            dash = np.abs(c * vh[sel, axis]).max()
-            assert dash > 0.05 * scale, axis     # the dashpot term matters at this level
+            # the spring and dashpot coefficients that explain the support force, per axis
+            A = -np.stack([h[sel, axis], vh[sel, axis]], axis=1)
+            (k_fit, c_fit), *_ = np.linalg.lstsq(A, support[sel, axis], rcond=None)
+            assert k_fit == pytest.approx(k, rel=0.02), axis
+            assert c_fit == pytest.approx(c, rel=0.1), axis
