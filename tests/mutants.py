@@ -22,6 +22,7 @@ rewrites the table between the markers of docs/physics.md ("Mutation check").
 from __future__ import annotations
 
 import json
+import re
 import shutil
 import subprocess
 import sys
@@ -157,42 +158,52 @@ class Death:
 
 
 def failure(stdout: str) -> tuple[str, str] | None:
-    """(test id, message) of the first failing test in a ``pytest -rfE`` summary, or None."""
-    for ln in stdout.splitlines():
-        if ln.startswith(("FAILED ", "ERROR ")):
-            head, _, msg = ln.partition(" - ")
-            return head.split(" ", 1)[1], msg.strip()
-    return None
+    """(test id, exception line) of the failing test in the output of ``pytest -x -rfE
+    --tb=line`` (the id from the summary's FAILED/ERROR line, the exception from the traceback's
+    ``path:line: message`` line), or None."""
+    lines = stdout.splitlines()
+    test = next((ln.split(" ", 1)[1].split(" - ")[0] for ln in lines
+                 if ln.startswith(("FAILED ", "ERROR "))), None)
+    if test is None:
+        return None
+    where = [m.group(1) for m in (re.match(r"^\S+:\d+: (.*)$", ln) for ln in lines) if m]
+    return test, (where[-1].strip() if where else "")
 
 
 def by_assertion(message: str) -> bool:
     """A failure message of an assertion (pytest's rewritten ``assert`` or an AssertionError,
     e.g. numpy.testing's), not of an exception the mutant's run raised."""
-    return message.startswith(("assert ", "AssertionError", "Failed: "))
+    return message.startswith(("assert ", "AssertionError", "Failed: ", "Failed"))
 
 
 def run(mutant: Mutant, tests=TESTS) -> Death:
-    """How one mutant dies (:class:`Death`), run in a fresh copy: the tests with ``-x``; a test
-    that fails by an exception is deselected and the rest run again."""
-    errors = []
+    """How one mutant dies (:class:`Death`), run in a fresh copy of the checkout."""
     with tempfile.TemporaryDirectory(prefix=f"mutant-{mutant.name}-") as tmp:
         root = Path(tmp)
         copy_tree(root)
         apply(mutant, root)
-        while True:
-            deselect = [a for test, _ in errors for a in ("--deselect", test)]
-            proc = subprocess.run([sys.executable, "-m", "pytest", "-x", "-q", "-rfE", "--tb=no",
-                                   "-p", "no:xdist", "-p", "no:cacheprovider", "-o", "addopts=",
-                                   *deselect, *tests], cwd=root, capture_output=True, text=True)
-            first = failure(proc.stdout)
-            if first is None:
-                # nothing failed: survived; a collection error (exit 2) says nothing either
-                last = (proc.stdout.strip().splitlines() or ["no output"])[-1]
-                return Death(False, None, last, tuple(errors))
-            test, message = first
-            if by_assertion(message):
-                return Death(True, test, message.splitlines()[0][:160], tuple(errors))
-            errors.append((test, message[:160]))
+        return die(root, tests)
+
+
+def die(root: Path, tests=TESTS) -> Death:
+    """The tests against the mutated copy at ``root`` with ``-x``; a test that fails by an
+    exception is deselected and the rest run again, until one fails by an assertion or none
+    fails."""
+    errors = []
+    while True:
+        deselect = [a for test, _ in errors for a in ("--deselect", test)]
+        proc = subprocess.run([sys.executable, "-m", "pytest", "-x", "-q", "-rfE", "--tb=line",
+                               "-p", "no:xdist", "-p", "no:cacheprovider", "-o", "addopts=",
+                               *deselect, *tests], cwd=root, capture_output=True, text=True)
+        first = failure(proc.stdout)
+        if first is None:
+            # nothing failed: survived; a collection error (exit 2) says nothing either
+            last = (proc.stdout.strip().splitlines() or ["no output"])[-1]
+            return Death(False, None, last, tuple(errors))
+        test, message = first
+        if by_assertion(message):
+            return Death(True, test, message[:160], tuple(errors))
+        errors.append((test, message[:160]))
 
 
 def table(data: dict) -> str:
