@@ -80,7 +80,8 @@ def test_sweep_cells_count_the_warnings_rotordrop_drop_prints(tmp_path, capsys):
                           "--set", "solver.output_rate=500", "--set", "solver.t_end=0.15",
                           "--jobs", "1")
     cell, = r["cells"]
-    assert cell["failed"] == 0 and cell["whirl_probability"] == 0.0
+    # left validity at the air gap before any whirl: undecided, out of the whirl probability
+    assert cell["failed"] == 0 and cell["whirl_probability"] is None and cell["whirl_undecided"] == 1
     assert cell["warnings"] == dict(no_fault=0, pre_fault_contact=1, stator_contact=1,
                                     coarse_output=1, missed_peaks=0, aliased_whirl=0,
                                     penetration=0, film_play=0, dry_whip=0)
