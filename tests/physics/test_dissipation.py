@@ -133,3 +133,22 @@ def test_a_heavily_damped_contact_never_pulls():
     assert check["terms"]["RB1.contact_damping"]["min_power_W"] >= 0.0
     res, e = energy_residual(r)
     assert res.max() < 1e-5 * e["dissipated"][-1]
+
+
+EARLY = [("paper, whirl, hertz_line", {**WHIRL, "contact.law": "hertz_line"}, 0.13),
+         ("paper, whirl, stator contact", {**WHIRL, "effects.stator_contact": True,
+                                           "support.stiffness": 5e6}, 0.14)]
+
+
+@pytest.mark.parametrize("label, overrides, t_end", EARLY, ids=[v[0] for v in EARLY])
+def test_the_first_contacts_dissipate_and_close_the_audit(label, overrides, t_end):
+    """The first impacts only (the stator first touched at 0.113 s): a force or power of the
+    wrong sign shows here as a failed check on a finite run, before it could drive the run to a
+    blow-up (which says only that the run broke, not what is wrong)."""
+    r = _drop(label, overrides, t_end)
+    check = dissipation_check(r)
+    assert check["ok"], check["negative"]
+    res, e = energy_residual(r)
+    assert res.max() < 1e-5 * e["dissipated"][-1]
+    if "stator" in label:
+        assert dissipation_powers(r)["AMB1.stator_damping"].max() > 0.0   # it touched
