@@ -94,7 +94,7 @@ def summary_table(m: dict) -> str:
     lines = [f"scene {m['scene']}: {m['t_end']:g} s simulated in {m['wall_time_s']:.3f} s "
              f"({m['rhs_evaluations']} rhs evaluations, {m['n_state']} states; compile/cache load "
              f"{m['compile_time_s']:.2f} s)", _contact_line(m),
-             f"final rotor speed {m['final_rotor_speed_rpm']:.0f} rpm"]
+             f"final rotor speed {_cell(m, 'final_rotor_speed_rpm', '.0f')} rpm"]
     r = m.get("rotor", {})
     if r.get("model") == "flexible":
         lines.insert(1, f"flexible rotor (shaft {r['shaft']!r}): {r['elastic_modes']} elastic modes"
@@ -107,11 +107,12 @@ def summary_table(m: dict) -> str:
     lines.append(f"{'AMB plane':10}{'max disp [µm]':>15}{'stator':>8}{'contacts':>10}{'peak F [N]':>12}")
     for p, v in m["amb_planes"].items():
         lines.append(f"{p:10}{_cell(v, 'max_displacement_um', '.1f'):>15}"
-                     f"{'yes' if v['stator_contact'] else 'no':>8}"
+                     f"{_yes(v, 'stator_contact'):>8}"
                      f"{_fmt(v['stator_contacts'], 'd'):>10}{_cell(v, 'stator_peak_force_N', '.0f'):>12}")
     if m["left_validity_at_s"] is not None:
-        lines.append(f"n/a (beyond validity at t = {m['left_validity_at_s']:.4f} s): the penetration "
-                     "passed the contact law's validity bound, force and displacement metrics are not "
+        lines.append(f"n/a (beyond validity at t = {m['left_validity_at_s']:.4f} s): "
+                     f"{m['left_validity_plane']} passed its validity bound "
+                     f"({m['left_validity_criterion']}); every metric of the motion after it is not "
                      "computable (metrics.json keeps their values up to then as *_before_invalid)")
     lines += [f"warning: {w}" for w in m["warnings"]]
     return "\n".join(lines)
@@ -133,11 +134,10 @@ def _post_fault_tables(m: dict) -> list[str]:
     lines = [f"{'plane':6}{'max disp [µm]':>15}{'peak F_r [N]':>14}{'whirl':>7}{'f_whirl [Hz]':>14}"
              f"{'sleeve [rpm]':>14}"]
     for p, v in m["planes"].items():
-        f = v["whirl_frequency_hz"]
         lines.append(f"{p:6}{_cell(v, 'max_displacement_um', '.1f'):>15}"
                      f"{_cell(v, 'peak_contact_force_N', '.0f'):>14}"
-                     f"{'yes' if v['backward_whirl'] else 'no':>7}{f'{f:.1f}' if f else '-':>14}"
-                     f"{v['final_sleeve_speed_rpm']:14.0f}")
+                     f"{_yes(v, 'backward_whirl'):>7}{_cell(v, 'whirl_frequency_hz', '.1f'):>14}"
+                     f"{_cell(v, 'final_sleeve_speed_rpm', '.0f'):>14}")
     lines.append(f"{'retainer':10}{'bearing load [N]':>17}{'s0':>7}{'worst ball [N]':>16}"
                  f"{'p_max [MPa]':>13}{'friction heat [J]':>19}")
     for p, v in m["planes"].items():
@@ -145,13 +145,15 @@ def _post_fault_tables(m: dict) -> list[str]:
                      f"{_cell(v, 'static_safety_factor', '.1f'):>7}"
                      f"{_cell(v, 'max_ball_load_N', '.0f'):>16}{_cell(v, 'max_contact_pressure_MPa', '.0f'):>13}"
                      f"{_cell(v, 'friction_heat_J', '.0f'):>19}")
+    from .metrics import valid_or_before
     p0 = m.get("rating_pressure_MPa")
+    created = {p: valid_or_before(v, "friction_energy_created_J") for p, v in m["planes"].items()}
     lines += ["s0: static safety factor C_0 / peak bearing load; p_max: Hertz pressure of the worst "
               "ball" + (f" (s0 = 1 at {p0:.0f} MPa for this bearing)" if p0 else ""),
               "friction heat: generated at the rotor-sleeve contact after the fault"
               + (" (net: the paper slip law also created "
-                 + ", ".join(f"{p} {v['friction_energy_created_J']:.1f} J" for p, v in m["planes"].items())
-                 + ")" if any(v["friction_energy_created_J"] > 0.0 for v in m["planes"].values())
+                 + ", ".join(f"{p} {v:.1f} J" for p, v in created.items())
+                 + ")" if any(v > 0.0 for v in created.values())
                  else "")]
     if "max_temperature_rise_K" in next(iter(m["planes"].values())):       # effects.thermal
         lines.append("sleeve heating: " + ", ".join(
@@ -168,6 +170,14 @@ def _cell(v: dict, key: str, spec: str) -> str:
     if v[key] is None and key + BEFORE_INVALID in v:
         return "n/a"
     return _fmt(v[key], spec)
+
+
+def _yes(v: dict, key: str) -> str:
+    """A per-plane yes/no metric for the tables, "n/a" like :func:`_cell`."""
+    from .metrics import BEFORE_INVALID
+    if v[key] is None and key + BEFORE_INVALID in v:
+        return "n/a"
+    return "yes" if v[key] else "no"
 
 
 def _fmt(value, spec: str) -> str:

@@ -2,10 +2,14 @@
 the checks that say when they do not describe a clean drop (contact before the fault, stator
 contact, no fault in the run, output samples too coarse), listed as ``warnings``.
 
-A run whose penetration passes a contact law's validity bound (:func:`physics.validity.validity_bound`)
-leaves the domain of its laws at ``left_validity_at_s``: its force and displacement metrics
-(:data:`INVALID_KEYS`, :data:`STATOR_INVALID_KEYS`) are then None, their values over the samples
-before that time kept as ``<key>_before_invalid``."""
+A run is valid up to the first validity bound it passes (:func:`physics.validity.validity_bound`),
+whichever it is: a contact law's penetration bound at a retainer plane, the stator contact's bound
+at an AMB plane, or, without ``effects.stator_contact``, the rotor reaching the AMB air gap (the
+stator it would hit is not modelled). From that time, ``left_validity_at_s``, the model does not
+describe the motion, so every metric that depends on the motion after it is None: the per-plane
+:data:`INVALID_KEYS` and :data:`STATOR_INVALID_KEYS` and the run-level :data:`RUN_INVALID_KEYS`
+(final speeds, whirl, end state), their values over the samples before that time kept as
+``<key>_before_invalid``; the energy audit covers the valid samples only."""
 from __future__ import annotations
 
 import functools
@@ -41,10 +45,17 @@ INVALID_KEYS = ("max_displacement_um", "max_y_displacement_um", "peak_contact_fo
                 "max_contact_pressure_MPa", "friction_heat_J", "max_penetration_um",
                 # effects.thermal: heated by that friction
                 "max_temperature_rise_K", "final_temperature_rise_K", "min_friction_coefficient",
-                "max_friction_coefficient")
+                "max_friction_coefficient",
+                # and every other number of the motion after the fault: speeds, whirl, film
+                "final_sleeve_speed_rpm", "max_sleeve_speed_rpm", "friction_energy_created_J",
+                "backward_whirl", "whirl_revolutions", "whirl_frequency_hz", "whirl_sampling_aliased",
+                "max_film_thickness_um")
 PRE_FAULT_KEYS = ("pre_fault_peak_contact_force_N",)    # invalid only if it left before the fault
 STATOR_INVALID_KEYS = ("max_displacement_um", "stator_peak_force_N", "stator_contact_time_s",
-                       "stator_penetration_um", "max_stator_displacement_um")
+                       "stator_penetration_um", "max_stator_displacement_um", "stator_contacts")
+# the run-level ones; the end state (final_slip_ratio, sleeves_still_sliding) is None without a
+# value before, and an event (first contact, reaching the air gap) keeps its time if it came first
+RUN_INVALID_KEYS = ("final_rotor_speed_rpm", "backward_whirl")
 BEFORE_INVALID = "_before_invalid"                 # suffix of their values up to that time
 SLIDING_SLIP = 0.1              # |1 - omega_s R / (Omega r)| at the end above which a sleeve slides
 SLIDING_WINDOW = 5e-3           # s: a plane counts as in contact at the end if it was in this window
@@ -220,7 +231,7 @@ def min_output_rate(result: Result, planes: dict) -> tuple[float, str]:
         load = max(abs(weight), valid_or_before(v, "peak_contact_force_N"),
                    valid_or_before(v, "pre_fault_peak_contact_force_N"))
         periods = {"contact": contact_period(scene, p, load)}
-        f_whirl = v["whirl_frequency_hz"]
+        f_whirl = valid_or_before(v, "whirl_frequency_hz")
         periods["backward-whirl"] = 1.0 / f_whirl if f_whirl else None
         for what, period in periods.items():
             if period is not None and SAMPLES_PER_PERIOD / period > best:
@@ -297,15 +308,21 @@ def check_metrics(result: Result, m: dict) -> dict:
                contact_before_fault=any(bool((result.penetration(p)[pre] > 0.0).any())
                                         for p in PLANES))
     out["amb_planes"] = amb_plane_metrics(result)
-    out["stator_contact"] = any(v["stator_contact"] for v in out["amb_planes"].values())
     out["stator_contact_modelled"] = bool(result.model.I[F_STATOR])
     validity = contact_validity(result)
     for p, v in validity.pop("planes").items():
         m["planes"][p].update(v)
     out.update(validity)
     out.update(mark_validity(result, m["planes"], out["amb_planes"]))
+    reached = [v["stator_contact"] for v in out["amb_planes"].values()]
+    out["stator_contact"] = True if any(reached) else None if None in reached else False
+    if out["left_validity_at_s"] is not None:     # the film check on the valid samples
+        out["film_exceeds_play"] = [p for p, v in m["planes"].items()
+                                    if (valid_or_before(v, "max_film_thickness_um") or 0.0)
+                                    > out["bearing_radial_play_um"]]
     rate = result.model.scene.solver.output_rate
-    need, source = min_output_rate(result, m["planes"])
+    t_inv = out["left_validity_at_s"]
+    need, source = min_output_rate(result if t_inv is None else result.until(t_inv), m["planes"])
     out.update(output_rate_hz=rate, min_output_rate_hz=need, min_output_rate_source=source,
                output_rate_too_coarse=rate < need)
     # the step maxima cover the whole post-fault run: not computable once it left validity
@@ -316,10 +333,11 @@ def check_metrics(result: Result, m: dict) -> dict:
 
 
 def left_validity(result: Result) -> dict:
-    """Per plane: the first time its penetration passes the contact law's validity bound
-    (``left_validity_at_s``, interpolated between samples; None if never) and the bound
-    (:meth:`physics.validity.Bound.to_dict`): the retainer planes always, the AMB planes with
-    ``effects.stator_contact`` (without it the stator contact check warns instead)."""
+    """Per plane: the first time it passes its validity bound (``left_validity_at_s``,
+    interpolated between samples; None if never) and the bound
+    (:meth:`physics.validity.Bound.to_dict`): at the retainer planes the contact law's penetration
+    bound, at the AMB planes the stator contact's bound with ``effects.stator_contact`` and the air
+    gap without it (the rotor reaches a stator the model does not have)."""
     scene = result.model.scene
     rb = validity_bound(scene, "retainer")
     out = {p: dict(left_validity_at_s=first_crossing(result.t, result.penetration(p), rb.penetration),
@@ -330,18 +348,41 @@ def left_validity(result: Result) -> dict:
             pen = result.stator_penetration(p)
             out[p] = dict(left_validity_at_s=first_crossing(result.t, pen, st.penetration),
                           **st.to_dict())
+    else:
+        gap = validity_bound(scene, "air_gap")
+        for p in AMB_PLANES:
+            out[p] = dict(left_validity_at_s=first_crossing(result.t, amb_radius(result, p),
+                                                            gap.penetration), **gap.to_dict())
     return out
 
 
+def amb_radius(result: Result, plane: str) -> np.ndarray:
+    """|r| [m] of the rotor axis at AMB plane ``plane`` over the run."""
+    o = result.amb_orbit(plane)
+    return np.hypot(o[:, 0], o[:, 1])
+
+
+def first_bound(validity: dict) -> tuple[float | None, str | None]:
+    """(time, plane) of the first validity bound a run passes, from :func:`left_validity`'s
+    per-plane table; (None, None) for a run that stays valid. Ties go to the first plane listed
+    (the retainer planes before the AMB planes)."""
+    times = [(v["left_validity_at_s"], p) for p, v in validity.items()
+             if v["left_validity_at_s"] is not None]
+    return min(times, key=lambda tp: tp[0], default=(None, None))
+
+
 def mark_validity(result: Result, planes: dict, amb_planes: dict) -> dict:
-    """Adds :func:`left_validity` to the per-plane metrics ``planes`` and ``amb_planes`` and, when
+    """Adds :func:`left_validity` to the per-plane metrics ``planes`` and ``amb_planes`` (a plane's
+    own time only where it is the first bound's, a later crossing being motion after it) and, when
     the run left validity at t_inv (the earliest plane), replaces their :data:`INVALID_KEYS` /
     :data:`STATOR_INVALID_KEYS` by None, keeping the values over the samples t < t_inv as
     ``<key>_before_invalid``. Returns the run-level keys: ``left_validity_at_s`` and the planes
     past their bound (``penetration_beyond_validity``, ``stator_beyond_validity``)."""
     validity = left_validity(result)
-    times = [v["left_validity_at_s"] for v in validity.values() if v["left_validity_at_s"] is not None]
-    t_inv = min(times, default=None)
+    t_inv, first = first_bound(validity)
+    for v in validity.values():             # a plane passing its own bound later: not physical
+        if v["left_validity_at_s"] is not None and v["left_validity_at_s"] > t_inv:
+            v["left_validity_at_s"] = None
     for table in (planes, amb_planes):
         for p, v in table.items():
             v.update(validity.get(p, dict(left_validity_at_s=None)))
@@ -354,24 +395,77 @@ def mark_validity(result: Result, planes: dict, amb_planes: dict) -> dict:
             table[p].update(v)
         _null(planes, table, keys)
         _null(amb_planes, amb_plane_metrics(early), STATOR_INVALID_KEYS)
+        gap = result.model.scene.amb.air_gap
+        for p, v in amb_planes.items():     # reaching the gap is an event: it stands if it came first
+            reached = first_crossing(result.t, amb_radius(result, p), gap)
+            if reached is None or reached > t_inv:
+                v["stator_contact"], v["stator_contact" + BEFORE_INVALID] = None, False
     left = [p for p, v in validity.items() if v["left_validity_at_s"] is not None]
-    return dict(left_validity_at_s=t_inv,
+    stator = bool(result.model.I[F_STATOR])
+    return dict(left_validity_at_s=t_inv, left_validity_plane=first,
+                left_validity_criterion=validity[first]["validity_criterion"] if first else None,
                 penetration_beyond_validity=[p for p in left if p in PLANES],
-                stator_beyond_validity=[p for p in left if p in AMB_PLANES])
+                stator_beyond_validity=[p for p in left if p in AMB_PLANES and stator],
+                air_gap_beyond_validity=[p for p in left if p in AMB_PLANES and not stator])
 
 
 def _null(table: dict, early: dict, keys: tuple[str, ...]) -> None:
     """table[p][key] -> None and table[p][key + BEFORE_INVALID] = early[p][key] (the same value
-    over the samples before the run left validity), for every plane and key that has a value."""
+    over the samples before the run left validity), for every plane and key that has a value
+    over the run or before it (a key None in both, e.g. the ball loads of a linear mount, stays
+    None without a ``_before_invalid``)."""
     for p, v in table.items():
-        for key in (k for k in keys if v.get(k) is not None):
-            v[key + BEFORE_INVALID] = early[p][key]
-            v[key] = None
+        for key in (k for k in keys if k in v):
+            before = early[p].get(key)
+            if v[key] is not None or before is not None:
+                v[key + BEFORE_INVALID] = before
+                v[key] = None
+
+
+def null_after_validity(result: Result, out: dict) -> None:
+    """The run-level metrics of ``out`` (:func:`compute_metrics`) that depend on the motion after
+    ``out["left_validity_at_s"]``: :data:`RUN_INVALID_KEYS` -> None with their values at or
+    before that time as ``<key>_before_invalid``; the end state (``final_slip_ratio``,
+    ``sleeves_still_sliding``) -> None; a first contact after it -> None; the energy audit and
+    the flexible rotor's strain energy over the samples before it."""
+    t_inv = out["left_validity_at_s"]
+    if t_inv is None:
+        return
+    early = result.until(t_inv)
+    before = dict(final_rotor_speed_rpm=float(early.rotor_speed[-1] * RPM),
+                  backward_whirl=any(valid_or_before(v, "backward_whirl")
+                                     for v in out["planes"].values()))
+    for key, value in before.items():
+        out[key], out[key + BEFORE_INVALID] = None, value
+    if out["first_contact_time_s"] is not None and out["first_contact_time_s"] >= t_inv:
+        out["first_contact_time_s"] = out["first_contact_after_fault_s"] = None
+    out["final_slip_ratio"] = out["sleeves_still_sliding"] = None
+    out["dissipation"] = dissipation_check(early)
+    if "max_strain_energy_J" in out["rotor"]:
+        out["rotor"]["max_strain_energy_J" + BEFORE_INVALID] = \
+            rotor_metrics(early)["max_strain_energy_J"]
+        out["rotor"]["max_strain_energy_J"] = None
 
 
 def valid_or_before(v: dict, key: str):
     """A per-plane metric, or its value before the run left validity where it is None."""
     return v[key] if v.get(key) is not None else v.get(key + BEFORE_INVALID)
+
+
+def whirl_decision(m: dict) -> bool | None:
+    """A drop's whirl decision (``metrics["backward_whirl"]``) within validity: True if it
+    whirled, also before leaving validity (``backward_whirl_before_invalid``: the backward
+    revolutions counted up to then already passed WHIRL_MIN_REVOLUTIONS), False if it stayed valid
+    without a whirl, None if it left validity before whirling (undecided: what followed is not
+    physical). Studies count the undecided drops apart."""
+    if valid_or_before(m, "backward_whirl"):
+        return True
+    return False if m.get("left_validity_at_s") is None else None
+
+
+def whirled(m: dict) -> bool:
+    """The drop whirled within validity (:func:`whirl_decision` is True)."""
+    return whirl_decision(m) is True
 
 
 def step_resolved_peaks(result: Result) -> dict | None:
@@ -408,10 +502,12 @@ def warnings_of(m: dict, scene) -> list[str]:
                    f"(peak contact force {peaks}); the post-fault metrics exclude it (check "
                    "contact.clearance, support.stiffness, unbalance)")
     if m["stator_contact"] and not m["stator_contact_modelled"]:
-        disp = ", ".join(f"{p} {valid_or_before(v, 'max_displacement_um'):.0f} µm"
-                         for p, v in m["amb_planes"].items())
+        disp = ", ".join(f"{p} at t = {v['left_validity_at_s']:.4f} s"
+                         if v.get("left_validity_at_s") is not None else
+                         f"{p} {valid_or_before(v, 'max_displacement_um'):.0f} µm"
+                         for p, v in m["amb_planes"].items() if v["stator_contact"])
         out.append(f"the rotor reaches the AMB stator (amb.air_gap = {scene.amb.air_gap * 1e6:.0f} µm; "
-                   f"max displacement {disp}): the model has no stator contact, the motion "
+                   f"{disp}): the model has no stator contact, the motion "
                    "beyond it is not physical (set effects.stator_contact = true)")
     if m["left_validity_at_s"] is not None:
         out.append(validity_warning(m, scene))
@@ -440,7 +536,7 @@ def warnings_of(m: dict, scene) -> list[str]:
     if sliding_warning(m):
         out.append(sliding_warning(m))
     for p, v in m["planes"].items():
-        if v["whirl_sampling_aliased"]:
+        if valid_or_before(v, "whirl_sampling_aliased"):
             out.append(f"{p}: the orbit turns more than {ALIAS_ANGLE / math.pi:g}π between output "
                        "samples (whirl_sampling_aliased): whirl detection and frequency are unreliable; "
                        "raise solver.output_rate")
@@ -481,18 +577,22 @@ def sliding_warning(m: dict) -> str | None:
 
 
 def validity_warning(m: dict, scene) -> str:
-    """The warning of a run that left the validity of its contact laws (:func:`mark_validity`)."""
+    """The warning of a run that left validity (:func:`mark_validity`): the first bound passed,
+    then every plane past its own."""
     where = {p: v for table in ("planes", "amb_planes") for p, v in m[table].items()
              if v.get("left_validity_at_s") is not None}
     when = ", ".join(f"{p} at t = {v['left_validity_at_s']:.4f} s" for p, v in where.items())
     bounds = "; ".join(sorted({f"{v['validity_bound_um']:.1f} µm ({v['validity_criterion']})"
                                for v in where.values()}))
-    return (f"the penetration passes the contact law's validity bound ({when}; bound {bounds}): "
-            f"the contact laws (contact.law = {scene.contact.law!r}"
+    t = m["left_validity_at_s"]
+    return (f"the run passes a validity bound first at {m['left_validity_plane']}, t = {t:.4f} s "
+            f"({m['left_validity_criterion']}; every plane past its bound: {when}; bounds {bounds})"
+            f": the model (contact.law = {scene.contact.law!r}"
             + (", stator contact: the rotor rolls on the stator, dry whip; read it as a destroyed "
                "stator, not a motion" if m["stator_beyond_validity"] else "")
-            + ") do not describe the run from then on; force and displacement metrics are n/a, "
-            f"their values before t = {m['left_validity_at_s']:.4f} s are the *{BEFORE_INVALID} keys")
+            + ") does not describe the run from then on; every metric of the motion after "
+            f"t = {t:.4f} s (forces, displacements, final speeds, whirl, end state) is n/a, their "
+            f"values before it are the *{BEFORE_INVALID} keys")
 
 
 def _per_plane(m: dict, planes: list[str], key: str, spec: str) -> str:
@@ -519,6 +619,7 @@ def compute_metrics(result: Result) -> dict:
     out["dissipation"] = dissipation_check(result)
     out["rotor"] = rotor_metrics(result)
     out.update(final_slip(result))
+    null_after_validity(result, out)
     out["warnings"] = warnings_of(out, result.model.scene)
     return out
 
@@ -567,9 +668,11 @@ def plane_metrics(result: Result, p: str, t_fault: float, post: slice, pre: slic
     return entry
 
 
-def worst_plane(metrics: dict, key: str) -> float | None:
+def worst_plane(metrics: dict, key: str, before_invalid: bool = False) -> float | None:
     """The larger of the two retainer planes' values of a per-plane metric (``metrics["planes"]``
     of :func:`compute_metrics`, e.g. ``"peak_contact_force_N"``); None where the metric is None
-    (e.g. the ball loads of a linear retainer mount)."""
-    values = [v[key] for v in metrics["planes"].values()]
+    (e.g. the ball loads of a linear retainer mount). ``before_invalid``: past validity, the
+    values before it (:func:`valid_or_before`), e.g. to compare solver settings on one drop."""
+    values = [valid_or_before(v, key) if before_invalid else v[key]
+              for v in metrics["planes"].values()]
     return None if any(v is None for v in values) else max(values)

@@ -9,7 +9,13 @@ the environments.
   (``contact.length``, ``rotor.journal_radius``, ``contact.clearance``, E* of the bearing steel)
   reaches the same half-width (:func:`physics.contact.half_width_load`), converted to δ through
   K δ^e (:func:`physics.contact.power_law_approach`);
-* stator (``effects.stator_contact``): :func:`physics.stator.penetration_bound`.
+* stator (``effects.stator_contact``): :func:`physics.stator.penetration_bound`;
+* AMB air gap (``where = "air_gap"``, without ``effects.stator_contact``): the rotor reaching
+  ``amb.air_gap`` at an AMB plane meets a stator the model does not have, so the motion from then
+  on is not physical; the bound is the gap itself (a radius, not a penetration).
+
+A run is valid up to the first of these bounds it passes, whichever it is
+(:func:`physics.metrics.left_validity`).
 """
 from __future__ import annotations
 
@@ -20,14 +26,15 @@ from .laws import contact_law
 from .laws.hertz_line import line_stiffness  # noqa: F401  (re-exported)
 from .stator import penetration_bound
 
-WHERE = ("retainer", "stator")
+WHERE = ("retainer", "stator", "air_gap")
 
 
 @dataclass(frozen=True)
 class Bound:
-    """A validity bound: the penetration [m], the law's elastic force there [N], the criterion."""
+    """A validity bound: the penetration [m] (the AMB-plane radius for the air gap), the law's
+    elastic force there [N] (None for the air gap: no law), the criterion."""
     penetration: float
-    load: float
+    load: float | None
     criterion: str
 
     def to_dict(self) -> dict:
@@ -36,10 +43,14 @@ class Bound:
 
 
 def validity_bound(scene, where: str = "retainer") -> Bound:
-    """The penetration bound of the rotor-sleeve law (``where = "retainer"``) or of the stator
-    contact (``"stator"``) in ``scene`` (module docstring)."""
+    """The penetration bound of the rotor-sleeve law (``where = "retainer"``), of the stator
+    contact (``"stator"``) or the AMB air gap of a scene without it (``"air_gap"``) in ``scene``
+    (module docstring)."""
     if where not in WHERE:
         raise ValueError(f"where must be one of {WHERE}; got {where!r}")
+    if where == "air_gap":
+        return Bound(scene.amb.air_gap, None, "the rotor reaches amb.air_gap: the stator is not "
+                     "modelled (effects.stator_contact = false)")
     lim = f"Hertz half-width b = {HALF_WIDTH_LIMIT:g} x"
     if where == "stator":
         st, g0 = scene.stator, scene.amb.air_gap

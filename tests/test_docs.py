@@ -132,7 +132,43 @@ def test_flexible_study_tables_match_their_data():
             assert abs(s["ratio"] / s["target_ratio"] - 1) < study.RATIO_TOL
     assert (ROOT / "docs/img/flexible-study.png").stat().st_size > 10_000
     assert (ROOT / "docs/data/flexible-study.csv").read_text().count("\n") == 1 + sum(
-        len(r["grid"]) + len(r["bisection"]) for r in data["rotors"])
+        len(r["grid"]) for r in data["rotors"])
+    # whirl fractions over the grid x the drop's perturbations, never a bisected threshold; an
+    # onset only where the fraction is monotone in mu, as the data say
+    assert data["members"] == study.members() and len(data["members"]) == study.MEMBERS
+    for r in data["rotors"]:
+        assert sorted((g["friction"], g["member"]) for g in r["grid"]) == sorted(
+            (mu, k) for mu in study.MU_GRID for k in range(study.MEMBERS))
+        assert study.summarise(r) == r
+        p = [f["fraction"] for f in r["whirl_fraction"] if f["fraction"] is not None]
+        assert r["onset"]["monotone"] == all(b >= a for a, b in zip(p, p[1:]))
+    assert "bisect" not in page[i:page.index(study.END, i)]
+
+def test_flexible_study_whirl_statistics():
+    """The flexible study's whirl fraction: Wilson's 95 % interval (0/10 -> [0, 0.278], 5/10 ->
+    [0.237, 0.763], the textbook values), undecided drops left out of n, and an onset band only
+    for a fraction that never falls along the grid."""
+    study = _example("flexible_study")
+    assert study.wilson(0, 10) == pytest.approx((0.0, 0.2775), abs=1e-4)
+    assert study.wilson(5, 10) == pytest.approx((0.2366, 0.7634), abs=1e-4)
+    grid = study.MU_GRID
+
+    def drops(whirls):                   # per grid mu: decisions True / False / None
+        return [dict(friction=mu, backward_whirl=w is True,
+                     left_validity_at_s=0.2 if w is None else None)
+                for mu, ws in zip(grid, whirls) for w in ws]
+    rising = [[False, False]] * 5 + [[True, False], [True, None]] + [[True, True]] * 9
+    f = study.whirl_fraction(drops(rising))
+    assert f[6]["decided"] == 1 and f[6]["undecided"] == 1 and f[6]["fraction"] == 1.0
+    assert study.onset_band(f) == dict(monotone=True, undecided_from=None, no_whirl_up_to=grid[4],
+                                       all_whirl_from=grid[6])
+    dip = [[False, False]] * 3 + [[True, True], [False, False]] + [[True, True]] * 11
+    assert study.onset_band(study.whirl_fraction(drops(dip))) == dict(
+        monotone=False, undecided_from=None, no_whirl_up_to=None, all_whirl_from=None)
+    lost = [[False, False]] * 7 + [[None, None]] * 9     # the rotor reaches the air gap undecided
+    assert study.onset_band(study.whirl_fraction(drops(lost))) == dict(
+        monotone=True, undecided_from=grid[7], no_whirl_up_to=None, all_whirl_from=None)
+
 
 def test_the_flexible_cost_table_is_the_benchmarks_output():
     """docs/scaling.md pastes the table benchmarks/bench_flexible.py wrote next to its data."""
@@ -157,3 +193,20 @@ def test_the_mode_tables_are_the_accuracy_runs_output(name):
     assert block and block in out
     rows = json.loads((ROOT / f"docs/data/accuracy-modes-{name}/accuracy.json").read_text())
     assert rows["modes"]
+
+
+def test_the_mutation_table_is_the_harness_output():
+    """docs/physics.md "Mutation check" holds the table tests/mutants.py renders from
+    docs/data/mutants.json, of today's mutants and test list, and no mutant recorded there
+    survived (run `python3 tests/mutants.py` to refresh it)."""
+    import mutants
+    data = json.loads(mutants.DATA.read_text())
+    page = mutants.PAGE.read_text()
+    i = page.index(mutants.START) + len(mutants.START)
+    assert page[i:page.index(mutants.END, i)] == mutants.table(data)
+    assert data["tests"] == list(mutants.TESTS)
+    assert [(m["name"], m["old"], m["new"]) for m in data["mutants"]] == [
+        (m.name, m.old.replace("\n", " "), m.new.replace("\n", " ")) for m in mutants.MUTANTS]
+    # how each died is the harness's verdict (tests/test_mutants.py fails a mutant that no
+    # assertion kills); the page says it as the data has it, and names no survivor
+    assert {m["how"] for m in data["mutants"]} <= {"assertion", "error only", "not run"}

@@ -1,4 +1,5 @@
-"""The energy tests fail when a friction or damping sign is flipped (tests/mutants.py).
+"""The physics tests fail by an assertion when a friction, damping or coupling sign is flipped
+(tests/mutants.py).
 
 Each mutant compiles its own copy of the kernels (~30 s), so one runs with the suite (the flip the
 energy audit alone missed: the contact friction's sign in both its force and its power) and the
@@ -16,5 +17,6 @@ SLOW = [pytest.param(m, marks=pytest.mark.slow, id=m.name) for m in MUTANTS
 @pytest.mark.parametrize("mutant", [pytest.param(BY_NAME["contact_friction"], id="contact_friction")]
                          + SLOW)
 def test_a_flipped_sign_fails_the_energy_tests(mutant):
-    killed, line = run(mutant)
-    assert killed, f"the energy tests pass with {mutant.name} flipped ({line})"
+    death = run(mutant)
+    assert death.killed, (f"no test fails by an assertion with {mutant.name} flipped "
+                          f"({death.how}: {death.why}; errors {death.errors})")

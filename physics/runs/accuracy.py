@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from ..laws import SLIP_LAWS, slip_law
-from ..metrics import worst_plane
+from ..metrics import whirled, worst_plane
 from ..scene import SceneError
 
 WINDOW_S = 0.02          # trajectory comparison window after the reference's first contact
@@ -260,9 +260,10 @@ def _window(o, t0: float) -> tuple[np.ndarray, dict, dict]:
 def score(o, ref) -> dict:
     """Errors of one run against the reference run of the same drop."""
     t_fc = ref.metrics["first_contact_time_s"]
-    err = {f"{name}_rel": _rel(worst_plane(o.metrics, key), worst_plane(ref.metrics, key))
+    # the drop's numbers up to the end of its validity (the same drop at each setting)
+    err = {f"{name}_rel": _rel(worst_plane(o.metrics, key, True), worst_plane(ref.metrics, key, True))
            for name, key in EXTREMES}
-    err["whirl_agrees"] = bool(o.metrics["backward_whirl"]) == bool(ref.metrics["backward_whirl"])
+    err["whirl_agrees"] = whirled(o.metrics) == whirled(ref.metrics)
     fc = o.metrics["first_contact_time_s"]
     err["first_contact_time_abs_us"] = (abs(fc - t_fc) * 1e6 if fc is not None and t_fc is not None
                                         else None)
@@ -337,9 +338,9 @@ def analyse(plan: AccuracyPlan, rows: list, outcomes: list) -> dict:
     best, why = recommend(table)
     ref_rows = [dict(member=k, command=o.run.to_dict()["command"],
                      wall_time_s=o.metrics["wall_time_s"], rhs_evaluations=o.metrics["rhs_evaluations"],
-                     **{key: worst_plane(o.metrics, key) for _, key in EXTREMES},
+                     **{key: worst_plane(o.metrics, key, True) for _, key in EXTREMES},
                      first_contact_time_s=o.metrics["first_contact_time_s"],
-                     backward_whirl=o.metrics["backward_whirl"], chaotic=k in chaotic)
+                     backward_whirl=whirled(o.metrics), chaotic=k in chaotic)
                 for k, o in refs.items()]
     return dict(reference=dict(setting=ref_label, rtol=plan.reference_rtol, members=ref_rows,
                                chaotic_members=chaotic, chaos_check=check),

@@ -7,7 +7,7 @@ import pytest
 from physics import load_scene, simulate
 from physics.contact import (hunt_crossley, hysteresis_factor, line_continuation, line_elastic_force,
                              line_potential)
-from physics.metrics import compute_metrics
+from physics.metrics import compute_metrics, left_validity
 
 from helpers import energy_residual
 
@@ -77,34 +77,39 @@ def test_hertz_line_drop_is_finite_and_its_energy_audit_closes(hertz_drops, mu):
     assert r.contact_force("RB1").max() > 1e3                    # it landed
     res, e = energy_residual(r)
     assert res.max() < 1e-5 * e["dissipated"][-1]
-    m = compute_metrics(r)
+    m, bounds = compute_metrics(r), left_validity(r)
     for p in ("RB1", "RB2"):                     # steel contact: micrometres, within its 28 µm
-        v = m["planes"][p]
-        assert 0.0 < v["max_penetration_um"] < v["validity_bound_um"] == pytest.approx(28.0, abs=0.1)
+        v = bounds[p]
+        pen = r.penetration(p).max() * 1e6
+        assert 0.0 < pen < v["validity_bound_um"] == pytest.approx(28.0, abs=0.1)
         assert v["left_validity_at_s"] is None
-    assert not m["penetration_beyond_validity"] and m["left_validity_at_s"] is None
+    assert not m["penetration_beyond_validity"]
+    # the mu = 0.5 whirl reaches the AMB air gap (no stator in the preset): valid up to there
+    assert m["air_gap_beyond_validity"] == ([] if mu < 0.5 else ["AMB1", "AMB2"])
 
 
 @pytest.fixture(scope="module")
 def paper_drops():
     return {name: simulate(load_scene("paper", ov), t_end=0.3)
             for name, ov in (("calm", {}), ("whirl", {"contact.friction": 0.5}),
-                             ("fast", {"contact.friction": 0.5, "rotor.speed_rpm": 30000.0}))}
+                             ("fast", {"contact.friction": 0.5, "rotor.speed_rpm": 30000.0,
+                                       # wide enough that it does not reach the AMB stator
+                                       "amb.air_gap": 3e-3}))}
 
 
 def test_max_penetration_is_reported_within_the_paper_laws_bound(paper_drops):
     """42 µm at mu = 0.25 and 179 µm in the mu = 0.5 whirl: both below the paper law's 553 µm
     (the 52 kN at which a steel line contact reaches b = 0.3 r): no warning, numbers kept."""
-    calm, whirl = (compute_metrics(paper_drops[k]) for k in ("calm", "whirl"))
+    calm = compute_metrics(paper_drops["calm"])
+    whirl = left_validity(paper_drops["whirl"])  # the retainer bounds (it reaches the AMB air gap)
     for p in ("RB1", "RB2"):
-        expect = paper_drops["whirl"].penetration(p).max() * 1e6
-        assert whirl["planes"][p]["max_penetration_um"] == pytest.approx(expect)
-        bound = whirl["planes"][p]["validity_bound_um"]
-        assert bound == pytest.approx(553.4, abs=0.1)
-        assert calm["planes"][p]["max_penetration_um"] < whirl["planes"][p]["max_penetration_um"] < bound
-    for m in (calm, whirl):
-        assert m["left_validity_at_s"] is None and not m["penetration_beyond_validity"]
-        assert not any("validity bound" in w for w in m["warnings"])
+        pen = paper_drops["whirl"].penetration(p).max() * 1e6
+        bound = whirl[p]["validity_bound_um"]
+        assert bound == pytest.approx(553.4, abs=0.1) and whirl[p]["left_validity_at_s"] is None
+        assert calm["planes"][p]["max_penetration_um"] < pen < bound
+    assert calm["left_validity_at_s"] is None and not calm["penetration_beyond_validity"]
+    assert not any("validity bound" in w for w in calm["warnings"])
+    assert not compute_metrics(paper_drops["whirl"])["penetration_beyond_validity"]
 
 
 def test_film_thicker_than_the_internal_play_is_warned(paper_drops):

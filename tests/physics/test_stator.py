@@ -160,7 +160,12 @@ def test_the_stator_stops_the_orbit_at_the_air_gap(whirl_drops):
     off = compute_metrics(whirl_drops["off"])
     stop = compute_metrics(whirl_drops["stop"])
     for p in ("AMB1", "AMB2"):
-        assert off["amb_planes"][p]["max_displacement_um"] > 1.3 * gap_um        # 831 µm
+        o = whirl_drops["off"].amb_orbit(p)
+        assert np.hypot(o[:, 0], o[:, 1]).max() * 1e6 > 1.3 * gap_um         # 831 µm
+        # without the stator, validity ends where the orbit reaches the gap: no numbers after
+        assert off["amb_planes"][p]["max_displacement_um"] is None
+        assert off["amb_planes"][p]["max_displacement_um_before_invalid"] <= gap_um
+        assert off["amb_planes"][p]["stator_contact"] and p in off["air_gap_beyond_validity"]
         v = stop["amb_planes"][p]
         assert gap_um < v["max_displacement_um"] < 1.3 * gap_um                 # 609 µm
         assert v["stator_contacts"] >= 1 and v["stator_peak_force_N"] > 1e3

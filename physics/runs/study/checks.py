@@ -33,11 +33,12 @@ NO_FAULT = "NoFault"
 
 
 def beyond_validity(metrics: dict | None) -> bool:
-    """The drop's penetration passed a contact law's validity bound (``left_validity_at_s``,
-    :func:`physics.metrics.mark_validity`): its force and displacement numbers are None, so a
-    study counts it apart and keeps it out of every ratio, median and peak table. Its whirl
-    decision still counts: the backward revolutions are counted on the orbit, and a whirl that
-    drives the contact past its bound is a whirl."""
+    """The drop passed a validity bound (``left_validity_at_s``, :func:`physics.metrics.mark_validity`:
+    a contact law's penetration bound, or the AMB air gap without stator contact): its numbers
+    of the motion after that time are None, so a study counts it apart and keeps it out of every
+    ratio, median and peak table. Its whirl decision is the one within validity
+    (:func:`physics.metrics.whirl_decision`): a whirl once its backward revolutions were counted
+    before that time, else undecided, and counted apart from the whirl probability."""
     return bool(metrics) and metrics.get("left_validity_at_s") is not None
 
 

@@ -43,12 +43,14 @@ def perturbations(n: int, t_off: float, seed: int = 0, jitter_s: float = JITTER_
 @dataclass(frozen=True)
 class Onset:
     """Whirl-onset statistics of one probability curve p(mu)."""
-    threshold: float | None         # mu where p first crosses 50 % going up (linear interpolation)
+    threshold: float | None         # mu where p crosses 50 % going up (linear interpolation),
+                                    # only where p never falls along the grid (``monotone``)
     logistic_mu50: float | None     # mu50 of a maximum-likelihood logistic fit to all runs
     logistic_width: float | None    # its scale s in p = 1 / (1 + exp(-(mu - mu50) / s))
     lowest_whirl: float | None      # lowest mu at which any member whirled
     certain_from: float | None      # lowest mu from which every member whirls at every larger mu
     crossings: int                  # how often p crosses 50 % (> 1: interleaved onset)
+    monotone: bool = True           # p never falls as mu grows: a threshold means something
 
     def to_dict(self) -> dict:
         return {k: (None if v is None else (round(v, 4) if isinstance(v, float) else v))
@@ -57,7 +59,9 @@ class Onset:
 
 def onset(mu: Sequence[float], p: Sequence[float], mu_runs: Sequence[float] | None = None,
           whirl_runs: Sequence[bool] | None = None) -> Onset:
-    """Onset statistics from a probability curve (sorted by mu) and, optionally, the raw runs."""
+    """Onset statistics from a probability curve (sorted by mu) and, optionally, the raw runs.
+    The 50 % threshold is named only where the curve never falls (checked on the grid): where
+    whirl comes and goes with mu, the curve itself, ``lowest_whirl`` and ``certain_from`` say it."""
     mu = np.asarray(mu, float)
     p = np.asarray(p, float)
     order = np.argsort(mu)
@@ -79,12 +83,15 @@ def onset(mu: Sequence[float], p: Sequence[float], mu_runs: Sequence[float] | No
             k -= 1
         certain = float(mu[k])
     crossings = int(np.count_nonzero(above[:-1] != above[1:]))
+    monotone = bool(np.all(np.diff(p) >= 0.0))
+    if not monotone:             # whirl is a probability here, not a threshold: name none
+        threshold = None
     mu50 = width = None
     if mu_runs is not None and whirl_runs is not None:
         fit = logistic_fit(mu_runs, whirl_runs)
         if fit is not None:
             mu50, width = fit
-    return Onset(threshold, mu50, width, lowest, certain, crossings)
+    return Onset(threshold, mu50, width, lowest, certain, crossings, monotone)
 
 
 def logistic_fit(x: Sequence[float], y: Sequence[bool], iters: int = 100) -> tuple[float, float] | None:

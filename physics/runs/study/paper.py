@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from ...laws import slip_kinematic, slip_paper
-from ...metrics import worst_plane
+from ...metrics import whirl_decision, worst_plane
 from ...results import Result
 from ...scene import Scene, SceneError, load_scene
 from ...simulate import IntegrationError, simulate
@@ -233,8 +233,8 @@ def _index(outcomes: list[Outcome]) -> dict[str, list[Outcome]]:
     return by
 
 
-def _whirl(o: Outcome) -> bool:
-    return bool(o.metrics["backward_whirl"])
+def _whirl(o: Outcome) -> bool | None:
+    return whirl_decision(o.metrics)
 
 
 def _friction(plan: Plan, outs: list[Outcome]) -> dict:
@@ -242,16 +242,18 @@ def _friction(plan: Plan, outs: list[Outcome]) -> dict:
     for slip in SLIPS:
         for drag in (True, False):
             grp = [o for o in outs if o.run.label["slip"] == slip and o.run.label["drag"] == drag]
-            ok = [o for o in grp if o.ok]
+            ran = [o for o in grp if o.ok]
+            ok = [o for o in ran if _whirl(o) is not None]     # the undecided count apart
             mus = [o.run.label["friction"] for o in ok]
             whirls = [_whirl(o) for o in ok]
             curve = probability_curve(mus, whirls)
             for c in curve:
-                c["failed"] = sum(1 for o in grp if not o.ok and
-                                  round(o.run.label["friction"], 6) == c["value"])
+                at = [o for o in grp if round(o.run.label["friction"], 6) == c["value"]]
+                c["failed"] = sum(1 for o in at if not o.ok)
                 probability.append(dict(friction=c["value"], slip=slip, bearing_friction=drag,
                                         probability=c["probability"], runs=c["runs"],
-                                        whirls=c["whirls"], failed=c["failed"]))
+                                        whirls=c["whirls"], failed=c["failed"],
+                                        undecided=sum(1 for o in at if o.ok and _whirl(o) is None)))
             key = f"{slip}, drag {'on' if drag else 'off'}"
             if curve:
                 onsets[key] = onset([c["value"] for c in curve], [c["probability"] for c in curve],
@@ -323,7 +325,7 @@ def _support(outs: list[Outcome], what: str) -> list[dict]:
         row: dict = {what: v}
         if nominal is not None and nominal.ok and beyond_validity(nominal.metrics):
             row.update(beyond_validity_at_s=nominal.metrics["left_validity_at_s"],
-                       backward_whirl=bool(nominal.metrics["backward_whirl"]),
+                       backward_whirl=whirl_decision(nominal.metrics),
                        command=nominal.run.to_dict()["command"])
         elif nominal is not None and nominal.ok:
             m, x = nominal.metrics, nominal.extra
@@ -331,7 +333,7 @@ def _support(outs: list[Outcome], what: str) -> list[dict]:
                 max_displacement_um=worst_plane(nominal.metrics, "max_displacement_um"),
                 max_y_displacement_um=worst_plane(nominal.metrics, "max_y_displacement_um"),
                 peak_contact_force_N=worst_plane(nominal.metrics, "peak_contact_force_N"),
-                backward_whirl=bool(m["backward_whirl"]),
+                backward_whirl=whirl_decision(m),
                 t_max_response_s=x["t_max_response_s"], force_settling_s=x["force_settling_s"],
                 mean_late_force_N=x["mean_late_force_N"], separations=x["separations"],
                 radial_speed_rms_mm_s=x["radial_speed_rms_mm_s"],
@@ -340,8 +342,11 @@ def _support(outs: list[Outcome], what: str) -> list[dict]:
             row.update(error=nominal.error if nominal is not None else "missing")
         if ens:
             valid, beyond = split_valid(ens)
+            decided = [w for w in map(_whirl, ens) if w is not None]
             row["ensemble"] = dict(members=len(ens), beyond_validity=beyond,
-                                   whirl_probability=sum(map(_whirl, ens)) / len(ens),
+                                   whirl_probability=(sum(decided) / len(decided) if decided
+                                                      else None),
+                                   whirl_undecided=len(ens) - len(decided),
                                    **_ensemble_stats(valid))
             for tag, sel in (("whirl", True), ("no_whirl", False)):
                 grp_ = [o for o in valid if _whirl(o) == sel]
@@ -370,7 +375,8 @@ def _sensitivity(outs: list[Outcome], settings: list[tuple[str, str, dict]]) -> 
     rows = []
     for factor, setting, overrides in settings:
         grp = [o for o in outs if (o.run.label["factor"], o.run.label["setting"]) == (factor, setting)]
-        sweep = [o for o in grp if o.run.label["friction"] != "soft" and o.ok]
+        sweep = [o for o in grp if o.run.label["friction"] != "soft" and o.ok
+                 and _whirl(o) is not None]                 # the undecided count apart
         soft, soft_beyond = split_valid(o for o in grp if o.run.label["friction"] == "soft" and o.ok)
         mus = [o.run.label["friction"] for o in sweep]
         whirls = [_whirl(o) for o in sweep]

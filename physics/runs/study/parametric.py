@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ...metrics import worst_plane
+from ...metrics import whirl_decision, worst_plane
 from ...scene import SceneError, load_scene
 from ..backend import Backend, plan_threads, run_drops
 from ..sweep import Outcome, Run
@@ -127,13 +127,17 @@ def summarize_cell(outcomes: list[Outcome]) -> dict:
     and have it (None where none has it, e.g. the ball-race pressure of a linear mount), and the
     drops per failed drop check (``warnings``, :mod:`physics.runs.study.checks`). A run without a
     fault is a failed drop (:func:`~physics.runs.study.checks.as_drop`). Drops beyond the contact
-    laws' validity count in ``beyond_validity`` and in the whirl probability, never in the KPIs."""
+    laws' validity count in ``beyond_validity``, never in the KPIs, and in the whirl probability
+    only if they whirled before (:func:`physics.metrics.whirl_decision`; ``whirl_undecided``: the
+    others)."""
     ok = [o for o in outcomes if o.ok]
     valid, beyond = split_valid(ok)
+    decided = [d for d in (whirl_decision(o.metrics) for o in ok) if d is not None]
     out = dict(members=len(outcomes), failed=len(outcomes) - len(ok), beyond_validity=beyond,
                errors=sorted({o.error.splitlines()[0] for o in outcomes if not o.ok}),
                warnings=warning_counts(outcomes),
-               whirl_probability=float(np.mean([o.metrics["backward_whirl"] for o in ok])) if ok else None)
+               whirl_probability=float(np.mean(decided)) if decided else None,
+               whirl_undecided=len(ok) - len(decided))
     for key in PLANE_KPIS:
         vals = np.array([v for v in (worst_plane(o.metrics, key) for o in valid) if v is not None])
         out[key] = dict(median=float(np.median(vals)), min=float(vals.min()),
@@ -243,9 +247,11 @@ def notes(report: dict, members: int) -> list[str]:
                    "are in sweep.json (cells[].errors, runs[].error)")
     beyond = sum(c["beyond_validity"] for c in report["cells"])
     if beyond:
-        out.append(f"{beyond} drops left the contact laws' validity (column 'beyond validity'): "
-                   "they count in the whirl probability but not in the force and displacement "
-                   "statistics")
+        undecided = sum(c.get("whirl_undecided", 0) for c in report["cells"])
+        out.append(f"{beyond} drops left validity (a contact law's bound, or the AMB air gap "
+                   "without stator contact; column 'beyond validity'): they are not in the force "
+                   "and displacement statistics, and count in the whirl probability only if they "
+                   f"whirled before ({undecided} did not: undecided, left out of it)")
     flagged = warnings_note(report["warnings"])
     if flagged:
         out.append(f"{flagged}; see column 'warnings', and runs[].metrics.warnings in sweep.json "

@@ -154,9 +154,14 @@ def plot_sensitivity(a: dict, out: Path) -> str:
     return _save(fig, out / "sensitivity.png")
 
 
+def _yes_no(decision) -> str:
+    """A whirl decision for the tables: yes, no, or n/a (left validity undecided)."""
+    return "n/a" if decision is None else "yes" if decision else "no"
+
+
 def _whirls(r: Result) -> bool:
-    from ...metrics import compute_metrics
-    return bool(compute_metrics(r)["backward_whirl"])
+    from ...metrics import compute_metrics, whirled
+    return whirled(compute_metrics(r))
 
 
 # ---------------------------------------------------------------------------------- report --
@@ -245,9 +250,11 @@ def write_report(a: dict, out: Path, figures: dict[str, list[str]], meta: dict) 
           "full friction (slip far above the regularisation threshold), where both laws give the "
           "same force μF_r. They differ once the sleeve approaches the rotor's surface speed "
           "(later forces, spin-down).")
-    w("\nThe threshold is where the whirl probability first reaches 50 % (linear interpolation "
-      "between grid points); the logistic fit uses every drop. More than one 50 % crossing means "
-      "whirling and non-whirling μ interleave below the μ from which every drop whirls.\n")
+    w("\nThe threshold is where the whirl probability reaches 50 % (linear interpolation "
+      "between grid points), named only where the probability never falls along the grid; the "
+      "logistic fit uses every drop. More than one 50 % crossing means whirling and non-whirling "
+      "μ interleave below the μ from which every drop whirls: whirl is then a probability over "
+      "μ, not a threshold (- in the column).\n")
     w(f"![orbits]({figures['friction'][0]})\n")
     w(f"![forces]({figures['friction'][1]})\n")
     w(f"![sleeve speed]({figures['friction'][2]})\n")
@@ -268,7 +275,7 @@ def write_report(a: dict, out: Path, figures: dict[str, list[str]], meta: dict) 
         w(f"| {r['stiffness']:.0e} | {_nominal(r, 'max_y_displacement_um')} | "
           f"{_nominal(r, 'max_displacement_um')} | {_nominal(r, 'peak_contact_force_N')} | "
           f"{_f(f / base_f if f and base_f else None)} | {_f(f / soft_f if f and soft_f else None)} | "
-          f"{'yes' if r.get('backward_whirl') else 'no'} | {_f(e.get('whirl_probability'))}, "
+          f"{_yes_no(r.get('backward_whirl'))} | {_f(e.get('whirl_probability'))}, "
           f"{_f(pf.get('median'), '.0f')} ({_f(pf.get('min'), '.0f')}–{_f(pf.get('max'), '.0f')}), "
           f"{e.get('beyond_validity', 0)} |")
     w("\nPaper: K_s = 5e8 gives 2× the base-case contact force and ≈ 5× the soft case; the soft "

@@ -5,6 +5,7 @@ import json
 import time
 from pathlib import Path
 
+from ...metrics import whirled
 from ...scene import load_scene
 from ..backend import Backend, plan_threads
 from . import report
@@ -82,13 +83,13 @@ def interesting_runs(a: dict, outcomes, base: StudyInput, plan: Plan) -> list[tu
           and o.run.label["slip"] == PRIMARY_SLIP and o.run.label["drag"]]
     fr.sort(key=lambda o: (o.run.label["friction"], o.run.label["member"]))
     out = []
-    first = next((o for o in fr if o.metrics["backward_whirl"]), None)
+    first = next((o for o in fr if whirled(o.metrics)), None)
     if first is not None:
         out.append((f"the lowest-μ drop that whirls (μ = {first.run.label['friction']:g})",
                     first.run.to_dict()["command"]))
     certain = a["friction_onset"][f"{PRIMARY_SLIP}, drag on"].get("certain_from")
     if certain is not None:
-        calm = [o for o in fr if not o.metrics["backward_whirl"] and o.run.label["friction"] < certain]
+        calm = [o for o in fr if not whirled(o.metrics) and o.run.label["friction"] < certain]
         if calm:
             o = calm[-1]
             out.append((f"the highest-μ drop that does not whirl (μ = {o.run.label['friction']:g})",

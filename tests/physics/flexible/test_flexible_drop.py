@@ -79,10 +79,15 @@ def test_rigid_body_properties_and_modes_of_the_presets():
 
 
 def stiff_and_rigid(mu: float, t_end: float):
-    rigid = compute_metrics(simulate(load_scene("paper", {"contact.friction": mu}), t_end=t_end))
+    """The rigid and the stiff-limit drop; the whirls reach the presets' AMB air gap, which would
+    end validity (no stator in the model): a wide gap keeps them valid, the retainer physics the
+    same."""
+    wide = {"amb.air_gap": 3e-3}
+    rigid = compute_metrics(simulate(load_scene("paper", {"contact.friction": mu, **wide}),
+                                     t_end=t_end))
     stiff = compute_metrics(simulate(load_scene("paper-flexible", {     # the static modes
         "contact.friction": mu, "flexible.modulus_scale": 1000.0,      # stay at E x 1000
-        "flexible.static_modes": True}), t_end=t_end))
+        "flexible.static_modes": True, **wide}), t_end=t_end))
     return rigid, stiff
 
 
@@ -164,7 +169,9 @@ def test_a_ross_rotor_drops(tmp_path):
         "positions.amb2": 0.6})
     r = simulate(scene, t_end=0.2)
     assert np.isfinite(r.Y).all() and audit_residual(r) <= AUDIT_TOL
-    assert compute_metrics(r)["planes"]["RB1"]["peak_contact_force_N"] > 0.0
+    m = compute_metrics(r)                   # a light rotor: it may reach the AMB air gap
+    assert (m["planes"]["RB1"]["peak_contact_force_N"]
+            or m["planes"]["RB1"]["peak_contact_force_N_before_invalid"]) > 0.0
 
 
 def test_the_mass_properties_the_error_prints_are_accepted_when_pasted_back():

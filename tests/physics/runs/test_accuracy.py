@@ -20,9 +20,10 @@ CRITERIA = (("peak_contact_force_rel", "max_converged"), ("max_displacement_rel"
             ("early_peak_force_rel", "max"), ("early_max_displacement_rel", "max"))
 
 
-def _quick_study(tmp_path_factory, scene: str):
+def _quick_study(tmp_path_factory, scene: str, *overrides: str):
     out = tmp_path_factory.mktemp(f"accuracy-{scene}")
-    assert cli_main(["accuracy", "--quick", "--scene", scene, "--jobs", "2", "--quiet",
+    sets = [a for o in overrides for a in ("--set", o)]
+    assert cli_main(["accuracy", "--quick", "--scene", scene, *sets, "--jobs", "2", "--quiet",
                      "--out", str(out)]) == 0
     return out, json.loads((out / "accuracy.json").read_text())
 
@@ -35,8 +36,10 @@ def quick(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def quick_spec(tmp_path_factory):
-    """The quick study of the spec scene, where a loose tolerance breaks the rule."""
-    return _quick_study(tmp_path_factory, "spec")
+    """The quick study of the spec scene, where a loose tolerance breaks the rule (with an AMB air
+    gap wide enough that its drops stay valid: at the preset's 600 µm they reach the gap, which
+    ends validity before the impacts where the tolerance shows)."""
+    return _quick_study(tmp_path_factory, "spec", "amb.air_gap=0.003")
 
 
 def _rows(a):
