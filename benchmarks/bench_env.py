@@ -1,7 +1,21 @@
-"""Environment speed: env steps per second at the 1 ms control step, single and batched.
+"""Environment speed: env steps per second at the 1 ms control step, single and batched, and
+in the controller seat (``--control-dt``) as ratios to Gymnasium's ``Pendulum-v1``.
 
     python benchmarks/bench_env.py [--repeats 3] [--episodes 2] [--n-envs 16] [--json out.json]
                                    [--set KEY=VALUE ...]
+    python benchmarks/bench_env.py --control-dt 2e-4 --control-dt 1e-4 [--repeats 7]
+                                   [--json docs/data/bench-env-seat.json]
+
+With ``--control-dt`` (one or more control steps [s]) it measures only the controller seat
+(:mod:`agents.control.seats`): ``RotorDrop-Full-v1`` with raw coil currents
+(``command="continuous"``) and dampers, the robust suite's sensor noise and the middle of its
+sensor delay range, random actions, resets as episodes end. Per step and repeat it times
+``Pendulum-v1`` (``gym.make``, random actions) and then the single env (``gym.make`` and
+``env.unwrapped``), the SB3 batch ``BatchedRotorDropVecEnv`` (one numba thread: per core) and
+the Gymnasium vector env (``gymnasium.make_vec``, one thread), and prints each rate's median
+and the median of its per-repeat ratios to Pendulum-v1's rate (the machine's speed cancels),
+then the cost split of a step. ``benchmarks/render_env_seat.py`` turns the JSON into the table
+of docs/environments.md.
 
 Paper scene, default environment settings (episode 0.3 s = 300 steps, 5 monitor samples per
 step), whole episodes including resets. Every figure is the median of ``--repeats`` runs after a
@@ -184,6 +198,90 @@ def default_vs_one_thread(env_id: str, kwargs: dict, n_envs: int, steps: int, re
             statistics.median(o for _, o in pairs))
 
 
+#: the controller seat's environment (module doc): raw currents and dampers
+SEAT_ENV = "RotorDrop-Full-v1"
+PENDULUM = "Pendulum-v1"
+
+
+def seat_kwargs(control_dt: float) -> dict:
+    """The env kwargs of a controller-seat row at ``control_dt``: raw currents, the robust
+    suite's sensor noise and the middle of its sensor delay range, no transport latency."""
+    from agents.benchmarking.robust import SENSOR_DELAY_S, SENSOR_NOISE
+    from agents.control.seats import CONTROLLER
+    return dict(CONTROLLER.env_kwargs(control_dt), command="continuous", sensor_noise=SENSOR_NOISE,
+                sensor_delay=0.5 * (SENSOR_DELAY_S[0] + SENSOR_DELAY_S[1]))
+
+
+def stepping_rate(env, steps: int, seed: int = 0):
+    """Steps per second of a single env (``gym.make``'d or unwrapped) over ``steps`` steps with
+    seeded random actions, reset as episodes end."""
+    space = env.action_space
+    space.seed(seed)
+    acts = [space.sample() for _ in range(1024)]
+    env.reset(seed=seed)
+
+    def run():
+        env.reset()
+        t0 = CLOCK()
+        for k in range(steps):
+            _, _, te, tr, _ = env.step(acts[k % len(acts)])
+            if te or tr:
+                env.reset()
+        return steps / (CLOCK() - t0)
+    return run
+
+
+def vector_rate(env_id: str, kwargs: dict, n_envs: int, steps: int, seed: int = 0):
+    """Env steps per second of the Gymnasium vector env on one thread (same-step autoreset)."""
+    venv = gym.make_vec(env_id, num_envs=n_envs, vectorization_mode="vector_entry_point",
+                        n_threads=1, **kwargs)
+    venv.action_space.seed(seed)
+    acts = [venv.action_space.sample() for _ in range(64)]
+    venv.reset(seed=seed)
+
+    def run():
+        t0 = CLOCK()
+        for k in range(steps):
+            venv.step(acts[k % len(acts)])
+        return steps * n_envs / (CLOCK() - t0)
+    return run
+
+
+def seat_speed(control_dt: float, repeats: int, n_envs: int, steps: int) -> dict:
+    """The controller seat's rates at ``control_dt`` and their ratios to Pendulum-v1's, each
+    the median over ``repeats`` rounds that time every case once (module doc)."""
+    kw = seat_kwargs(control_dt)
+    made = gym.make(SEAT_ENV, **kw)
+    cases = {PENDULUM: stepping_rate(gym.make(PENDULUM), 4 * steps),
+             "single (gym.make)": stepping_rate(made, steps),
+             "single (unwrapped)": stepping_rate(gym.make(SEAT_ENV, **kw).unwrapped, steps),
+             f"SB3 batch N={n_envs}, per core": batched_rate(SEAT_ENV, kw, n_envs,
+                                                             max(1, steps // n_envs), 1),
+             f"vector env N={n_envs}, per core": vector_rate(SEAT_ENV, kw, n_envs,
+                                                             max(1, steps // n_envs))}
+    for run in cases.values():                          # warm-up (JIT, scenario caches)
+        run()
+    rounds = [{name: run() for name, run in cases.items()} for _ in range(repeats)]
+    out = {"control_dt_s": control_dt, "env_id": SEAT_ENV, "env_kwargs": kw, "repeats": repeats,
+           "rates": {}, "ratio_to_pendulum": {}}
+    for name in cases:
+        out["rates"][name] = statistics.median(r[name] for r in rounds)
+        if name != PENDULUM:
+            out["ratio_to_pendulum"][name] = statistics.median(r[name] / r[PENDULUM] for r in rounds)
+    out["per-step us"] = {k: _median(fn, repeats) for k, fn in cost_split(SEAT_ENV, kw, 1).items()}
+    return out
+
+
+def _print_seat(res: dict) -> None:
+    print(f"controller seat, {res['env_id']} {res['env_kwargs']}, random actions, resets as "
+          f"episodes end (median of {res['repeats']} rounds):")
+    for name, rate in res["rates"].items():
+        ratio = res["ratio_to_pendulum"].get(name)
+        print(f"  {name:32s} {rate:10.0f} steps/s"
+              + ("" if ratio is None else f"   {ratio:.2f}x Pendulum-v1"))
+    _print_split(res["env_id"], res["per-step us"])
+
+
 def _print_split(env_id: str, split: dict) -> None:
     print(f"  cost split of one {env_id} step [µs] (same trajectory):")
     print(f"    physics (integrate_segment)        {split['physics']:8.1f}")
@@ -207,9 +305,22 @@ def main(argv=None) -> int:
     p.add_argument("--json", default=None, help="write the figures to this JSON file")
     p.add_argument("--clock", choices=("cpu", "wall"), default="cpu",
                    help="process CPU time (per core; default) or wall-clock time")
+    p.add_argument("--control-dt", type=float, action="append", default=[], metavar="SECONDS",
+                   help="measure the controller seat at this control step (repeatable) against "
+                        "Pendulum-v1 instead of the 1 ms figures")
+    p.add_argument("--steps", type=int, default=3000,
+                   help="env steps per controller-seat run (per case and round)")
     args = p.parse_args(argv)
     global CLOCK
     CLOCK = time.process_time if args.clock == "cpu" else time.perf_counter
+    if args.control_dt:
+        res = {"clock": args.clock, "n_envs": args.n_envs, "steps": args.steps,
+               "seat": [seat_speed(dt, args.repeats, args.n_envs, args.steps)
+                        for dt in args.control_dt]}
+        for r in res["seat"]:
+            _print_seat(r)
+        _write(args.json, res)
+        return 0
     kwargs = {"overrides": dict(parse_assignment(a) for a in args.overrides)} if args.overrides else {}
     R, E = args.repeats, args.episodes
     res: dict = {"scene": "paper", "overrides": kwargs.get("overrides", {}), "clock": args.clock,
@@ -258,11 +369,15 @@ def main(argv=None) -> int:
                                                  max(steps, 4800 // n_b), R)
         res[f"batched N={n_b} default/one thread (wall)"] = ratio
         print(f"  N = {n_b:3d}: {ratio:.2f}x ({auto:.0f} vs {one:.0f} env steps/s)")
-    if args.json:
-        with open(args.json, "w") as fh:
-            json.dump(res, fh, indent=2)
-        print(f"wrote {args.json}")
+    _write(args.json, res)
     return 0
+
+
+def _write(path: str | None, res: dict) -> None:
+    if path:
+        with open(path, "w") as fh:
+            json.dump(res, fh, indent=2)
+        print(f"wrote {path}")
 
 
 if __name__ == "__main__":
