@@ -303,6 +303,9 @@ def _print_seat(res: dict) -> None:
     i = res["integrator per step"]
     print(f"    integrator per control step: {i['rhs']:.1f} right-hand sides, {i['steps']:.2f} "
           f"steps, {i['rejected']:.2f} rejected")
+    ceiling = 1e6 / res["per-step us"]["physics"] / res["rates"][PENDULUM]
+    print(f"    the physics alone steps at {ceiling:.2f}x Pendulum-v1 (the most any work outside "
+          f"the integrator can reach, from the medians)")
 
 
 def seat_table(res: dict) -> str:
@@ -318,7 +321,8 @@ def seat_table(res: dict) -> str:
                         f"{'1 (reference)' if ratio is None else f'{ratio:.2f}'} |")
     rows += ["", "| control step | physics | + monitors, reward, obs | + Python `step` | "
              "+ wrappers | `env.step` | physics share | integrator steps (rejected), "
-             "right-hand sides |", "|---|---|---|---|---|---|---|---|"]
+             "right-hand sides | physics alone, × Pendulum-v1 |",
+             "|---|---|---|---|---|---|---|---|---|"]
     for r in res["seat"]:
         c = r["per-step us"]
         rows.append(f"| {1e3 * r['control_dt_s']:g} ms | {c['physics']:.1f} µs | "
@@ -327,7 +331,8 @@ def seat_table(res: dict) -> str:
                     f"{100 * c['physics'] / c['wrapped']:.0f} % | "
                     f"{r['integrator per step']['steps']:.1f} "
                     f"({r['integrator per step']['rejected']:.2f}), "
-                    f"{r['integrator per step']['rhs']:.0f} |")
+                    f"{r['integrator per step']['rhs']:.0f} | "
+                    f"{1e6 / c['physics'] / r['rates'][PENDULUM]:.2f} |")
     kw = res["seat"][0]["env_kwargs"]
     rows += ["", f"{res['seat'][0]['env_id']}, "
              + ", ".join(f"`{k}={v!r}`" for k, v in kw.items() if k != "control_dt")
