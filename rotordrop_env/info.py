@@ -56,7 +56,7 @@ def info_dict(v: np.ndarray, latency, relevitate: bool) -> dict:
     N (``(N, N_V)``: arrays of N, one fresh array each); ``latency``: the episode's observation
     latency (int, or int array of N)."""
     if v.ndim == 1:
-        return _one(v, v.tolist(), latency, relevitate)
+        return _one(list(v[:_NF]), v.tolist(), np.int64(latency), v[K.V_TIME], relevitate)
     bidx = _BOOL_IDX[relevitate]
     cols = v.T.copy()                        # fresh: nothing a caller holds is reused
     info = dict(zip(FLOAT_KEYS, cols[:_NF]))
@@ -66,23 +66,26 @@ def info_dict(v: np.ndarray, latency, relevitate: bool) -> dict:
     return info
 
 
-def _one(v: np.ndarray, numbers: list, latency, relevitate: bool) -> dict:
-    """One environment's info from its numbers ``v`` (as an array and as ``v.tolist()``): one
-    dict built in one go (it is made every step: the floats as fresh numpy scalars, the bools
-    as numpy's two bool scalars)."""
-    values = list(v[:_NF])
-    values += [_NP_BOOL[numbers[i] > 0.0] for i in _BOOL_SLOTS[relevitate]]
-    values.append(np.int64(latency))
-    values.append(v[K.V_TIME])
-    return dict(zip(_KEYS[relevitate], values))
+def _one(floats: list, numbers: list, latency: np.int64, time, relevitate: bool) -> dict:
+    """One environment's info, built in one go (it is made every step): its float entries
+    ``floats`` (fresh numpy scalars), its numbers as Python floats (for the bools: numpy's two
+    bool scalars), its latency and its time (numpy scalars)."""
+    floats += [_NP_BOOL[numbers[i] > 0.0] for i in _BOOL_SLOTS[relevitate]]
+    floats.append(latency)
+    floats.append(time)
+    return dict(zip(_KEYS[relevitate], floats))
 
 
 def row_infos(v: np.ndarray, latency: np.ndarray, relevitate: bool) -> list[dict]:
     """Each environment's info (numpy scalars, as a single environment's) from the numbers
-    ``v`` of N, ``(N, N_V)``: the SB3 VecEnv's list of infos."""
+    ``v`` of N, ``(N, N_V)``: the SB3 VecEnv's list of infos (every numpy scalar made in one
+    pass per kind)."""
+    floats = list(v[:, :_NF].ravel())
     numbers = v.tolist()
-    lat = latency.tolist()
-    return [_one(v[e], numbers[e], lat[e], relevitate) for e in range(v.shape[0])]
+    lat = list(np.asarray(latency, dtype=np.int64))
+    times = list(v[:, K.V_TIME])
+    return [_one(floats[e * _NF:(e + 1) * _NF], numbers[e], lat[e], times[e], relevitate)
+            for e in range(v.shape[0])]
 
 
 def kpi_keys(info: dict) -> dict:
