@@ -1,7 +1,21 @@
-"""Environment speed: env steps per second at the 1 ms control step, single and batched.
+"""Environment speed: env steps per second at the 1 ms control step, single and batched, and
+in the controller seat (``--control-dt``) as ratios to Gymnasium's ``Pendulum-v1``.
 
     python benchmarks/bench_env.py [--repeats 3] [--episodes 2] [--n-envs 16] [--json out.json]
                                    [--set KEY=VALUE ...]
+    python benchmarks/bench_env.py --control-dt 2e-4 --control-dt 1e-4 [--repeats 7]
+                                   [--json docs/data/bench-env-seat.json]
+
+With ``--control-dt`` (one or more control steps [s]) it measures only the controller seat
+(:mod:`agents.control.seats`): ``RotorDrop-Full-v1`` with raw coil currents
+(``command="continuous"``) and dampers, the robust suite's sensor noise and the middle of its
+sensor delay range, random actions, resets as episodes end. Per step and repeat it times
+``Pendulum-v1`` (``gym.make``, random actions) and then the single env (``gym.make`` and
+``env.unwrapped``), the SB3 batch ``BatchedRotorDropVecEnv`` (one numba thread: per core) and
+the Gymnasium vector env (``gymnasium.make_vec``, one thread), and prints each rate's median
+and the median of its per-repeat ratios to Pendulum-v1's rate (the machine's speed cancels),
+then the cost split of a step. ``--render JSON`` prints the table of docs/environments.md
+from that JSON (:func:`seat_table`).
 
 Paper scene, default environment settings (episode 0.3 s = 300 steps, 5 monitor samples per
 step), whole episodes including resets. Every figure is the median of ``--repeats`` runs after a
@@ -70,11 +84,14 @@ def single_env_rate(env_id: str, kwargs: dict, episodes: int, unwrapped: bool, s
     return run
 
 
-def cost_split(env_id: str, kwargs: dict, episodes: int, seed: int = 0):
+def cost_split(env_id: str, kwargs: dict, episodes: int, seed: int = 0,
+               stats: dict | None = None):
     """Per-step microseconds of physics, kernel, unwrapped step and wrapped step of ``env_id``
     on one trajectory (the passive env without action; others with seeded uniform random
     actions, the same in every part). The physics replays the controls ``U`` each step of the
-    episode left in the kernel, so it integrates the very trajectory the env steps."""
+    episode left in the kernel, so it integrates the very trajectory the env steps. ``stats``
+    (a dict) receives the integrator's right-hand sides, steps and rejected steps per control
+    step of the physics part."""
     env = gym.make(env_id, **kwargs)
     u = env.unwrapped
     space = env.action_space
@@ -125,11 +142,14 @@ def cost_split(env_id: str, kwargs: dict, episodes: int, seed: int = 0):
         y = b.y.copy()
         sv = u.scene.solver
         work = np.empty((9, y.size))
+        counts = np.zeros(3, dtype=np.int64)
         t0 = CLOCK()
         status = _physics_loop(y, b.M[K.M_T], u.dt, controls, b.P, b.I, sv.rtol, b.atol,
-                               b.M[K.M_H], sv.max_step, sv.min_step, work)
+                               b.M[K.M_H], sv.max_step, sv.min_step, work, counts)
         elapsed = CLOCK() - t0
         assert status == 0
+        if stats is not None:
+            stats.update(zip(("rhs", "steps", "rejected"), (counts / len(controls)).tolist()))
         return elapsed / len(controls) * 1e6
 
     return dict(physics=physics, kernel=per_step(kernel_step), unwrapped=per_step(unwrapped_step),
@@ -137,15 +157,19 @@ def cost_split(env_id: str, kwargs: dict, episodes: int, seed: int = 0):
 
 
 @njit
-def _physics_loop(y, t, dt, controls, P, I, rtol, atol, h, h_max, h_min, work):
+def _physics_loop(y, t, dt, controls, P, I, rtol, atol, h, h_max, h_min, work, counts):
     """The physics alone: a control step of integrate_segment per row of ``controls`` (the
-    U of each step), in one compiled call."""
+    U of each step), in one compiled call; ``counts`` += its right-hand sides, steps and
+    rejected steps."""
     no_t = np.empty(0)
     no_Y = np.empty((0, y.shape[0]))
     for k in range(controls.shape[0]):
-        status, _, h, _, _, _, _ = integrate_segment(y, t, t + dt, P, I, controls[k], rtol, atol,
-                                                     h, h_max, h_min, False, 10**9, no_t, no_Y, 0,
-                                                     work)
+        status, _, h, _, n_rhs, n_steps, n_rej = integrate_segment(
+            y, t, t + dt, P, I, controls[k], rtol, atol, h, h_max, h_min, False, 10**9, no_t,
+            no_Y, 0, work)
+        counts[0] += n_rhs
+        counts[1] += n_steps
+        counts[2] += n_rej
         if status != 0:
             return status
         t += dt
@@ -184,6 +208,139 @@ def default_vs_one_thread(env_id: str, kwargs: dict, n_envs: int, steps: int, re
             statistics.median(o for _, o in pairs))
 
 
+#: the controller seat's environment (module doc): raw currents and dampers
+SEAT_ENV = "RotorDrop-Full-v1"
+PENDULUM = "Pendulum-v1"
+
+
+def seat_kwargs(control_dt: float) -> dict:
+    """The env kwargs of a controller-seat row at ``control_dt``: raw currents, the robust
+    suite's sensor noise and the middle of its sensor delay range, no transport latency."""
+    from agents.benchmarking.robust import SENSOR_DELAY_S, SENSOR_NOISE
+    from agents.control.seats import CONTROLLER
+    return dict(CONTROLLER.env_kwargs(control_dt), command="continuous", sensor_noise=SENSOR_NOISE,
+                sensor_delay=0.5 * (SENSOR_DELAY_S[0] + SENSOR_DELAY_S[1]))
+
+
+def stepping_rate(env, steps: int, seed: int = 0):
+    """Steps per second of a single env (``gym.make``'d or unwrapped) over ``steps`` steps with
+    seeded random actions, reset as episodes end."""
+    space = env.action_space
+    space.seed(seed)
+    acts = [space.sample() for _ in range(1024)]
+    env.reset(seed=seed)
+
+    def run():
+        env.reset()
+        t0 = CLOCK()
+        for k in range(steps):
+            _, _, te, tr, _ = env.step(acts[k % len(acts)])
+            if te or tr:
+                env.reset()
+        return steps / (CLOCK() - t0)
+    return run
+
+
+def vector_rate(env_id: str, kwargs: dict, n_envs: int, steps: int, seed: int = 0):
+    """Env steps per second of the Gymnasium vector env on one thread (same-step autoreset)."""
+    venv = gym.make_vec(env_id, num_envs=n_envs, vectorization_mode="vector_entry_point",
+                        n_threads=1, **kwargs)
+    venv.action_space.seed(seed)
+    acts = [venv.action_space.sample() for _ in range(64)]
+    venv.reset(seed=seed)
+
+    def run():
+        t0 = CLOCK()
+        for k in range(steps):
+            venv.step(acts[k % len(acts)])
+        return steps * n_envs / (CLOCK() - t0)
+    return run
+
+
+def seat_cases(control_dt: float, n_envs: int, steps: int) -> dict:
+    """The timed runs of the controller seat at ``control_dt`` (each returns steps/s), warmed
+    up: Pendulum-v1, the single env (``gym.make``, unwrapped), the SB3 batch and the vector env
+    (``n_envs``, one thread)."""
+    kw = seat_kwargs(control_dt)
+    batch_steps = max(1, steps // n_envs)
+    cases = {PENDULUM: stepping_rate(gym.make(PENDULUM), 4 * steps),
+             "single (gym.make)": stepping_rate(gym.make(SEAT_ENV, **kw), steps),
+             "single (unwrapped)": stepping_rate(gym.make(SEAT_ENV, **kw).unwrapped, steps),
+             f"SB3 batch N={n_envs}, per core": batched_rate(SEAT_ENV, kw, n_envs, batch_steps, 1),
+             f"vector env N={n_envs}, per core": vector_rate(SEAT_ENV, kw, n_envs, batch_steps)}
+    for run in cases.values():                          # warm-up (JIT, scenario caches)
+        run()
+    return cases
+
+
+def seat_speed(control_dt: float, repeats: int, n_envs: int, steps: int) -> dict:
+    """The controller seat's rates at ``control_dt`` and their ratios to Pendulum-v1's, each
+    the median over ``repeats`` rounds that time every case once (module doc)."""
+    kw = seat_kwargs(control_dt)
+    cases = seat_cases(control_dt, n_envs, steps)
+    rounds = [{name: run() for name, run in cases.items()} for _ in range(repeats)]
+    out = {"control_dt_s": control_dt, "env_id": SEAT_ENV, "env_kwargs": kw, "repeats": repeats,
+           "rates": {}, "ratio_to_pendulum": {}}
+    for name in cases:
+        out["rates"][name] = statistics.median(r[name] for r in rounds)
+        if name != PENDULUM:
+            out["ratio_to_pendulum"][name] = statistics.median(r[name] / r[PENDULUM] for r in rounds)
+    stats: dict = {}
+    out["per-step us"] = {k: _median(fn, repeats)
+                          for k, fn in cost_split(SEAT_ENV, kw, 1, stats=stats).items()}
+    out["integrator per step"] = stats
+    return out
+
+
+def _print_seat(res: dict) -> None:
+    print(f"controller seat, {res['env_id']} {res['env_kwargs']}, random actions, resets as "
+          f"episodes end (median of {res['repeats']} rounds):")
+    for name, rate in res["rates"].items():
+        ratio = res["ratio_to_pendulum"].get(name)
+        print(f"  {name:32s} {rate:10.0f} steps/s"
+              + ("" if ratio is None else f"   {ratio:.2f}x Pendulum-v1"))
+    _print_split(res["env_id"], res["per-step us"])
+    i = res["integrator per step"]
+    print(f"    integrator per control step: {i['rhs']:.1f} right-hand sides, {i['steps']:.2f} "
+          f"steps, {i['rejected']:.2f} rejected")
+    ceiling = 1e6 / res["per-step us"]["physics"] / res["rates"][PENDULUM]
+    print(f"    the physics alone steps at {ceiling:.2f}x Pendulum-v1 (the most any work outside "
+          f"the integrator can reach, from the medians)")
+
+
+def seat_table(res: dict) -> str:
+    """The markdown table of a ``--control-dt`` run's JSON (docs/environments.md pastes it
+    between its markers; ``--render JSON`` prints it)."""
+    rows = ["| control step | case | env steps/s | × Pendulum-v1 (median of per-round ratios) |",
+            "|---|---|---|---|"]
+    for r in res["seat"]:
+        dt = f"{1e3 * r['control_dt_s']:g} ms"
+        for name, rate in r["rates"].items():
+            ratio = r["ratio_to_pendulum"].get(name)
+            rows.append(f"| {dt} | {name} | {rate:,.0f} | "
+                        f"{'1 (reference)' if ratio is None else f'{ratio:.2f}'} |")
+    rows += ["", "| control step | physics | + monitors, reward, obs | + Python `step` | "
+             "+ wrappers | `env.step` | physics share | integrator steps (rejected), "
+             "right-hand sides | physics alone, × Pendulum-v1 |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for r in res["seat"]:
+        c = r["per-step us"]
+        rows.append(f"| {1e3 * r['control_dt_s']:g} ms | {c['physics']:.1f} µs | "
+                    f"{c['kernel'] - c['physics']:.1f} µs | {c['unwrapped'] - c['kernel']:.1f} µs | "
+                    f"{c['wrapped'] - c['unwrapped']:.1f} µs | {c['wrapped']:.1f} µs | "
+                    f"{100 * c['physics'] / c['wrapped']:.0f} % | "
+                    f"{r['integrator per step']['steps']:.1f} "
+                    f"({r['integrator per step']['rejected']:.2f}), "
+                    f"{r['integrator per step']['rhs']:.0f} | "
+                    f"{1e6 / c['physics'] / r['rates'][PENDULUM]:.2f} |")
+    kw = res["seat"][0]["env_kwargs"]
+    rows += ["", f"{res['seat'][0]['env_id']}, "
+             + ", ".join(f"`{k}={v!r}`" for k, v in kw.items() if k != "control_dt")
+             + f"; {res['steps']} env steps per case and round, {res['seat'][0]['repeats']} "
+             f"rounds, N = {res['n_envs']}, {res['clock']} clock."]
+    return "\n".join(rows) + "\n"
+
+
 def _print_split(env_id: str, split: dict) -> None:
     print(f"  cost split of one {env_id} step [µs] (same trajectory):")
     print(f"    physics (integrate_segment)        {split['physics']:8.1f}")
@@ -207,9 +364,28 @@ def main(argv=None) -> int:
     p.add_argument("--json", default=None, help="write the figures to this JSON file")
     p.add_argument("--clock", choices=("cpu", "wall"), default="cpu",
                    help="process CPU time (per core; default) or wall-clock time")
+    p.add_argument("--control-dt", type=float, action="append", default=[], metavar="SECONDS",
+                   help="measure the controller seat at this control step (repeatable) against "
+                        "Pendulum-v1 instead of the 1 ms figures")
+    p.add_argument("--steps", type=int, default=3000,
+                   help="env steps per controller-seat run (per case and round)")
+    p.add_argument("--render", default=None, metavar="JSON",
+                   help="print the table of a --control-dt run's JSON and exit")
     args = p.parse_args(argv)
+    if args.render:
+        with open(args.render) as fh:
+            print(seat_table(json.load(fh)), end="")
+        return 0
     global CLOCK
     CLOCK = time.process_time if args.clock == "cpu" else time.perf_counter
+    if args.control_dt:
+        res = {"clock": args.clock, "n_envs": args.n_envs, "steps": args.steps,
+               "seat": [seat_speed(dt, args.repeats, args.n_envs, args.steps)
+                        for dt in args.control_dt]}
+        for r in res["seat"]:
+            _print_seat(r)
+        _write(args.json, res)
+        return 0
     kwargs = {"overrides": dict(parse_assignment(a) for a in args.overrides)} if args.overrides else {}
     R, E = args.repeats, args.episodes
     res: dict = {"scene": "paper", "overrides": kwargs.get("overrides", {}), "clock": args.clock,
@@ -258,11 +434,15 @@ def main(argv=None) -> int:
                                                  max(steps, 4800 // n_b), R)
         res[f"batched N={n_b} default/one thread (wall)"] = ratio
         print(f"  N = {n_b:3d}: {ratio:.2f}x ({auto:.0f} vs {one:.0f} env steps/s)")
-    if args.json:
-        with open(args.json, "w") as fh:
-            json.dump(res, fh, indent=2)
-        print(f"wrote {args.json}")
+    _write(args.json, res)
     return 0
+
+
+def _write(path: str | None, res: dict) -> None:
+    if path:
+        with open(path, "w") as fh:
+            json.dump(res, fh, indent=2)
+        print(f"wrote {path}")
 
 
 if __name__ == "__main__":

@@ -132,10 +132,11 @@ class Batch:
                 env._check_open("step")
             raise gym.error.ResetNeeded("call reset() on the vector environment before step()")
 
-    def step(self, actions, active: np.ndarray | None = None):
+    def step(self, actions, active: np.ndarray | None = None, columns: bool = True):
         """All environments one control step (no reset): observations (float32), rewards
         (float64), terminated, truncated (bool arrays) and the info columns
-        (:func:`rotordrop_env.info.info_dict`, one array entry per environment).
+        (:func:`rotordrop_env.info.info_dict`, one array entry per environment; ``columns``
+        False: None, the numbers stay in ``values`` for :func:`rotordrop_env.info.row_infos`).
 
         ``active``: advance only these rows (bool mask); the others are left as they are (just
         reset: their observation is the kernel's reset one, their reward 0 and their info the
@@ -176,7 +177,7 @@ class Batch:
         terminated = out[:, K.O_TERM] > 0.0
         truncated = out[:, K.O_TRUNC] > 0.0
         K.info_rows(out, stack.M, stack.C, self.values)
-        info = info_dict(self.values, self.latency, self.relevitate)
+        info = info_dict(self.values, self.latency, self.relevitate) if columns else None
         if self.rendering:                        # before the auto-resets clear the views
             for e in rows:
                 self.envs[e]._show_step()

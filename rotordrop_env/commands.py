@@ -139,6 +139,10 @@ def real_action(action, space: spaces.Space, names) -> np.ndarray:
 def load_action(action, act: np.ndarray, space: spaces.Space, names) -> None:
     """Write one environment's ``action`` into its kernel action array ``act``; ValueError
     naming the action space for a wrong type or shape (the kernel checks the values)."""
+    if type(action) is np.ndarray and action.dtype.kind == "f" and action.shape == act.shape \
+            and not isinstance(space, spaces.Discrete):
+        act[:] = action                     # the common case, checked at once
+        return
     a = real_action(action, space, names)
     if isinstance(space, spaces.Discrete):
         if a.size != 1:

@@ -292,7 +292,8 @@ class RotorDropEnv(SettingsGuard, EpisodeView, gym.Env):
             raise IntegrationError(explain_status(int(out[K.O_STATUS]), b.M[K.M_T], b.M[K.M_H], self.model))
         terminated = bool(out[K.O_TERM])
         truncated = bool(out[K.O_TRUNC])
-        self._ended |= terminated or truncated
+        if terminated or truncated:         # (assigned only then: attributes go through
+            self._ended = True              # SettingsGuard's checks)
         reward = self.reward_function.one(out, b.M, b.C, self._relevitate)
         info = self._info()
         self._show_step()

@@ -44,31 +44,50 @@ _BOOLS = (("backward_whirl", K.V_WHIRL), ("relevitated", K.V_RELEV),
 _BOOL_KEYS = {r: tuple(k for k, _ in _BOOLS if r or k != "relevitated") for r in (False, True)}
 _BOOL_IDX = {r: np.array([i for k, i in _BOOLS if r or k != "relevitated"]) for r in (False, True)}
 _NF = K.N_V_FLOAT
+#: every key in its order: the floats, the bools, the latency, the episode time
+_KEYS = {r: FLOAT_KEYS + _BOOL_KEYS[r] + ("obs_latency_steps", "kpi_episode_time_s")
+         for r in (False, True)}
+_BOOL_SLOTS = {r: tuple(int(i) for i in _BOOL_IDX[r]) for r in (False, True)}
+_NP_BOOL = (np.False_, np.True_)            # numpy's two bool scalars (no allocation per step)
 
 
 def info_dict(v: np.ndarray, latency, relevitate: bool) -> dict:
     """The ``info`` from the numbers ``v`` of one environment (``(N_V,)``: numpy scalars) or of
     N (``(N, N_V)``: arrays of N, one fresh array each); ``latency``: the episode's observation
     latency (int, or int array of N)."""
-    bidx = _BOOL_IDX[relevitate]
     if v.ndim == 1:
-        info = dict(zip(FLOAT_KEYS, list(v[:_NF])))
-        info.update(zip(_BOOL_KEYS[relevitate], list(v[bidx] > 0.0)))
-        info["obs_latency_steps"] = np.int64(latency)
-    else:
-        cols = v.T.copy()                        # fresh: nothing a caller holds is reused
-        info = dict(zip(FLOAT_KEYS, cols[:_NF]))
-        info.update(zip(_BOOL_KEYS[relevitate], cols[bidx] > 0.0))
-        info["obs_latency_steps"] = np.array(latency, dtype=np.int64)
+        return _one(list(v[:_NF]), v.tolist(), np.int64(latency), v[K.V_TIME], relevitate)
+    bidx = _BOOL_IDX[relevitate]
+    cols = v.T.copy()                        # fresh: nothing a caller holds is reused
+    info = dict(zip(FLOAT_KEYS, cols[:_NF]))
+    info.update(zip(_BOOL_KEYS[relevitate], cols[bidx] > 0.0))
+    info["obs_latency_steps"] = np.array(latency, dtype=np.int64)
     info["kpi_episode_time_s"] = info["time_s"].copy()
     return info
+
+
+def _one(floats: list, numbers: list, latency: np.int64, time, relevitate: bool) -> dict:
+    """One environment's info, built in one go (it is made every step): its float entries
+    ``floats`` (fresh numpy scalars), its numbers as Python floats (for the bools: numpy's two
+    bool scalars), its latency and its time (numpy scalars)."""
+    floats += [_NP_BOOL[numbers[i] > 0.0] for i in _BOOL_SLOTS[relevitate]]
+    floats.append(latency)
+    floats.append(time)
+    return dict(zip(_KEYS[relevitate], floats))
+
+
+def row_infos(v: np.ndarray, latency: np.ndarray, relevitate: bool) -> list[dict]:
+    """Each environment's info (numpy scalars, as a single environment's) from the numbers
+    ``v`` of N, ``(N, N_V)``: the SB3 VecEnv's list of infos (every numpy scalar made in one
+    pass per kind)."""
+    floats = list(v[:, :_NF].ravel())
+    numbers = v.tolist()
+    lat = list(np.asarray(latency, dtype=np.int64))
+    times = list(v[:, K.V_TIME])
+    return [_one(floats[e * _NF:(e + 1) * _NF], numbers[e], lat[e], times[e], relevitate)
+            for e in range(v.shape[0])]
 
 
 def kpi_keys(info: dict) -> dict:
     """The ``kpi_*`` entries of ``info``."""
     return {k: v for k, v in info.items() if k.startswith("kpi_")}
-
-
-def row_info(columns: dict, e: int) -> dict:
-    """Environment ``e``'s info (numpy scalars) from the columns of a batch."""
-    return {k: v[e] for k, v in columns.items()}

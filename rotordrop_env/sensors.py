@@ -33,6 +33,8 @@ import numbers
 
 import numpy as np
 
+from physics.jit import njit
+
 from .kernels import SUP_MIN_RADIUS
 from .layout import SUPERVISOR_OBS
 
@@ -105,6 +107,8 @@ class Sensing:
             self.speed_col = names.index("rotor_speed")
             self.r_min = SUP_MIN_RADIUS * clearance
         self.buffer = np.zeros((latency[1] + 1, len(names)))
+        self._cols = self.cols if noise > 0.0 else np.zeros(0, dtype=np.int64)   # for _sense
+        self._sigma = self.sigma if noise > 0.0 else np.zeros(0)
         self.k = 0
         self.n = 0                      # measurements taken this episode
 
@@ -121,6 +125,20 @@ class Sensing:
         """Measure ``true_obs`` (normalised, as the kernel wrote it) and return the float32
         observation the agent sees now; the displacement noise sample goes to the controls ``U``
         (the physics' sensed displacement until the next measurement) when given."""
+        if U is not None and (self.noise == 0.0 or self.orbit is None):
+            # one compiled call, the same numbers as step_python (the supervisor's orbit
+            # entries take the Python path)
+            z = rng.standard_normal(len(self.cols)) if self.noise > 0.0 else _NO_DRAW
+            out = np.empty(true_obs.shape[0], dtype=np.float32)
+            _sense(true_obs, z, self._sigma, self._cols, U, self.noise_control, self.noise,
+                   self.buffer, self.n, self.k, self.time_col, out)
+            self.n += 1
+            return out
+        return self.step_python(true_obs, rng, U)
+
+    def step_python(self, true_obs: np.ndarray, rng: np.random.Generator,
+                    U: np.ndarray | None = None) -> np.ndarray:
+        """:meth:`step` in numpy (any settings; the reference of its compiled path)."""
         m = self._measure(true_obs, rng, U)
         L = len(self.buffer)
         self.buffer[self.n % L] = m
@@ -155,3 +173,32 @@ class Sensing:
             rate = spin * (px * vy - py * vx) / (r * r) if r > self.r_min else 0.0
             m[self.orbit[k]] = r / self.scale[self.orbit[k]]
             m[self.orbit[2 + k]] = rate / self.scale[self.orbit[2 + k]]
+
+
+_NO_DRAW = np.zeros(0)
+
+
+@njit
+def _sense(true_obs, z, sigma, cols, U, noise_control, noise, buffer, n, k, time_col, out):
+    """:meth:`Sensing.step` without the supervisor's orbit entries, compiled: the measurement
+    (``true_obs`` + ``sigma`` z at ``cols``; the noise ``noise`` z of the 4 displacements into
+    ``U``) into the latency ring ``buffer`` (all of it at the episode's first measurement, n =
+    0) and the float32 observation of k measurements ago (its ``time`` the present) into ``out``."""
+    L = buffer.shape[0]
+    row = n % L
+    for i in range(true_obs.shape[0]):
+        buffer[row, i] = true_obs[i]
+    for j in range(cols.shape[0]):
+        buffer[row, cols[j]] += sigma[j] * z[j]
+    if cols.shape[0] > 0:
+        for j in range(4):                  # x1, y1, x2, y2: the AMB axes' order
+            U[noise_control + j] = noise * z[j]
+    if n == 0:
+        for r in range(L):
+            if r != row:
+                for i in range(true_obs.shape[0]):
+                    buffer[r, i] = buffer[row, i]
+    src = (n - min(k, n)) % L
+    for i in range(true_obs.shape[0]):
+        out[i] = buffer[src, i]
+    out[time_col] = true_obs[time_col]

@@ -19,7 +19,7 @@ from stable_baselines3.common.vec_env.base_vec_env import VecEnv
 
 from .batch import (ENVS_PER_THREAD, RECHOOSE_EVERY, TRIAL_STEPS, Batch, ThreadChoice,  # noqa: F401
                     auto_threads)
-from .info import PEAK_KEYS, row_info
+from .info import PEAK_KEYS, row_infos
 
 #: torch threads above which the SB3 VecEnv warns (once per process, :func:`check_torch_threads`)
 TORCH_THREADS_QUIET = 1
@@ -105,9 +105,10 @@ class BatchedRotorDropVecEnv(VecEnv):
         self.actions = actions
 
     def step_wait(self):
-        obs, rewards, terminated, truncated, columns = self.batch.step(self.actions)
+        batch = self.batch
+        obs, rewards, terminated, truncated, _ = batch.step(self.actions, columns=False)
         dones = terminated | truncated
-        infos = [row_info(columns, e) for e in range(self.num_envs)]
+        infos = row_infos(batch.values, batch.latency, batch.relevitate)
         for e in np.flatnonzero(dones):
             infos[e]["terminal_observation"] = obs[e].copy()
             infos[e]["TimeLimit.truncated"] = bool(truncated[e] and not terminated[e])

@@ -199,3 +199,23 @@ def test_reward_kwargs_are_checked():
     with pytest.raises(ValueError, match="reward = 'kpis' is not a reward"):
         gym.make("RotorDrop-Damping-v1", reward="kpis")
     assert set(KPI_WEIGHTS) >= set(W)
+
+
+@pytest.mark.parametrize("relevitate", [False, True])
+def test_the_sb3_rows_are_the_single_env_info_of_each_row(relevitate):
+    """row_infos (the SB3 VecEnv's list) gives each row exactly what info_dict gives that row
+    alone: the same keys in the same order, values and numpy types; every dict and scalar its
+    own (no row shares a value with another)."""
+    from rotordrop_env.info import info_dict, row_infos
+    from rotordrop_env import kernels as K
+    rng = np.random.default_rng(0)
+    v = rng.normal(size=(5, K.N_V))
+    latency = np.arange(5, dtype=np.int64)
+    rows = row_infos(v, latency, relevitate)
+    for e, row in enumerate(rows):
+        one = info_dict(v[e], int(latency[e]), relevitate)
+        assert list(row) == list(one)
+        for k in one:
+            assert type(row[k]) is type(one[k]) and row[k] == one[k], k
+        assert row["time_s"] is not row["kpi_episode_time_s"]
+    assert rows[0]["time_s"] != rows[1]["time_s"] and rows[0] is not rows[1]

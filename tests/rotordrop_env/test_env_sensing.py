@@ -162,3 +162,29 @@ def test_env_checkers_pass_with_noise_and_latency():
     run_env_checkers(lambda: gym.make(FULL, **SUP, sensor_noise=2e-6, obs_latency_steps=(1, 3)))
     run_env_checkers(lambda: gym.make("RotorDrop-Passive-v1", episode_time=0.01,
                                       sensor_noise=2e-6, obs_latency_steps=2))
+
+
+@pytest.mark.parametrize("noise, latency", [(2e-6, (0, 0)), (2e-6, (1, 3)), (0.0, (2, 2)),
+                                            (1e-5, (0, 4))])
+def test_the_compiled_sensing_step_is_the_numpy_one_bit_for_bit(noise, latency):
+    """Sensing.step's compiled path (every setting but the supervisor's orbit entries) gives
+    the numpy path's observations, held noise controls and draws, bit for bit, through the
+    latency ring's first fill and its wrap-around (with a kernel-like true observation)."""
+    from rotordrop_env.sensors import Sensing
+    env = gym.make(FULL, command="continuous").unwrapped
+    names, scale = env.obs_names, env.obs_scale
+    make = lambda: Sensing(noise, latency, names, scale, 1e-4, U_SENS_NOISE)  # noqa: E731
+    fast, slow = make(), make()
+    slow.step = slow.step_python                         # reset() measures through it too
+    assert fast.active
+    rng_f, rng_s = np.random.default_rng(5), np.random.default_rng(5)
+    U_f, U_s = np.zeros(U_SENS_NOISE + 4), np.zeros(U_SENS_NOISE + 4)
+    truth = np.random.default_rng(1).normal(size=(12, len(names)))
+    for n, true_obs in enumerate(truth):
+        if n % 6 == 0:                                   # a new episode (its latency drawn)
+            a, b = fast.reset(true_obs, rng_f, U_f), slow.reset(true_obs, rng_s, U_s)
+        else:
+            a, b = fast.step(true_obs, rng_f, U_f), slow.step(true_obs, rng_s, U_s)
+        assert a.dtype == b.dtype == np.float32
+        assert np.array_equal(a, b) and np.array_equal(U_f, U_s) and fast.k == slow.k
+    assert rng_f.random() == rng_s.random()              # the same draws were taken
