@@ -18,6 +18,7 @@ import numpy as np
 
 from ..control.controllers import Controller
 from ..control.plant import ControllerError
+from ..control.seats import seat_for_kwargs
 
 #: the channel that selects each re-levitation command (``controllers.command_for``)
 _COMMAND_CHANNEL = {None: (), "continuous": ("currents",), "supervisor": ("gain",),
@@ -67,8 +68,12 @@ def policy_controller(policy: Callable[[np.ndarray], np.ndarray], env_id: str, n
         raise ValueError(f"name = {name!r}: a leaderboard name without spaces, '|' or '`'")
     if not callable(policy):
         raise ValueError(f"policy = {policy!r}: allowed a function of a batch of observations")
+    # its seat is where its command and step run (a learned row's rule): 1 ms over the PID is
+    # the supervisor's, 0.1-0.2 ms raw currents the controller's; a step no seat runs is refused
+    seat = seat_for_kwargs({"command": command, "control_dt": control_dt or 1e-3}).name
     return type(f"Foreign_{name.replace('-', '_')}", (ForeignPolicy,),
                 {"name": name, "env_id": env_id, "command": command, "control_dt": control_dt,
+                 "seat": seat,
                  "needs": _COMMAND_CHANNEL[command], "policy": staticmethod(policy),
                  "__doc__": f"{name}: a foreign policy in {env_id}"})
 

@@ -99,7 +99,15 @@ def test_it_runs_only_in_its_own_environment_and_seat():
     from agents.control.plant import plant_of
     cls = policy_controller(lambda obs: obs, "RotorDrop-Full-v1", name="sup", command="supervisor")
     assert issubclass(cls, ForeignPolicy)
-    assert controller_env_kwargs(cls, "RotorDrop-Full-v1") == {"command": "supervisor"}
+    assert cls.seat == "supervisor"             # the PID's supervisor, at the seat's 1 ms step
+    assert controller_env_kwargs(cls, "RotorDrop-Full-v1") == {"command": "supervisor",
+                                                               "control_dt": 1e-3}
+    fast = policy_controller(lambda obs: obs, "RotorDrop-Full-v1", name="fast",
+                             command="continuous", control_dt=2e-4)
+    assert fast.seat == "controller"            # raw currents at 0.2 ms: inside the controller
+    with pytest.raises(ValueError, match="no seat runs control_dt = 0.5 ms"):
+        policy_controller(lambda obs: obs, "RotorDrop-Full-v1", name="odd",
+                          command="continuous", control_dt=5e-4)
     assert cls.supports(plant_of("RotorDrop-Full-v1", command="supervisor"))
     assert not cls.supports(plant_of(ENV))
 
