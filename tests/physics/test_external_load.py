@@ -105,3 +105,14 @@ def test_off_by_default_no_state_and_nothing_changes():
 def test_bad_input_is_refused_by_name(overrides, match):
     with pytest.raises(SceneError, match=match):
         load_scene("paper", overrides)
+
+
+def test_on_a_flexible_rotor_the_load_acts_at_the_unbalance_station_and_the_audit_closes():
+    over = {"effects.external_load": True, "external_load.peak": 2000.0,
+            "external_load.start": 0.03, "external_load.duration": 0.01}
+    r = simulate(load_scene("paper-flexible", over), t_end=0.15)
+    assert r.model.elastic_modes > 0
+    res, e = energy_residual(r)
+    assert res.max() < 1e-6 * e["dissipated"][-1]
+    with pytest.raises(SceneError, match=r"external_load\.z = 0\.1 m: with rotor\.model = 'flexible'"):
+        load_scene("paper-flexible", {**over, "external_load.z": 0.1})

@@ -108,3 +108,13 @@ def test_a_change_to_the_same_unbalance_changes_nothing():
 def test_bad_input_is_refused_by_name(overrides, match):
     with pytest.raises(SceneError, match=match):
         load_scene("paper", overrides)
+
+
+def test_on_a_flexible_rotor_the_audit_closes_across_the_change():
+    """The difference acts at the unbalance station, whose elastic motion its power includes."""
+    r = simulate(load_scene("paper-flexible", {"effects.unbalance_change": True,
+                                               "unbalance_change.time": 0.03,
+                                               "unbalance_change.mass": 0.05}), t_end=0.15)
+    assert r.model.elastic_modes > 0
+    res, e = energy_residual(r)
+    assert res.max() < 1e-6 * e["dissipated"][-1]
