@@ -10,8 +10,7 @@ import numpy as np
 from .equilibrium import levitated_state
 from .integrate import (N_PEAK, NOT_FINITE, OK, SAMPLE_BLOCK, STEP_COLLAPSE, TOO_MANY_STEPS,
                         integrate_segment, sample_diagnostics)
-from . import external_load, unbalance_change
-from .model import N_AUX, AMB_NONE, F_AMB, Model, build_model
+from .model import EFFECTS, N_AUX, AMB_NONE, F_AMB, Model, build_model
 from .results import Result, RunStats
 from .scene import Scene, SceneError, param_meta
 
@@ -148,8 +147,9 @@ def segments(model: Model, t_end: float) -> list[tuple[float, float, bool]]:
 
 
 def event_times(scene) -> tuple[float, ...]:
-    """The times the switched-on events' forces jump or kink (their ``breaks``)."""
-    return tuple(sorted({t for effect in (unbalance_change, external_load)
+    """The times the switched-on effects' forces jump or kink: what the effects with a
+    ``breaks(scene)`` return (an event's start and end)."""
+    return tuple(sorted({t for effect in EFFECTS if hasattr(effect, "breaks")
                          for t in effect.breaks(scene)}))
 
 
