@@ -26,8 +26,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import amb as amb_mod
-from . import (ball_bearing, contact, flexible_rotor, ground, laws, rotor, seal, sensor, stator,
-               support, thermal)
+from . import (ball_bearing, contact, external_load, flexible_rotor, ground, laws, rotor, seal,
+               sensor, stator, support, thermal, unbalance_change)
 from ._jit import njit, njit_borrow, njit_inline
 from .amb import (AMB_ACTUATOR, AMB_AXES, AMB_LINEAR, AMB_NONE, ORBIT_FRAME_CORE,  # noqa: F401
                   amb_currents, orbit_offset)
@@ -67,7 +67,7 @@ class EnergyAudit:
 
 #: the registered effects, in the order their states are laid out (adding an effect: one line)
 EFFECTS = (rotor, contact, ball_bearing, amb_mod, support, EnergyAudit, thermal, stator, sensor,
-           seal, flexible_rotor, ground)
+           seal, flexible_rotor, ground, unbalance_change, external_load)
 #: the packed arrays' named slots, from the effects' declarations
 LAYOUT = Layout.build(EFFECTS)
 #: the constants the kernels index the packed arrays with (``P_M``, ``U_ICMD``, ``A_FR`` ...),
@@ -259,6 +259,10 @@ def loads(t, y, P, I, U, dy, aux):
     flexible_rotor.clear_station_forces(aux)
     if dy is not None and I[F_UNB]:
         load = rotor.unbalance(y, P, I, dy, aux, load)
+        if I[F_UCHANGE]:
+            load = unbalance_change.force(t, y, P, I, aux, load)
+    if dy is not None and I[F_XLOAD]:
+        load = external_load.force(t, y, P, I, aux, load)
     if dy is not None and I[F_SEAL]:
         load = seal.force(y, P, I, load)
     if dy is not None and amb_mod.acting(I, U):

@@ -201,12 +201,19 @@ def weight(P):
 @njit_inline
 def unbalance(y, P, I, dy, aux, load):
     """The unbalance's load (its station's elastic motion included) and the spin angle's rate."""
-    iphi = I[S_PHI]
+    dy[I[S_PHI]] = y[I[S_W]]
+    return unbalance_of(y, P, I, aux, load, P[P_MUE], P[P_UB_PHASE])
+
+
+@njit_inline
+def unbalance_of(y, P, I, aux, load, m_e, phase):
+    """The load with an unbalance m_e [kg m] at ``phase`` [rad] from the spin angle, at the
+    unbalance station, added: its force, moments and power (the station's elastic motion
+    included); the rotor's own unbalance and a change of it (physics/unbalance_change.py)."""
     W = y[I[S_W]]
-    ux, uy, _, _, p = unbalance_load(P[P_MUE], W, y[iphi], P[P_UB_PHASE], P[P_Z_UB],
+    ux, uy, _, _, p = unbalance_load(m_e, W, y[I[S_PHI]], phase, P[P_Z_UB],
                                      y[I[S_VX]], y[I[S_VY]], y[I[S_VA]], y[I[S_VB]])
     load = add_external(add_station_force(load, P, I, aux, ST_UB, ux, uy), p)
-    dy[iphi] = W
     if I[I_FX_N] > 0:                            # the unbalance station's elastic motion
         _, _, evx, evy = elastic_motion(y, P, I[I_FX], I[I_FX_N], P_FX_SHAPE + ST_UB * FX_ROW)
         load = add_external(load, ux * evx + uy * evy)

@@ -285,6 +285,37 @@ class Ground:
 
 
 @dataclass(frozen=True)
+class UnbalanceChange:
+    """A sudden unbalance change (physics/unbalance_change.py; effects.unbalance_change): at
+    time t_s the rotor's unbalance steps from unbalance.* to the one given here (a blade or
+    fragment loss), at the same axial station unbalance.z."""
+    time: float = param(0.05, "s", 0.0, 100.0, "time t_s of the change", "A")
+    mass: float = param(0.01, "kg", 0.0, 1.0, "unbalance mass m_u' after the change", "A")
+    radius: float = param(0.0975, "m", 0.0, 1.0, "its radius e'", "A")
+    angle_deg: float = param(90.0, "deg", -360.0, 360.0, "its angle from +X at spin angle 0 (as"
+                             " unbalance.angle_deg)", "A")
+
+
+@dataclass(frozen=True)
+class ExternalLoad:
+    """A transient external load on the rotor (physics/external_load.py; effects.external_load):
+    a force of given peak, direction and axial position with a half-sine or a held-step time
+    profile (a process load, possibly beyond the AMBs' force capacity)."""
+    peak: float = param(0.0, "N", 0.0, 1e7, "peak force F", "A")
+    angle_deg: float = param(-90.0, "deg", -360.0, 360.0, "direction of the force in the x-y"
+                             " plane, from +x towards +y (-90: downward)", "A")
+    z: float = param(0.0, "m", -5.0, 5.0, "axial position of the force (centre-of-mass frame);"
+                     " a flexible rotor takes it at unbalance.z", "A")
+    start: float = param(0.05, "s", 0.0, 100.0, "time t_0 the load starts", "A")
+    duration: float = param(0.011, "s", 1e-5, 100.0, "duration T of the load", "A")
+    profile: str = param("half_sine", "-", doc="time profile: half_sine (F sin(pi s / T)) or step"
+                         " (F held for T, with linear ramps of external_load.ramp at both ends)",
+                         choices=("half_sine", "step"), tag="A")
+    ramp: float = param(0.0, "s", 0.0, 100.0, "rise and fall time of the step profile (<= T/2;"
+                        " 0: a sharp step)", "A")
+
+
+@dataclass(frozen=True)
 class Flexible:
     """The flexible rotor (rotor.model = "flexible"; physics/flexible_rotor.py, docs/flexible.md):
     Timoshenko shaft elements reduced to the rigid-body motion plus elastic modes. The force
@@ -356,13 +387,20 @@ class Effects:
                                   doc="the ground under the housings and AMB stators accelerates"
                                       " (ground.* parameters: a half-sine pulse and/or a record;"
                                       " no state)", tag="A")
+    unbalance_change: bool = param(False, "-",
+                                   doc="the rotor's unbalance steps to unbalance_change.* at"
+                                       " unbalance_change.time (blade or fragment loss; no"
+                                       " state)", tag="A")
+    external_load: bool = param(False, "-",
+                                doc="a transient external force on the rotor (external_load.*:"
+                                    " half-sine or held step; no state)", tag="A")
 
 
 GROUPS: dict[str, type] = {
     "rotor": Rotor, "positions": Positions, "unbalance": Unbalance, "world": World, "amb": Amb,
     "contact": Contact, "stator": Stator, "sleeve": Sleeve, "thermal": Thermal, "bearing": Bearing,
     "support": Support, "sensor": Sensor, "seal": Seal, "ground": Ground,
-    "flexible": Flexible,
+    "unbalance_change": UnbalanceChange, "external_load": ExternalLoad, "flexible": Flexible,
     "solver": Solver, "effects": Effects,
 }
 
@@ -385,6 +423,8 @@ class Scene:
     sensor: Sensor = field(default_factory=Sensor)
     seal: Seal = field(default_factory=Seal)
     ground: Ground = field(default_factory=Ground)
+    unbalance_change: UnbalanceChange = field(default_factory=UnbalanceChange)
+    external_load: ExternalLoad = field(default_factory=ExternalLoad)
     flexible: Flexible = field(default_factory=Flexible)
     solver: Solver = field(default_factory=Solver)
     effects: Effects = field(default_factory=Effects)
@@ -652,6 +692,10 @@ def _check_consistency(s: Scene) -> None:
         _check_thermal(s)
     if s.effects.base_excitation:
         _check_ground(s)
+    if s.effects.unbalance_change:
+        _check_unbalance_change(s)
+    if s.effects.external_load:
+        _check_external_load(s)
     if s.effects.semi_active_damper:
         sp = s.support
         if not s.effects.housing:
@@ -721,6 +765,29 @@ def _check_ground(s: Scene) -> None:
             load_record(g.record)
         except ValueError as exc:
             raise SceneError(str(exc)) from None
+
+
+def _check_unbalance_change(s: Scene) -> None:
+    """The change has a rotating unbalance to change (its spin angle state)."""
+    if not s.effects.unbalance or s.unbalance.mass * s.unbalance.radius == 0.0:
+        raise SceneError("effects.unbalance_change = true needs effects.unbalance = true and"
+                         " unbalance.mass x unbalance.radius > 0 (the unbalance that changes;"
+                         f" got effects.unbalance = {s.effects.unbalance},"
+                         f" unbalance.mass = {s.unbalance.mass:g} kg,"
+                         f" unbalance.radius = {s.unbalance.radius:g} m)")
+
+
+def _check_external_load(s: Scene) -> None:
+    """A force to apply; ramps that fit in the step; a station on a flexible rotor."""
+    e = s.external_load
+    if e.peak == 0.0:
+        raise SceneError("effects.external_load = true needs external_load.peak > 0 N")
+    if e.profile == "step" and 2.0 * e.ramp > e.duration:
+        raise SceneError(f"external_load.ramp = {e.ramp:g} s must be <= external_load.duration / 2"
+                         f" = {0.5 * e.duration:g} s (a rise and a fall within the load)")
+    if s.rotor.model == "flexible" and e.z != s.unbalance.z:
+        raise SceneError(f"external_load.z = {e.z:g} m: with rotor.model = 'flexible' the load acts"
+                         f" at the unbalance station; allowed only unbalance.z = {s.unbalance.z:g} m")
 
 
 MIN_THERMAL_TIME_CONSTANT = 0.1     # s: a lumped sleeve cools no faster (physics/thermal.py)

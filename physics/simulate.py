@@ -10,7 +10,7 @@ import numpy as np
 from .equilibrium import levitated_state
 from .integrate import (N_PEAK, NOT_FINITE, OK, SAMPLE_BLOCK, STEP_COLLAPSE, TOO_MANY_STEPS,
                         integrate_segment, sample_diagnostics)
-from .model import N_AUX, AMB_NONE, F_AMB, Model, build_model
+from .model import EFFECTS, N_AUX, AMB_NONE, F_AMB, Model, build_model
 from .results import Result, RunStats
 from .scene import Scene, SceneError, param_meta
 
@@ -127,15 +127,30 @@ def warm_up(model: Model) -> float:
 
 
 def segments(model: Model, t_end: float) -> list[tuple[float, float, bool]]:
-    """(start, end, AMB powered) pieces of the run, split exactly at the fault time."""
+    """(start, end, AMB powered) pieces of the run, split exactly at the fault time and at the
+    times an event's force jumps or kinks (:func:`event_times`), so that a step boundary meets
+    each of them."""
     t_off = model.scene.amb.off_time
     if model.I[F_AMB] == AMB_NONE:
-        return [(0.0, t_end, False)]
-    if t_off >= t_end:
-        return [(0.0, t_end, True)]
-    if t_off <= 0.0:
-        return [(0.0, t_end, False)]
-    return [(0.0, t_off, True), (t_off, t_end, False)]
+        pieces = [(0.0, t_end, False)]
+    elif t_off >= t_end:
+        pieces = [(0.0, t_end, True)]
+    elif t_off <= 0.0:
+        pieces = [(0.0, t_end, False)]
+    else:
+        pieces = [(0.0, t_off, True), (t_off, t_end, False)]
+    for t in event_times(model.scene):
+        pieces = [part for a, b, powered in pieces
+                  for part in (((a, t, powered), (t, b, powered)) if a < t < b
+                               else ((a, b, powered),))]
+    return pieces
+
+
+def event_times(scene) -> tuple[float, ...]:
+    """The times the switched-on effects' forces jump or kink: what the effects with a
+    ``breaks(scene)`` return (an event's start and end)."""
+    return tuple(sorted({t for effect in EFFECTS if hasattr(effect, "breaks")
+                         for t in effect.breaks(scene)}))
 
 
 def run_segments(integ: Integrator, y: np.ndarray, t_end: float, t_out=None, Y=None,
