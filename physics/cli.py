@@ -121,7 +121,15 @@ def summary_table(m: dict) -> str:
 def _contact_line(m: dict) -> str:
     fc = m["first_contact_after_fault_s"]
     if not m["fault_simulated"]:
-        return "no fault in the simulated time (the AMBs never switched off)"
+        if not m["amb_on_events"]:
+            return "no fault in the simulated time (the AMBs never switched off)"
+        from .metrics import valid_or_before
+        t0 = m["first_contact_time_s"]
+        touched = ("no retainer contact" if t0 is None else
+                   f"first retainer contact at t = {t0 * 1e3:.2f} ms, peak contact force "
+                   + ", ".join(f"{p} {valid_or_before(v, 'pre_fault_peak_contact_force_N'):.0f} N"
+                               for p, v in m["planes"].items()))
+        return f"AMBs on throughout ({', '.join(m['amb_on_events'])}): {touched}"
     if fc is None:
         return "no contact"
     if fc < 0.0:

@@ -490,12 +490,12 @@ def sampled_peaks_missed(planes: dict, stepped: dict | None) -> list[dict]:
 def warnings_of(m: dict, scene) -> list[str]:
     """One line per failed check of :func:`check_metrics` and per aliased whirl plane."""
     out = []
-    if not m["fault_simulated"]:
+    if not m["fault_simulated"] and not m["amb_on_events"]:
         out.append(f"no fault in the simulated time: the AMBs switch off at amb.off_time = "
                    f"{scene.amb.off_time:g} s, not before the end t_end = {m['t_end']:g} s; no drop "
                    "happened, the per-plane and retainer numbers are the levitated rotor's at the "
                    "last sample (raise --t-end / solver.t_end above amb.off_time)")
-    if m["contact_before_fault"]:
+    if m["contact_before_fault"] and not m["amb_on_events"]:
         peaks = ", ".join(f"{p} {valid_or_before(v, 'pre_fault_peak_contact_force_N'):.0f} N"
                           for p, v in m["planes"].items())
         out.append(f"the rotor touches the retainer bearings before the fault, while levitated "
@@ -605,6 +605,7 @@ def compute_metrics(result: Result) -> dict:
     t_fault = result.t_fault if result.t_fault is not None else result.t[-1]
     t_fc = first_contact_time(result)
     out = dict(scene=result.model.scene.name, t_end=float(result.t[-1]), t_fault_s=result.t_fault,
+               amb_on_events=result.model.scene.events(),
                first_contact_time_s=t_fc,
                first_contact_after_fault_s=(t_fc - t_fault) if t_fc is not None else None,
                final_rotor_speed_rpm=float(result.rotor_speed[-1] * RPM),

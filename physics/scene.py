@@ -396,6 +396,10 @@ class Effects:
                                     " half-sine or held step; no state)", tag="A")
 
 
+#: the effects that are events for a levitated rotor (shock, unbalance change, external load):
+#: a scene with one on is about the AMBs-on response, whether or not the AMBs fail later
+EVENT_EFFECTS = ("base_excitation", "unbalance_change", "external_load")
+
 GROUPS: dict[str, type] = {
     "rotor": Rotor, "positions": Positions, "unbalance": Unbalance, "world": World, "amb": Amb,
     "contact": Contact, "stator": Stator, "sleeve": Sleeve, "thermal": Thermal, "bearing": Bearing,
@@ -435,6 +439,11 @@ class Scene:
         _check_consistency(self)
 
     # -- access ---------------------------------------------------------------------------
+    def events(self) -> list[str]:
+        """The events this scene switches on that push a levitated rotor (AMBs on) into its
+        retainers: the names of :data:`EVENT_EFFECTS` that are on, in that order."""
+        return [name for name in EVENT_EFFECTS if getattr(self.effects, name)]
+
     def get(self, key: str) -> Any:
         group, name = _split_key(key)
         return getattr(getattr(self, group), name)
