@@ -34,7 +34,10 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 # the cheap kinematic and cross checks first (with -x a mutant stops at its first failure)
-TESTS = ("tests/physics/test_kinematics.py",
+TESTS = (# single impacts: the Hunt-Crossley loss, the stator mount's momentum balance
+         "tests/physics/test_contact_law.py::test_hunt_crossley_impact_loses_the_work_of_its_hysteresis",
+         "tests/physics/test_stator.py::test_the_stator_mount_takes_the_reaction_of_the_contact_force",
+         "tests/physics/test_kinematics.py",
          # the workless gyroscopic couplings: only a cross-check with the linearised rotor sees them
          "tests/physics/flexible/test_flexible_campbell.py::"
          "test_the_drop_kernel_whirls_as_the_linearised_flexible_rotor",

@@ -64,6 +64,48 @@ def test_hunt_crossley_damping_gives_the_restitution_at_the_reference_speed():
     assert rebound(0.3 * v_ref) > rebound(v_ref)
 
 
+def impact(v0, chi, m=48.65, h=5e-8):
+    """A mass m hitting the hertz_line law at v0 (symplectic Euler on hunt_crossley): (exit
+    speed, the power (F - F_el) delta' of the hysteresis part integrated over the contact)."""
+    x, v, dissipated = 0.0, v0, 0.0
+    while x >= 0.0:
+        f_el = line_elastic_force(x, A, C)
+        f = hunt_crossley(f_el, v, chi)
+        dissipated += h * (f - f_el) * v
+        v -= h * f / m
+        x += h * v
+    return -v, dissipated
+
+
+def elastic_damping_work(v0, chi, m=48.65, n=4000):
+    """First order in chi v0: the hysteresis work along the undamped impact, 2 chi ∫ F_el(δ) δ'(δ) dδ
+    over the approach to δ_max (½ m v0² = V(δ_max)), with δ'² = v0² - 2 V(δ)/m (rebound mirrored)."""
+    lo, hi = 0.0, 1e-3                                  # δ_max by bisection on V(δ) = ½ m v0²
+    for _ in range(80):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if line_potential(mid, A, C) < 0.5 * m * v0 * v0 else (lo, mid)
+    d = lo * (1.0 - np.cos(np.linspace(0.0, 0.5 * np.pi, n)))       # dense near δ_max
+    rate = np.sqrt(np.maximum(v0 * v0 - 2.0 * np.array([line_potential(x, A, C) for x in d]) / m, 0.0))
+    g = np.array([line_elastic_force(x, A, C) for x in d]) * rate
+    return 2.0 * chi * float(np.sum(0.5 * (g[1:] + g[:-1]) * np.diff(d)))
+
+
+@pytest.mark.parametrize("v_scale", [0.1, 0.3])
+def test_hunt_crossley_impact_loses_the_work_of_its_hysteresis(v_scale):
+    """One impact on the hertz_line law, slow enough that chi v0 << 1: the kinetic energy it loses
+    is the work of the hysteresis part chi F_el delta' of the force (the balance closes), that work
+    is a loss (> 0, so e < 1), and it matches the first-order estimate along the undamped impact,
+    2 chi ∫ F_el delta' d delta (the loss grows as chi v0: 1 - e² ∝ chi v0 for this law too)."""
+    m, v_ref = 48.65, math.sqrt(2 * 9.80665 * C)
+    chi = hysteresis_factor(0.9, v_ref)
+    v0 = v_scale * v_ref
+    v1, dissipated = impact(v0, chi)
+    lost = 0.5 * m * (v0 * v0 - v1 * v1)
+    assert lost == pytest.approx(dissipated, rel=1e-4)             # the balance of the impact
+    assert lost > 0.0 and v1 < v0                              # a loss: e < 1
+    assert lost == pytest.approx(elastic_damping_work(v0, chi), rel=1.5 * chi * v0)   # next order: ~chi v0
+
+
 @pytest.fixture(scope="module")
 def hertz_drops():
     return {mu: simulate(load_scene("paper", {"contact.law": "hertz_line", "contact.friction": mu}),

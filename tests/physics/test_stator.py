@@ -242,3 +242,38 @@ def test_each_amb_plane_damps_the_impact_of_its_own_mass_share():
         assert c == pytest.approx(2.0 * damping_ratio(e) * math.sqrt(k * mk), rel=1e-12)
         assert point_mass_rebound(mk, k, c, 600e-6, 0.1) == pytest.approx(e, rel=2e-3)
     assert m.P[i] / m.P[i + 1] == pytest.approx(math.sqrt(shares[0] / shares[1]), rel=1e-12)
+
+
+def test_the_stator_mount_takes_the_reaction_of_the_contact_force():
+    """Newton's third law at the stator, from the recorded motion alone: the rotor, not spinning,
+    falls straight onto both mounted stators (no friction); over the first impact each stator's
+    momentum changes by the impulse of the contact's reaction F_n n (n the unit vector from the
+    stator centre to the rotor axis: the contact pushes the stator outward, after the rotor) and of its
+    mount's spring and dashpot, m_m Δq' = ∫ (F_n n - k_m q - c_m q') dt, from the first contact
+    sample on (the dashpot's jump at the touch falls between samples). A short run (0.4 ms of
+    contact), so an error in the reaction shows as a wrong impulse, not as a blow-up."""
+    ov = {"effects.stator_contact": True, "effects.stator_mount": True, "stator.friction": 0.0,
+          "contact.clearance": 0.003, "rotor.speed_rpm": 0.0, "effects.unbalance": False,
+          "solver.output_rate": 2e6, "solver.rtol": 1e-9}
+    scene = load_scene("paper", ov)
+    gap, g = scene.amb.air_gap, 9.80665
+    t_touch = scene.amb.off_time + math.sqrt(2.0 * gap / g)          # free fall through the gap
+    r = simulate(scene, t_end=t_touch + 4e-4)
+    st = scene.stator
+    k, m = st.mount_stiffness, st.mount_mass
+    c = 2.0 * st.mount_damping_ratio * math.sqrt(k * m)
+    for plane in ("AMB1", "AMB2"):
+        f_n = r.stator_force(plane)
+        assert f_n.max() > 1e3                                        # a real impact
+        q = r.stator(plane)
+        qv = np.column_stack([r.state(f"{plane}.stator_vx"), r.state(f"{plane}.stator_vy")])
+        d = r.amb_orbit(plane) - q                                    # rotor axis from the stator
+        n = d / np.maximum(np.hypot(d[:, 0], d[:, 1]), 1e-300)[:, None]
+        force = f_n[:, None] * n - k * q - c * qv                     # on the stator
+        impulse = np.concatenate(([[0.0, 0.0]], np.cumsum(
+            0.5 * (force[1:] + force[:-1]) * np.diff(r.t)[:, None], axis=0)))
+        i = np.flatnonzero(f_n > 0.0)[0]                              # the first contact sample
+        change = m * (qv - qv[i]) - (impulse - impulse[i])
+        peak = m * np.abs(qv[i:, 1]).max()
+        np.testing.assert_allclose(change[i:], 0.0, atol=1e-4 * peak)
+        assert q[i:, 1].min() < -1e-7 and peak > 0.0                 # pushed down, away
