@@ -188,12 +188,20 @@ def _soft_600(a, _c):
 
 
 def _same_regime(e1: dict, e2: dict, key: str) -> tuple[float, float, str]:
-    """Medians of ``key`` over drops with the same outcome in both ensembles where possible."""
-    prob = f"whirl probability {e1['whirl_probability']:.2f} vs {e2['whirl_probability']:.2f}"
-    for tag, text in (("no_whirl", "non-whirling drops"), ("whirl", "whirling drops")):
-        if e1[tag]["members"] and e2[tag]["members"]:
-            return e1[tag][key]["median"], e2[tag][key]["median"], f"{text} ({prob})"
-    return e1[key]["median"], e2[key]["median"], f"all drops, in different regimes ({prob})"
+    """Medians of ``key`` over drops with the same outcome in both ensembles where possible; a
+    ValueError (the claim is then not computable) where neither ensemble has a value (every
+    drop left validity before it could be measured)."""
+    prob = (f"whirl probability {_fmt(e1['whirl_probability'])} vs "
+            f"{_fmt(e2['whirl_probability'])}")
+    candidates = [(e1[tag][key]["median"], e2[tag][key]["median"], f"{text} ({prob})")
+                  for tag, text in (("no_whirl", "non-whirling drops"), ("whirl", "whirling drops"))
+                  if e1[tag]["members"] and e2[tag]["members"]]
+    candidates.append((e1[key]["median"], e2[key]["median"],
+                       f"all drops, in different regimes ({prob})"))
+    for a, b, note in candidates:
+        if a is not None and b is not None:
+            return a, b, note
+    raise ValueError(f"no {key} in both ensembles: their drops left validity before it")
 
 
 def _soft_settles(a, _c):

@@ -277,3 +277,22 @@ def test_a_sweep_over_a_flexible_rotor_sees_its_softer_impact(tmp_path):
     assert all(run["ok"] and "--scene paper-flexible" in run["command"] for run in flex["runs"])
     soft, stiff = rest["peak_contact_force_N"]["max"], rigid["cells"][0]["peak_contact_force_N"]["min"]
     assert 0.8 * stiff < soft < 0.95 * stiff
+
+
+def test_a_claim_whose_drops_all_left_validity_is_not_computable_not_a_crash():
+    """Settling medians of drops that left validity before settling are None: the claim then
+    says which quantity is missing (ValueError, reported as 'not computable'), and the same
+    regime is still preferred where both ensembles have a value."""
+    from physics.runs.study.claims import _same_regime
+
+    def ensemble(p, whirl, no_whirl, overall):
+        return {"whirl_probability": p, "force_settling_s": {"median": overall},
+                "whirl": {"members": 1, "force_settling_s": {"median": whirl}},
+                "no_whirl": {"members": 1, "force_settling_s": {"median": no_whirl}}}
+
+    a, b, note = _same_regime(ensemble(0.5, 0.2, None, 0.3), ensemble(None, 0.4, None, 0.5),
+                              "force_settling_s")
+    assert (a, b) == (0.2, 0.4) and note.startswith("whirling drops")
+    with pytest.raises(ValueError, match="no force_settling_s in both ensembles"):
+        _same_regime(ensemble(None, None, None, None), ensemble(0.1, None, None, None),
+                     "force_settling_s")
