@@ -10,8 +10,8 @@ the 20 validation drops after every evaluation, every 10 000 of its 1e6 steps).
 
 The tuned constants are stored with a record of what they were tuned under
 (``agents/benchmarking/tuned/<suite>.json``, package data, read by :mod:`agents.benchmarking.tuned`): the env id (its version is the
-``-vN`` suffix), the package version, the seat and control step, the suite's sensing and a
-*sensing fingerprint* (:func:`sensing_fingerprint`: a hash of the observations of one short
+``-vN`` suffix), the package version (for the reader: not compared), the seat and control step,
+the suite's sensing and a *sensing fingerprint* (:func:`sensing_fingerprint`: a hash of the observations of one short
 validation drop, which changes whenever the sensing model or the plant does). The benchmark
 runs a designed row with its tuned constants (:func:`tuned_gains`); the test suite fails when a
 shipped record no longer matches the current environment, so a change of the sensing or the
@@ -49,6 +49,11 @@ DESIGNED: dict[str, Designed] = {d.name: d for d in (
     Designed("whirl-brake", {"kp": (0.0, 30.0), "kd": (0.0, 5.0), "kc": (-3.0, 3.0),
                              "kt": (-0.5, 0.5), "kr": (-1.0, 1.0), "ff": (0.0, 2.0)}, 20),
 )}
+
+
+#: recorded for the reader, not compared: a release that changes neither the plant nor the
+#: sensing (the fingerprint says) leaves a tuning valid
+INFORMATIVE = ("package_version",)
 
 
 def package_version() -> str:
@@ -104,7 +109,8 @@ def stale(suite, name: str) -> list[str]:
     if rec is None:
         raise ValueError(f"no tuned record of {name} on the {suite.name} suite")
     now = environment_record(suite, BASELINES[name], rec["env_id"])
-    return [k for k, v in now.items() if json.loads(json.dumps(v)) != rec["tuned_under"].get(k)]
+    return [k for k, v in now.items()
+            if k not in INFORMATIVE and json.loads(json.dumps(v)) != rec["tuned_under"].get(k)]
 
 
 def budget_plan(designed: Designed, episodes: int, drops: int) -> int:
