@@ -168,10 +168,11 @@ def _support_row(a, k):
 
 def _stiff(a, k):
     """The nominal drop's row at support stiffness ``k``; a ValueError (the claim is then not
-    computable) when it left the contact laws' validity: its forces and displacements are None."""
+    computable) when it left validity: its forces and displacements are None."""
     r = _support_row(a, k)
     if r.get("beyond_validity_at_s") is not None:
-        raise ValueError(f"the K_s = {k:g} drop left the contact law's validity at t = "
+        raise ValueError(f"the K_s = {k:g} drop left validity (the first bound it passed: the "
+                         f"contact law's, the AMB air gap or the stator's) at t = "
                          f"{r['beyond_validity_at_s']:.3f} s: its forces and displacements are n/a")
     return r
 
@@ -193,11 +194,12 @@ def _same_regime(e1: dict, e2: dict, key: str) -> tuple[float, float, str]:
     drop left validity before it could be measured)."""
     prob = (f"whirl probability {_fmt(e1['whirl_probability'])} vs "
             f"{_fmt(e2['whirl_probability'])}")
-    candidates = [(e1[tag][key]["median"], e2[tag][key]["median"], f"{text} ({prob})")
+    def median(e: dict):                 # an empty class's statistics carry no median
+        return (e.get(key) or {}).get("median")
+    candidates = [(median(e1[tag]), median(e2[tag]), f"{text} ({prob})")
                   for tag, text in (("no_whirl", "non-whirling drops"), ("whirl", "whirling drops"))
                   if e1[tag]["members"] and e2[tag]["members"]]
-    candidates.append((e1[key]["median"], e2[key]["median"],
-                       f"all drops, in different regimes ({prob})"))
+    candidates.append((median(e1), median(e2), f"all drops, in different regimes ({prob})"))
     for a, b, note in candidates:
         if a is not None and b is not None:
             return a, b, note

@@ -296,3 +296,7 @@ def test_a_claim_whose_drops_all_left_validity_is_not_computable_not_a_crash():
     with pytest.raises(ValueError, match="no force_settling_s in both ensembles"):
         _same_regime(ensemble(None, None, None, None), ensemble(0.1, None, None, None),
                      "force_settling_s")
+    empty = ensemble(0.0, None, None, None)
+    empty["force_settling_s"] = {}                  # no drop measured at all: no statistics
+    with pytest.raises(ValueError, match="no force_settling_s in both ensembles"):
+        _same_regime(empty, ensemble(0.1, None, None, None), "force_settling_s")
