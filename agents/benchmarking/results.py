@@ -727,8 +727,9 @@ def readme_block(root: Path = ROOT) -> str:
     full = [e for e in nominal["leaderboard"] if e["task"] == "full"]
     return "\n".join([f"`rotordrop benchmark`, damping and re-levitation together "
                       f"(`RotorDrop-Full-v1`, passive threshold μ\\* = {_f(nominal['passive_threshold'], 'g')}"
-                      + (f", {nominal['score']} score; SE and Δ: paired bootstrap over the drops against "
-                         "the best designed row" if nominal.get("score") else "")
+                      + (f", {nominal['score']} score; SE and Δ: "
+                         f"{(nominal.get('bootstrap') or {}).get('method', 'paired bootstrap over the drops')}"
+                         ", against the best designed row of any seat" if nominal.get("score") else "")
                       + "); every table: [docs/results.md](docs/results.md).", ""]
                      + leaderboard_table(full))
 
