@@ -300,3 +300,18 @@ def test_a_claim_whose_drops_all_left_validity_is_not_computable_not_a_crash():
     empty["force_settling_s"] = {}                  # no drop measured at all: no statistics
     with pytest.raises(ValueError, match="no force_settling_s in both ensembles"):
         _same_regime(empty, ensemble(0.1, None, None, None), "force_settling_s")
+
+
+def test_a_claim_that_cannot_be_computed_still_names_the_paper_statement_and_criterion():
+    """An analysis without data (every section empty) gives 14 rows, none reproduced, each with
+    the paper's statement, value and criterion, and 'ours' saying why it is not computable."""
+    from physics.runs.study.claims import claims
+
+    rows = claims({"friction_onset": {}, "friction_observables": {}, "support_stiffness": [],
+                   "support_damping": []}, 300.0)
+    assert len(rows) == 14 and not any(r["reproduced"] for r in rows)
+    for r in rows:
+        assert r["claim"][0] not in "(" and r["paper"] != "-" and r["criterion"] != "-"
+        assert r["ours"].startswith("not computable from this run")
+    assert rows[3]["paper"] == "orbit beyond the 300 µm circle"
+    assert rows[0]["criterion"] == "|threshold − 0.39| ≤ 0.03"
