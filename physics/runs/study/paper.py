@@ -247,8 +247,12 @@ def _friction(plan: Plan, outs: list[Outcome]) -> dict:
             mus = [o.run.label["friction"] for o in ok]
             whirls = [_whirl(o) for o in ok]
             curve = probability_curve(mus, whirls)
-            for c in curve:
-                at = [o for o in grp if round(o.run.label["friction"], 6) == c["value"]]
+            decided = {c["value"]: c for c in curve}
+            # every μ of the grid gets a row: one whose drops all left validity before their whirl
+            # verdict has no probability (None) but its undecided count
+            for mu in sorted({round(o.run.label["friction"], 6) for o in grp}):
+                c = decided.get(mu, dict(value=mu, probability=None, runs=0, whirls=0))
+                at = [o for o in grp if round(o.run.label["friction"], 6) == mu]
                 c["failed"] = sum(1 for o in at if not o.ok)
                 probability.append(dict(friction=c["value"], slip=slip, bearing_friction=drag,
                                         probability=c["probability"], runs=c["runs"],

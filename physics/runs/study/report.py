@@ -33,8 +33,14 @@ def plot_probability(a: dict, out: Path) -> str:
         rows = [r for r in a["whirl_probability"] if r["slip"] == slip and r["bearing_friction"] == drag]
         if not rows:
             continue
-        ax.plot([r["friction"] for r in rows], [r["probability"] for r in rows], st, marker=".",
-                ms=4, lw=1.2, label=f"{slip} slip, bearing drag {'on' if drag else 'off'}")
+        ax.plot([r["friction"] for r in rows],
+                [np.nan if r["probability"] is None else r["probability"] for r in rows], st,
+                marker=".", ms=4, lw=1.2, label=f"{slip} slip, bearing drag {'on' if drag else 'off'}")
+        undecided = [(r["friction"], r["undecided"] / (r["runs"] + r["undecided"])) for r in rows
+                     if r["undecided"]]
+        if undecided and (slip, drag) == (PRIMARY_SLIP, True):
+            ax.plot(*zip(*undecided), "x", color="0.4", ms=5,
+                    label=f"undecided share ({slip} slip, drag on): left validity before the verdict")
     ax.axhline(0.5, color="0.6", lw=0.8)
     ax.axvline(PAPER_THRESHOLD, color="k", ls="--", lw=0.8, label="paper: whirl from μ = 0.39")
     ax.set_xlabel("friction coefficient μ")
@@ -43,6 +49,22 @@ def plot_probability(a: dict, out: Path) -> str:
     ax.set_title(f"Backward-whirl probability over {a['plan']['members']} equally plausible drops per μ")
     ax.legend(fontsize=8, loc="center right")
     return _save(fig, out / "whirl_probability.png")
+
+
+def _undecided_note(rows: list[dict]) -> str:
+    """How many drops of the friction study left validity before their whirl verdict (counted
+    apart from the probability), and at which μ (primary slip law, drag on)."""
+    n = sum(r["undecided"] for r in rows)
+    if not n:
+        return "\nEvery drop of the friction study was decided (whirl or not) within validity.\n"
+    mine = [r for r in rows if r["slip"] == PRIMARY_SLIP and r["bearing_friction"] and r["undecided"]]
+    none = [r["friction"] for r in mine if r["probability"] is None]
+    where = (f"; with {PRIMARY_SLIP} slip and drag on, {sum(r['undecided'] for r in mine)} at "
+             f"μ = {mine[0]['friction']:.2f} … {mine[-1]['friction']:.2f}" if mine else "")
+    return (f"\n{n} drops left validity before their whirl verdict (undecided, counted apart from "
+            f"the probability: grey crosses in the figure){where}"
+            + (f"; from μ = {none[0]:.2f} on, some μ have no decided drop at all ({len(none)} "
+               f"grid values)" if none else "") + ".\n")
 
 
 def _orbit_row(runs: dict[float, Result], label: str, path: Path, width: float, share: bool) -> str:
@@ -255,6 +277,7 @@ def write_report(a: dict, out: Path, figures: dict[str, list[str]], meta: dict) 
       "logistic fit uses every drop. More than one 50 % crossing means whirling and non-whirling "
       "μ interleave below the μ from which every drop whirls: whirl is then a probability over "
       "μ, not a threshold (- in the column).\n")
+    w(_undecided_note(a["whirl_probability"]))
     w(f"![orbits]({figures['friction'][0]})\n")
     w(f"![forces]({figures['friction'][1]})\n")
     w(f"![sleeve speed]({figures['friction'][2]})\n")

@@ -315,3 +315,21 @@ def test_a_claim_that_cannot_be_computed_still_names_the_paper_statement_and_cri
         assert r["ours"].startswith("not computable from this run")
     assert rows[3]["paper"] == "orbit beyond the 300 µm circle"
     assert rows[0]["criterion"] == "|threshold − 0.39| ≤ 0.03"
+
+
+def test_the_report_names_friction_values_whose_drops_all_left_validity_before_the_verdict():
+    """A μ whose drops all reached a validity bound before their whirl verdict has no probability
+    but is not dropped: the report counts the undecided drops and says from which μ none is
+    decided."""
+    from physics.runs.study.report import _undecided_note
+
+    def row(mu, p, runs, undecided, slip="kinematic"):
+        return dict(friction=mu, slip=slip, bearing_friction=True, probability=p, runs=runs,
+                    whirls=0, failed=0, undecided=undecided)
+
+    rows = [row(0.30, 0.0, 13, 3), row(0.37, 0.06, 16, 0), row(0.38, None, 0, 16),
+            row(0.39, None, 0, 16), row(0.38, None, 0, 16, slip="paper")]
+    note = _undecided_note(rows)
+    assert "51 drops left validity" in note and "35 at μ = 0.30 … 0.39" in note
+    assert "from μ = 0.38 on" in note and "(2 grid values)" in note
+    assert "was decided" in _undecided_note([row(0.30, 0.0, 16, 0)])
