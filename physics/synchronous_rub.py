@@ -263,3 +263,57 @@ def simulated_rub(result, window: float) -> dict:
                 contact_force=float(np.mean(result.contact_force("RB1")[i:])),
                 penetration=float(np.mean(result.penetration("RB1")[i:])),
                 speed=float(np.mean(result.rotor_speed[i:])), phase_deg=math.degrees(lead))
+
+
+def free_orbit(scene, speed_rpm: float | None = None, plant: RubPlant | None = None) -> float | None:
+    """The contact-free synchronous orbit's radius [m] by the same balance without the contact,
+    |K_amb(|X|) − m Ω²/2| |X| = (U/2) Ω² (the smallest root), or None if the rotor cannot whirl
+    inside the clearance (no root below c): then every steady state touches."""
+    plant = plant or RubPlant(scene)
+    omega = (scene.rotor.speed_rpm if speed_rpm is None else speed_rpm) * math.pi / 30.0
+    target = 0.5 * plant.U * omega ** 2
+    if target <= 0.0:
+        return 0.0
+
+    def g(a):
+        return abs(plant.amb_stiffness(a, omega)[0] - 0.5 * plant.m * omega ** 2) * a - target
+
+    grid = np.geomspace(1e-9, plant.c, 120)
+    vals = np.array([g(a) for a in grid])
+    up = np.flatnonzero((vals[:-1] < 0) & (vals[1:] >= 0))
+    if up.size == 0:
+        return None
+    lo, hi = grid[up[0]], grid[up[0] + 1]
+    for _ in range(50):
+        mid = math.sqrt(lo * hi)
+        lo, hi = (mid, hi) if g(mid) < 0 else (lo, mid)
+    return math.sqrt(lo * hi)
+
+
+def contact_stiffened_speed(scene, load: float, plant: RubPlant | None = None) -> float | None:
+    """The rotor's synchronous natural frequency [rpm] while it presses into its sleeves with the
+    contact force ``load`` [N]: the lowest Ω with Re[K_amb(Ω) + K_c(Ω)] = m Ω²/2, K_c the series
+    of the contact's tangent stiffness at ``load`` and the sleeve's dynamic stiffness on its
+    bearing and housing (f_s / S of (R3)–(R5)); None if there is none below 60 000 rpm. Below it
+    the in-contact response to the unbalance is in phase with it and pushes into the sleeve."""
+    plant = plant or RubPlant(scene)
+    if not load > 0.0:
+        raise ValueError(f"load = {load!r} N: allowed > 0")
+    c = scene.contact
+    k_contact = c.exponent * c.stiffness * (load / c.stiffness) ** ((c.exponent - 1) / c.exponent)
+
+    def net(omega):
+        S = plant.support(complex(load), omega, omega)[0]
+        k_chain = 1.0 / (1.0 / k_contact + S / load)
+        return (plant.amb_stiffness(1e-7, omega)[0] + k_chain).real - 0.5 * plant.m * omega ** 2
+
+    grid = np.linspace(10.0, 60000 * math.pi / 30, 600)
+    vals = np.array([net(w) for w in grid])
+    down = np.flatnonzero((vals[:-1] > 0) & (vals[1:] <= 0))
+    if down.size == 0:
+        return None
+    lo, hi = grid[down[0]], grid[down[0] + 1]
+    for _ in range(50):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if net(mid) > 0 else (lo, mid)
+    return 0.5 * (lo + hi) * 30 / math.pi
