@@ -14,7 +14,8 @@ from physics.ball_bearing import ball_forces, film_thickness
 from physics.model import P_CB, P_FILM, P_HALF_PLAY, P_KS, P_KTOT, P_MH, P_MS, P_NB
 from physics.scene import SceneError
 from physics.persistence import end_state
-from physics.synchronous_rub import RubPlant, rub_solutions, simulated_rub
+from physics.synchronous_rub import (RubPlant, contact_stiffened_speed, free_orbit, rub_solutions,
+                                     simulated_rub)
 
 RUB = {"effects.gravity": False}
 #: the stated tolerances of the check (docs/physics.md)
@@ -110,3 +111,22 @@ def test_scenes_outside_the_derivation_are_refused_by_name():
         rub_solutions(load_scene("amb-persistent"), speed_rpm=-5.0)
     with pytest.raises(ValueError, match="window"):
         simulated_rub(simulate(load_scene("amb-persistent", {"solver.t_end": 0.01})), 1.0)
+
+
+def test_the_contact_free_orbit_is_the_simulated_one_without_a_shock(scene, plant):
+    """Without the shock the preset stays contact-free; its orbit radius at RB1 is the balance's
+    without the contact (no gravity), within 1 %."""
+    result = simulate(scene.with_overrides({"effects.base_excitation": False}))
+    assert end_state(result).label == "contact_free"
+    a = free_orbit(scene, plant=plant)
+    assert simulated_rub(result, 0.05)["amplitude"] == pytest.approx(a, rel=0.01)
+    assert free_orbit(scene.with_overrides({"unbalance.mass": 0.5})) is None   # it cannot fit
+
+
+def test_a_stiffer_support_raises_the_contact_stiffened_speed(scene, plant):
+    soft = load_scene("amb-persistent", {**RUB, "support.stiffness": 5e7})
+    stiff = contact_stiffened_speed(scene, 4000.0, plant)
+    assert contact_stiffened_speed(soft, 4000.0) < stiff
+    assert stiff > scene.rotor.speed_rpm         # the preset runs below it: the rub pushes in
+    with pytest.raises(ValueError, match="load"):
+        contact_stiffened_speed(scene, 0.0, plant)
