@@ -208,7 +208,8 @@ def tables(data: dict) -> str:
         lines.append("| none | | | " + " | " * (len(data["shocks_g"]) - 1) + " |")
     lines += ["", "Harmonic balance against the simulated steady rub (stiff support, no gravity,"
               f" shocked at 10 g; the last {data['check_window_s'] * 1e3:g} ms at RB1; the"
-              " balance at the run's own mean speed):", "",
+              " balance at the run's own mean speed; phase: the orbit's angle minus the unbalance"
+              " force's, < 0 when the orbit lags it):", "",
               "| speed [rpm] | unbalance [kg] | end state | orbit \\|X\\| sim / HB [µm] | error |"
               " contact force sim / HB [N] | error | phase sim / HB [°] | difference |"
               " PID peak command [A] |", "|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|"]
