@@ -90,6 +90,18 @@ def first_contact_time(result: Result) -> float | None:
     return min((t for t in times if t is not None), default=None)
 
 
+def backward_turns(e: np.ndarray, r: np.ndarray, clearance: float,
+                   spin: float) -> tuple[np.ndarray, np.ndarray]:
+    """The orbit ``e`` (N, 2) of the rotor in its sleeve turns between consecutive samples that
+    both lie beyond WHIRL_RADIUS_FRACTION x ``clearance`` (``r``: its radius): (the turns [rad],
+    > 0 against the sign of ``spin``, i.e. backward; the mask of the sample pairs that count)."""
+    ang = np.arctan2(e[:, 1], e[:, 0])
+    far = r > WHIRL_RADIUS_FRACTION * clearance
+    both = far[1:] & far[:-1]
+    dang = (np.diff(ang)[both] + np.pi) % (2 * np.pi) - np.pi
+    return -spin * dang, both
+
+
 def whirl(result: Result, plane: str, after: float) -> dict:
     """Backward-whirl detection from the orbit of the rotor relative to its sleeve.
 
@@ -104,17 +116,13 @@ def whirl(result: Result, plane: str, after: float) -> dict:
     c = result.model.scene.contact.clearance
     spin = (np.sign(result.rotor_speed[i:].mean()) or 1.0) if i < len(result.t) else 1.0
     r = result.radius_after(plane, after, relative=True)
-    ang = np.arctan2(e[:, 1], e[:, 0])
-    far = r > WHIRL_RADIUS_FRACTION * c
-    both = far[1:] & far[:-1]
-    dang = (np.diff(ang)[both] + np.pi) % (2 * np.pi) - np.pi
-    backward_rad = -spin * dang.sum()
-    revs = backward_rad / (2 * np.pi)
+    back, both = backward_turns(e, r, c, spin)
+    revs = back.sum() / (2 * np.pi)
     dt = np.diff(t)[both]
-    moving_back = -spin * dang > 0
+    moving_back = back > 0
     t_back = dt[moving_back].sum()
-    freq = (-spin * dang[moving_back]).sum() / (2 * np.pi * t_back) if t_back > 0 else None
-    aliased = bool(dang.size and np.max(np.abs(dang)) > ALIAS_ANGLE)
+    freq = back[moving_back].sum() / (2 * np.pi * t_back) if t_back > 0 else None
+    aliased = bool(back.size and np.max(np.abs(back)) > ALIAS_ANGLE)
     is_whirl = bool(revs >= WHIRL_MIN_REVOLUTIONS)
     return dict(backward_whirl=is_whirl, whirl_revolutions=float(revs),
                 whirl_frequency_hz=float(freq) if (is_whirl and freq is not None) else None,

@@ -35,15 +35,19 @@ from __future__ import annotations
 import argparse
 import csv
 import json
+import sys
 import time
 from pathlib import Path
 
 import matplotlib
 
 matplotlib.use("Agg")
+sys.path.insert(0, str(Path(__file__).parent))   # the sibling generated_block
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from tqdm.auto import tqdm  # noqa: E402
+
+from generated_block import publish  # noqa: E402
 
 from physics import compute_metrics, load_scene, simulate  # noqa: E402
 from physics.campbell import SPRINGS_ONLY, first_bending, flexible_whirl  # noqa: E402
@@ -374,13 +378,6 @@ def figure(data: dict, path: Path) -> None:
     plt.close(fig)
 
 
-def paste(page: Path, block: str) -> None:
-    text = page.read_text()
-    i = text.index(START) + len(START)
-    j = text.index(END, i)
-    page.write_text(text[:i] + block + text[j:])
-
-
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--t-end", type=float, default=1.0)
@@ -401,9 +398,7 @@ def main(argv=None) -> None:
     img.parent.mkdir(parents=True, exist_ok=True)
     write_csv(data, data_path.with_suffix(".csv"))
     figure(data, img)
-    if a.page:
-        paste(Path(a.page), tables(data))
-    print(tables(data))
+    publish(a.page, tables(data), START, END)
 
 
 if __name__ == "__main__":
