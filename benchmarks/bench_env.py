@@ -27,7 +27,7 @@ a machine shared with other jobs) or by the wall clock (``--clock wall``).
   it is (mu = 0.25: drop, bounces, no whirl) and at mu = 0.5, which whirls backward (run on
   through the whirl with ``terminate_on_failure=False``; the physics is costliest there);
 * cost split (passive and damping env, each on one trajectory: the damping env's random actions
-  are replayed as the controls they set): physics alone (``integrate_segment`` over each 1 ms
+  are replayed as the controls they set): physics alone (``integrate_segment_into`` over each 1 ms
   step, in one compiled loop), the step kernel (physics + sub-sampled monitors, reward,
   observation), the Python ``step`` and Gymnasium's wrappers, and the physics' share;
 * batched: ``BatchedRotorDropVecEnv`` with N envs of the damping env, with 1 numba thread (the
@@ -50,7 +50,7 @@ import numpy as np
 import rotordrop_env
 from physics._jit import njit
 from physics.scene import parse_assignment
-from physics.integrate import integrate_segment
+from physics.integrate import integrate_segment_into
 from rotordrop_env import kernels as K
 
 
@@ -145,7 +145,7 @@ def cost_split(env_id: str, kwargs: dict, episodes: int, seed: int = 0,
         counts = np.zeros(3, dtype=np.int64)
         t0 = CLOCK()
         status = _physics_loop(y, b.M[K.M_T], u.dt, controls, b.P, b.I, sv.rtol, b.atol,
-                               b.M[K.M_H], sv.max_step, sv.min_step, work, counts)
+                               b.M[K.M_H], sv.max_step, sv.min_step, work, b.aux.copy(), counts)
         elapsed = CLOCK() - t0
         assert status == 0
         if stats is not None:
@@ -157,16 +157,16 @@ def cost_split(env_id: str, kwargs: dict, episodes: int, seed: int = 0,
 
 
 @njit
-def _physics_loop(y, t, dt, controls, P, I, rtol, atol, h, h_max, h_min, work, counts):
-    """The physics alone: a control step of integrate_segment per row of ``controls`` (the
+def _physics_loop(y, t, dt, controls, P, I, rtol, atol, h, h_max, h_min, work, aux, counts):
+    """The physics alone: a control step of integrate_segment_into per row of ``controls`` (the
     U of each step), in one compiled call; ``counts`` += its right-hand sides, steps and
     rejected steps."""
     no_t = np.empty(0)
     no_Y = np.empty((0, y.shape[0]))
     for k in range(controls.shape[0]):
-        status, _, h, _, n_rhs, n_steps, n_rej = integrate_segment(
+        status, _, h, _, n_rhs, n_steps, n_rej = integrate_segment_into(
             y, t, t + dt, P, I, controls[k], rtol, atol, h, h_max, h_min, False, 10**9, no_t,
-            no_Y, 0, work)
+            no_Y, 0, work, aux)
         counts[0] += n_rhs
         counts[1] += n_steps
         counts[2] += n_rej
@@ -343,7 +343,7 @@ def seat_table(res: dict) -> str:
 
 def _print_split(env_id: str, split: dict) -> None:
     print(f"  cost split of one {env_id} step [µs] (same trajectory):")
-    print(f"    physics (integrate_segment)        {split['physics']:8.1f}")
+    print(f"    physics (integrate_segment_into)   {split['physics']:8.1f}")
     print(f"    + monitors, reward, obs (kernel)   {split['kernel'] - split['physics']:8.1f}"
           f"   (kernel call {split['kernel']:.1f})")
     print(f"    + Python step()                    {split['unwrapped'] - split['kernel']:8.1f}"

@@ -10,7 +10,7 @@ VecEnv run the very same code (the batch owns (N, ...) stacks, each environment 
   of :func:`physics.validity.validity_bound`...),
 * ``out`` float64 per-step results (reward and its terms, flags, status; indices ``O_*``).
 
-The physics is :func:`physics.integrate.integrate_segment` on :func:`physics.model.rhs`; the
+The physics is :func:`physics.integrate.integrate_segment_into` on :func:`physics.model.rhs`; the
 control step is sampled ``n_sub`` times (dense output) for the contact force, whirl and
 re-levitation monitors, so short impacts and fast orbits are not missed between control steps.
 """
@@ -22,7 +22,7 @@ import numba
 import numpy as np
 
 from physics.jit import njit, njit_parallel
-from physics.integrate import integrate_segment
+from physics.integrate import integrate_segment_into
 from physics.model import (A_FR, A_QMAX, A_WS, F_SENSOR, I_AMB_FILT, I_AMB_INT, I_CS,
                            N_AUX_PLANE, P_CLR, ST_AMB1, ST_RB1, S_W, U_AMB_DIRECT, U_AMB_GAIN,
                            U_AMB_POWER, U_CS1, U_ICMD, U_REF0, U_REF_OFF, U_T_ON, amb_currents,
@@ -253,9 +253,9 @@ def step_one(a, y, P, I, U, atol, work, t_sub, Y_sub, aux, cur, C, M, scale, obs
     for k in range(n_sub):
         t_sub[k] = t0 + dt * (k + 1) / n_sub
     t_sub[n_sub - 1] = t1
-    status, t_end, h, _, _, _, _ = integrate_segment(
+    status, t_end, h, _, _, _, _ = integrate_segment_into(
         y, t0, t1, P, I, U, C[C_RTOL], atol, M[M_H], C[C_HMAX], C[C_HMIN], C[C_FIXED] > 0.0,
-        int(C[C_MAXSTEPS]), t_sub, Y_sub, 0, work)
+        int(C[C_MAXSTEPS]), t_sub, Y_sub, 0, work, aux)
     if status != 0:                             # y is at t_end: report where and with what step
         out[O_STATUS] = status
         M[M_T] = t_end
@@ -280,7 +280,7 @@ def step_one(a, y, P, I, U, atol, work, t_sub, Y_sub, aux, cur, C, M, scale, obs
     for s in range(n_sub):
         ys = Y_sub[s]
         ts = t_sub[s]
-        rhs(ts, ys, P, I, U, work[0], aux)
+        rhs(ts, ys, P, I, U, None, aux)        # the diagnostics alone (the same bits)
         ok = M[M_POWER] > 0.0
         for k in range(2):
             fr = aux[k * N_AUX_PLANE + A_FR]
