@@ -21,7 +21,7 @@ import math
 import numba
 import numpy as np
 
-from physics.jit import njit, njit_parallel
+from physics.jit import njit, njit_borrow, njit_parallel
 from physics.integrate import integrate_segment_into
 from physics.model import (A_FR, A_QMAX, A_WS, F_SENSOR, I_AMB_FILT, I_AMB_INT, I_CS,
                            N_AUX_PLANE, P_CLR, ST_AMB1, ST_RB1, S_W, U_AMB_DIRECT, U_AMB_GAIN,
@@ -233,11 +233,13 @@ def observe_now(y, P, I, U, C, M, work, aux, cur, scale, obs):
     observe(t, y, P, I, U, C, M, aux, cur, scale, obs)
 
 
-@njit
+@njit_borrow
 def step_one(a, y, P, I, U, atol, work, t_sub, Y_sub, aux, cur, C, M, scale, obs, out):
     """One control step of one environment. Results go to ``obs`` and ``out``; nothing raises:
     ``out[O_ERR]`` flags a bad action (nothing is advanced), ``out[O_STATUS]`` an integrator
-    failure (see physics.integrate status codes)."""
+    failure (see physics.integrate status codes). It allocates nothing, so it is compiled without
+    reference counting (:data:`physics.jit.njit_borrow`: its row views cost nothing; ~5 % of
+    a 0.2 ms step)."""
     for i in range(N_O):
         out[i] = 0.0
     err = check_action(a, C)
@@ -350,10 +352,11 @@ def step_one(a, y, P, I, U, atol, work, t_sub, Y_sub, aux, cur, C, M, scale, obs
     observe(t1, y, P, I, U, C, M, aux, cur, scale, obs)
 
 
-@njit
+@njit_borrow
 def step_rows(A, Y, P, I, U, ATOL, WORK, TSUB, YSUB, AUX, CUR, C, M, SCALE, OBS, OUT):
     """:func:`step_one` for N environments (rows), one after the other on the calling thread
-    (no parallel launch: the batch's choice when threads do not pay)."""
+    (no parallel launch: the batch's choice when threads do not pay); without reference
+    counting, as ``step_one``."""
     for e in range(Y.shape[0]):
         step_one(A[e], Y[e], P[e], I[e], U[e], ATOL[e], WORK[e], TSUB[e], YSUB[e], AUX[e], CUR[e],
                  C[e], M[e], SCALE[e], OBS[e], OUT[e])
