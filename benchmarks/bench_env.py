@@ -3,7 +3,7 @@ in the controller seat (``--control-dt``) as ratios to Gymnasium's ``Pendulum-v1
 
     python benchmarks/bench_env.py [--repeats 3] [--episodes 2] [--n-envs 16] [--json out.json]
                                    [--set KEY=VALUE ...]
-    python benchmarks/bench_env.py --control-dt 2e-4 --control-dt 1e-4 [--repeats 7]
+    python benchmarks/bench_env.py --control-dt 2e-4 --control-dt 1e-4 [--repeats 15]
                                    [--json docs/data/bench-env-seat.json]
 
 With ``--control-dt`` (one or more control steps [s]) it measures only the controller seat
@@ -14,7 +14,8 @@ sensor delay range, random actions, resets as episodes end. Per step and repeat 
 ``env.unwrapped``), the SB3 batch ``BatchedRotorDropVecEnv`` (one numba thread: per core) and
 the Gymnasium vector env (``gymnasium.make_vec``, one thread), and prints each rate's median
 and the median of its per-repeat ratios to Pendulum-v1's rate (the machine's speed cancels),
-then the cost split of a step. ``--render JSON`` prints the table of docs/environments.md
+then the cost split of a step and what the physics is made of (right-hand sides per step, the
+cost of one at the episode's states, their share of the physics alone). ``--render JSON`` prints the table of docs/environments.md
 from that JSON (:func:`seat_table`).
 
 Paper scene, default environment settings (episode 0.3 s = 300 steps, 5 monitor samples per
@@ -27,7 +28,7 @@ a machine shared with other jobs) or by the wall clock (``--clock wall``).
   it is (mu = 0.25: drop, bounces, no whirl) and at mu = 0.5, which whirls backward (run on
   through the whirl with ``terminate_on_failure=False``; the physics is costliest there);
 * cost split (passive and damping env, each on one trajectory: the damping env's random actions
-  are replayed as the controls they set): physics alone (``integrate_segment`` over each 1 ms
+  are replayed as the controls they set): physics alone (``integrate_segment_into`` over each 1 ms
   step, in one compiled loop), the step kernel (physics + sub-sampled monitors, reward,
   observation), the Python ``step`` and Gymnasium's wrappers, and the physics' share;
 * batched: ``BatchedRotorDropVecEnv`` with N envs of the damping env, with 1 numba thread (the
@@ -50,7 +51,8 @@ import numpy as np
 import rotordrop_env
 from physics._jit import njit
 from physics.scene import parse_assignment
-from physics.integrate import integrate_segment
+from physics.integrate import integrate_segment_into
+from physics.model import rhs
 from rotordrop_env import kernels as K
 
 
@@ -128,13 +130,15 @@ def cost_split(env_id: str, kwargs: dict, episodes: int, seed: int = 0,
         return te or tr
 
     env.reset(seed=seed)                    # the controls of each step of one episode
-    controls = []
+    controls, times, states = [], [], []
     while True:
+        times.append(u._b.M[K.M_T])
+        states.append(u._b.y.copy())
         done = kernel_step(acts[len(controls) % len(acts)])
         controls.append(u._b.U.copy())
         if done:
             break
-    controls = np.array(controls)
+    controls, times, states = np.array(controls), np.array(times), np.array(states)
 
     def physics():
         env.reset(seed=seed)
@@ -145,28 +149,43 @@ def cost_split(env_id: str, kwargs: dict, episodes: int, seed: int = 0,
         counts = np.zeros(3, dtype=np.int64)
         t0 = CLOCK()
         status = _physics_loop(y, b.M[K.M_T], u.dt, controls, b.P, b.I, sv.rtol, b.atol,
-                               b.M[K.M_H], sv.max_step, sv.min_step, work, counts)
+                               b.M[K.M_H], sv.max_step, sv.min_step, work, b.aux.copy(), counts)
         elapsed = CLOCK() - t0
         assert status == 0
         if stats is not None:
             stats.update(zip(("rhs", "steps", "rejected"), (counts / len(controls)).tolist()))
+            stats["rhs_ns"] = _median(lambda: rhs_cost(b), 5)
         return elapsed / len(controls) * 1e6
+
+    def rhs_cost(b):
+        """ns per right-hand side (with its rates) at the start of each step of the episode."""
+        t0 = CLOCK()
+        _rhs_loop(times, states, controls, b.P, b.I, np.empty(b.y.size), b.aux.copy())
+        return (CLOCK() - t0) / len(controls) * 1e9
 
     return dict(physics=physics, kernel=per_step(kernel_step), unwrapped=per_step(unwrapped_step),
                 wrapped=per_step(wrapped_step))
 
 
 @njit
-def _physics_loop(y, t, dt, controls, P, I, rtol, atol, h, h_max, h_min, work, counts):
-    """The physics alone: a control step of integrate_segment per row of ``controls`` (the
+def _rhs_loop(T, Y, controls, P, I, dy, aux):
+    """The right-hand side at each time, state and controls of a trajectory, in one compiled
+    call."""
+    for k in range(T.shape[0]):
+        rhs(T[k], Y[k], P, I, controls[k], dy, aux)
+
+
+@njit
+def _physics_loop(y, t, dt, controls, P, I, rtol, atol, h, h_max, h_min, work, aux, counts):
+    """The physics alone: a control step of integrate_segment_into per row of ``controls`` (the
     U of each step), in one compiled call; ``counts`` += its right-hand sides, steps and
     rejected steps."""
     no_t = np.empty(0)
     no_Y = np.empty((0, y.shape[0]))
     for k in range(controls.shape[0]):
-        status, _, h, _, n_rhs, n_steps, n_rej = integrate_segment(
+        status, _, h, _, n_rhs, n_steps, n_rej = integrate_segment_into(
             y, t, t + dt, P, I, controls[k], rtol, atol, h, h_max, h_min, False, 10**9, no_t,
-            no_Y, 0, work)
+            no_Y, 0, work, aux)
         counts[0] += n_rhs
         counts[1] += n_steps
         counts[2] += n_rej
@@ -302,10 +321,18 @@ def _print_seat(res: dict) -> None:
     _print_split(res["env_id"], res["per-step us"])
     i = res["integrator per step"]
     print(f"    integrator per control step: {i['rhs']:.1f} right-hand sides, {i['steps']:.2f} "
-          f"steps, {i['rejected']:.2f} rejected")
+          f"steps, {i['rejected']:.2f} rejected; a right-hand side costs {i['rhs_ns']:.0f} ns: "
+          f"{100 * _rhs_share(res):.0f} % of the physics")
     ceiling = 1e6 / res["per-step us"]["physics"] / res["rates"][PENDULUM]
     print(f"    the physics alone steps at {ceiling:.2f}x Pendulum-v1 (the most any work outside "
           f"the integrator can reach, from the medians)")
+
+
+def _rhs_share(res: dict) -> float:
+    """The share of the physics alone that its right-hand sides take (their count per step x
+    the cost of one at the episode's states); the rest is the integrator's own arithmetic."""
+    i = res["integrator per step"]
+    return i["rhs"] * i["rhs_ns"] * 1e-3 / res["per-step us"]["physics"]
 
 
 def seat_table(res: dict) -> str:
@@ -321,8 +348,9 @@ def seat_table(res: dict) -> str:
                         f"{'1 (reference)' if ratio is None else f'{ratio:.2f}'} |")
     rows += ["", "| control step | physics | + monitors, reward, obs | + Python `step` | "
              "+ wrappers | `env.step` | physics share | integrator steps (rejected), "
-             "right-hand sides | physics alone, × Pendulum-v1 |",
-             "|---|---|---|---|---|---|---|---|---|"]
+             "right-hand sides | a right-hand side (share of the physics) | physics alone, × "
+             "Pendulum-v1 |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
     for r in res["seat"]:
         c = r["per-step us"]
         rows.append(f"| {1e3 * r['control_dt_s']:g} ms | {c['physics']:.1f} µs | "
@@ -332,6 +360,7 @@ def seat_table(res: dict) -> str:
                     f"{r['integrator per step']['steps']:.1f} "
                     f"({r['integrator per step']['rejected']:.2f}), "
                     f"{r['integrator per step']['rhs']:.0f} | "
+                    f"{r['integrator per step']['rhs_ns']:.0f} ns ({100 * _rhs_share(r):.0f} %) | "
                     f"{1e6 / c['physics'] / r['rates'][PENDULUM]:.2f} |")
     kw = res["seat"][0]["env_kwargs"]
     rows += ["", f"{res['seat'][0]['env_id']}, "
@@ -343,7 +372,7 @@ def seat_table(res: dict) -> str:
 
 def _print_split(env_id: str, split: dict) -> None:
     print(f"  cost split of one {env_id} step [µs] (same trajectory):")
-    print(f"    physics (integrate_segment)        {split['physics']:8.1f}")
+    print(f"    physics (integrate_segment_into)   {split['physics']:8.1f}")
     print(f"    + monitors, reward, obs (kernel)   {split['kernel'] - split['physics']:8.1f}"
           f"   (kernel call {split['kernel']:.1f})")
     print(f"    + Python step()                    {split['unwrapped'] - split['kernel']:8.1f}"

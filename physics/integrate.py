@@ -54,11 +54,23 @@ def _dense(th, j):
 @njit
 def integrate_segment(y, t0, t1, P, I, U, rtol, atol, h, h_max, h_min, fixed, max_steps,
                       t_out, Y_out, out_pos, work, peaks=None, clock=None):
+    """Advance ``y`` (in place) from t0 to exactly t1: :func:`integrate_segment_into` with a
+    diagnostics scratch array of its own (its arguments and return values)."""
+    return integrate_segment_into(y, t0, t1, P, I, U, rtol, atol, h, h_max, h_min, fixed,
+                                  max_steps, t_out, Y_out, out_pos, work, np.empty(N_AUX), peaks,
+                                  clock)
+
+
+@njit_borrow
+def integrate_segment_into(y, t0, t1, P, I, U, rtol, atol, h, h_max, h_min, fixed, max_steps,
+                           t_out, Y_out, out_pos, work, aux, peaks=None, clock=None):
     """Advance ``y`` (in place) from t0 to exactly t1.
 
     Samples the solution into ``Y_out[out_pos:]`` for every ``t_out[j]`` in (t0, t1].
-    ``work`` is a (9, n) scratch array (stages, a trial state and a sum), so nothing is allocated per
-    step. ``peaks`` (optional, (2 N_PEAK,)) keeps the running maxima of the contact force,
+    ``work`` is a (9, n) scratch array (stages, a trial state and a sum) and ``aux`` an
+    (N_AUX,) one (the right-hand side's diagnostics of each evaluation),
+    so nothing is allocated: the kernel is compiled without reference counting
+    (:data:`physics._jit.njit_borrow`; its stage rows are views at no cost). ``peaks`` (optional, (2 N_PEAK,)) keeps the running maxima of the contact force,
     bearing load and largest ball load per retainer plane at every accepted step end (the
     first-same-as-last stage's diagnostics), whatever the output rate; without it the branch is
     compiled out. ``clock`` (optional, (1,)) receives the time reached after every accepted
@@ -69,7 +81,6 @@ def integrate_segment(y, t0, t1, P, I, U, rtol, atol, h, h_max, h_min, fixed, ma
     K = work[:7]
     ytry = work[7]
     acc = work[8]
-    aux = np.empty(N_AUX)
     n_rhs = 0
     n_steps = 0
     n_rej = 0

@@ -29,7 +29,7 @@ from .buffers import Buffers
 from .commands import (DAMPING_ACTIONS, DEFAULT_POWER_RETURN, LEV_CODES,  # noqa: F401 (re-exported)
                        SUPERVISOR_OCTAVES, SUPERVISOR_OFFSET, Commands, action_error, load_action,
                        real_action, supervisor_scales)
-from .info import MISSING, REWARD_TERMS, info_dict, kpi_keys  # noqa: F401 (REWARD_TERMS re-exported)
+from .info import MISSING, REWARD_TERMS, StepInfo, kpi_keys  # noqa: F401 (REWARD_TERMS re-exported)
 from .layout import observation_layout
 from .reward import Reward, make_reward
 from .scenario import (POWER_RETURN, POWER_RETURN_LIMITS, fault_state, layout_base, reset_options,
@@ -155,6 +155,7 @@ class RotorDropEnv(SettingsGuard, EpisodeView, gym.Env):
                            int(samples_per_step), self.model.sizes))
         self._configure_static(relevitation_hold)
         self._values = np.zeros(K.N_V)          # the info numbers (rotordrop_env.info)
+        self._step_info = StepInfo(self._relevitate)
         self._scenario: dict = {}
         self._needs_reset = True
         self._closed = self._warned = False     # _warned: a step after the end was warned about
@@ -285,16 +286,16 @@ class RotorDropEnv(SettingsGuard, EpisodeView, gym.Env):
     def _finish(self, action):
         """Turn the kernel's outputs into Gymnasium's (obs, reward, terminated, truncated, info)."""
         b = self._b
-        out = b.out
+        out = b.out.tolist()                # Python floats: one conversion for every flag
         if out[K.O_ERR]:
-            self._action_error(out[K.O_ERR], action)
+            self._action_error(int(out[K.O_ERR]), action)
         if out[K.O_STATUS]:
             raise IntegrationError(explain_status(int(out[K.O_STATUS]), b.M[K.M_T], b.M[K.M_H], self.model))
         terminated = bool(out[K.O_TERM])
         truncated = bool(out[K.O_TRUNC])
         if terminated or truncated:         # (assigned only then: attributes go through
             self._ended = True              # SettingsGuard's checks)
-        reward = self.reward_function.one(out, b.M, b.C, self._relevitate)
+        reward = self.reward_function.one(b.out, b.M, b.C, self._relevitate)
         info = self._info()
         self._show_step()
         return self.observed(), reward, terminated, truncated, info
@@ -315,7 +316,7 @@ class RotorDropEnv(SettingsGuard, EpisodeView, gym.Env):
         """The ``info`` of the reset or step just taken (:mod:`rotordrop_env.info`)."""
         b = self._b
         K.info_values(b.out, b.M, b.C, self._values)
-        return info_dict(self._values, self._sensing.k, self._relevitate)
+        return self._step_info(self._values, self._sensing.k)
 
     def kpis(self) -> dict:
         """Episode KPIs so far (numpy scalars; every step's ``info`` carries them, the final

@@ -49,6 +49,7 @@ _KEYS = {r: FLOAT_KEYS + _BOOL_KEYS[r] + ("obs_latency_steps", "kpi_episode_time
          for r in (False, True)}
 _BOOL_SLOTS = {r: tuple(int(i) for i in _BOOL_IDX[r]) for r in (False, True)}
 _NP_BOOL = (np.False_, np.True_)            # numpy's two bool scalars (no allocation per step)
+assert min(_BOOL_SLOTS[True]) >= _NF        # the bools follow the floats in V_*
 
 
 def info_dict(v: np.ndarray, latency, relevitate: bool) -> dict:
@@ -56,7 +57,8 @@ def info_dict(v: np.ndarray, latency, relevitate: bool) -> dict:
     N (``(N, N_V)``: arrays of N, one fresh array each); ``latency``: the episode's observation
     latency (int, or int array of N)."""
     if v.ndim == 1:
-        return _one(list(v[:_NF]), v.tolist(), np.int64(latency), v[K.V_TIME], relevitate)
+        return _one(list(v[:_NF]), _tail(v.tolist(), latency, relevitate), v[K.V_TIME],
+                    relevitate)
     bidx = _BOOL_IDX[relevitate]
     cols = v.T.copy()                        # fresh: nothing a caller holds is reused
     info = dict(zip(FLOAT_KEYS, cols[:_NF]))
@@ -66,14 +68,36 @@ def info_dict(v: np.ndarray, latency, relevitate: bool) -> dict:
     return info
 
 
-def _one(floats: list, numbers: list, latency: np.int64, time, relevitate: bool) -> dict:
+def _tail(numbers: list, latency, relevitate: bool) -> list:
+    """The entries after the floats but the episode time: the bools (numpy's two bool scalars,
+    from the numbers as Python floats) and the latency (a numpy int)."""
+    return [_NP_BOOL[numbers[i] > 0.0] for i in _BOOL_SLOTS[relevitate]] + [np.int64(latency)]
+
+
+def _one(floats: list, tail: list, time, relevitate: bool) -> dict:
     """One environment's info, built in one go (it is made every step): its float entries
-    ``floats`` (fresh numpy scalars), its numbers as Python floats (for the bools: numpy's two
-    bool scalars), its latency and its time (numpy scalars)."""
-    floats += [_NP_BOOL[numbers[i] > 0.0] for i in _BOOL_SLOTS[relevitate]]
-    floats.append(latency)
+    ``floats`` (fresh numpy scalars), the :func:`_tail` entries, then its time (a numpy
+    scalar of its own)."""
+    floats += tail
     floats.append(time)
     return dict(zip(_KEYS[relevitate], floats))
+
+
+class StepInfo:
+    """The ``info`` of one environment, made at every step: :func:`info_dict`'s, the bools and
+    the latency (which change a few times per episode at most) reused from the previous step
+    while their numbers are the same."""
+
+    def __init__(self, relevitate: bool):
+        self.relevitate = relevitate
+        self._key: tuple | None = None
+        self._tail: list = []
+
+    def __call__(self, v: np.ndarray, latency: int) -> dict:
+        key = (v[_NF:].tobytes(), latency)
+        if key != self._key:
+            self._key, self._tail = key, _tail(v.tolist(), latency, self.relevitate)
+        return _one(list(v[:_NF]), self._tail, v[K.V_TIME], self.relevitate)
 
 
 def row_infos(v: np.ndarray, latency: np.ndarray, relevitate: bool) -> list[dict]:
@@ -82,10 +106,10 @@ def row_infos(v: np.ndarray, latency: np.ndarray, relevitate: bool) -> list[dict
     pass per kind)."""
     floats = list(v[:, :_NF].ravel())
     numbers = v.tolist()
-    lat = list(np.asarray(latency, dtype=np.int64))
+    lat = np.asarray(latency, dtype=np.int64).tolist()
     times = list(v[:, K.V_TIME])
-    return [_one(floats[e * _NF:(e + 1) * _NF], numbers[e], lat[e], times[e], relevitate)
-            for e in range(v.shape[0])]
+    return [_one(floats[e * _NF:(e + 1) * _NF], _tail(numbers[e], lat[e], relevitate), times[e],
+                 relevitate) for e in range(v.shape[0])]
 
 
 def kpi_keys(info: dict) -> dict:
