@@ -10,12 +10,16 @@ true motion.
 * **Delay** τ = ``sensor_delay`` [s]: inside the physics (a Padé approximant per AMB axis); the
   kernel's observations x1 ... vy2 and orbit entries are the delayed ones.
 * **Noise**: the four displacements x1, y1, x2, y2 get independent Gaussian noise of standard
-  deviation σ = ``sensor_noise`` [m], one sample per control step; the same sample is what the
-  built-in PID and the supervisor's orbit frame see during the next control step (the U entries
-  ``sensor.noise``: a sample taken at t_n is held until t_n+1). The four velocities, which a
-  real machine estimates by differencing the displacement signal, get σ_v = √2 σ /
-  ``VELOCITY_ESTIMATE_DT`` (the noise of a difference over 1 ms, the same for every control
-  step; observations only). With ``command="supervisor"`` the orbit radius and rate are
+  deviation σ = ``sensor_noise`` [m], one sample per axis at each sensor sample instant
+  t_k = k / f_s (f_s = ``sensor_sample_rate``, the scene's ``sensor.sample_rate``), held until
+  the next, whatever the control step: :meth:`Sensing.draw_step` draws the samples strictly
+  inside a step before it (the kernel holds them in turn, the U entries ``sensor.noise``), the
+  measurement after the step draws the one at its end, if an instant falls there, and carries
+  the sample current then; the built-in PID and the supervisor's orbit frame read the same
+  samples. The four velocities, which a real machine estimates by differencing the displacement
+  signal, get independent noise of σ_v = √2 σ / ``VELOCITY_ESTIMATE_DT`` per observation (the
+  noise of a difference of two samples 1 ms apart, the same for every control step;
+  observations only). With ``command="supervisor"`` the orbit radius and rate are
   computed from the noisy values (the same formula as the kernel's). Spin speeds, damper states
   and coil currents are not noised.
 * **Latency**: the observation returned after control step n is the (noisy) measurement taken
@@ -24,7 +28,8 @@ true motion.
   own clock. Before the episode has k measurements, the first one is repeated.
 
 All draws come from the environment's ``np_random``; with σ = 0 and k = 0 nothing is drawn and
-the observations are bit-identical to an environment without these kwargs.
+the observations are bit-identical to an environment without these kwargs. At f_s = 1 /
+control_dt the draws are those of a noise held per control step.
 """
 from __future__ import annotations
 
@@ -105,6 +110,7 @@ class Sensing:
         self.rate, self.dt = sample_rate, control_dt
         self.z = np.zeros(4)                    # standard normals of the held noise sample
         self.fresh = True                       # a sample instant at the coming measurement
+        self.last_drawn = 0                     # samples inside the last step (draw_step)
         self.noise_control = noise_control      # first of the 4 noise controls in U
         self.active = noise > 0.0 or latency[1] > 0
         self.time_col = names.index("time")
@@ -151,6 +157,7 @@ class Sensing:
             return 0
         t1 = t0 + self.dt                       # as the kernel computes it
         _, n = samples_inside(t0, t1, self.rate)
+        self.last_drawn = n
         if n > 0:
             Z[:n] = rng.standard_normal((n, 4))
             self.z = Z[n - 1].copy()
