@@ -190,15 +190,9 @@ def scenario_record(s: Scenario) -> dict:
                 latency_ms=round(1e3 * s.latency_s, 9))
 
 
-def sample_rate_phrase(d: dict) -> str:
-    """", noise sampled at 10 kHz" from a distribution record (empty for a record made before
-    the sensors had a sample rate: noise held per control step)."""
-    rate = d.get("sensor_sample_rate_hz")
-    return "" if rate is None else f", noise sampled at {rate / 1e3:g} kHz"
-
-
 def robust_markdown(report: dict, scenario_rows: bool = True) -> str:
     from .benchmark import leaderboard_tables, score_sentence
+    from .results import sample_rate_phrase
     from .score import target_sentence
     d = report["distribution"]
     ranges = ", ".join(f"{k} {lo:g}-{hi:g}" for k, (lo, hi) in d["ranges"].items())
