@@ -118,6 +118,7 @@ def cost_split(env_id: str, kwargs: dict, episodes: int, seed: int = 0,
 
     def kernel_step(a):
         u._b.act[:] = a
+        u.draw_noise()                      # the sensor noise samples inside the step
         K.step_one(*u._args)
         return bool(u._b.out[K.O_TERM] or u._b.out[K.O_TRUNC])
 

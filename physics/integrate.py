@@ -11,7 +11,8 @@ import numpy as np
 
 from ._jit import njit, njit_borrow
 from .layout import Slots
-from .model import A_FR, A_LOAD, A_QMAX, N_AUX, N_AUX_PLANE, rhs
+from .model import A_FR, A_LOAD, A_QMAX, F_SENSOR, N_AUX, N_AUX_PLANE, P_SENS_RATE, P_SENS_SIGMA, rhs
+from .sensor import hold_noise, samples_inside
 
 # step-resolved peaks per retainer plane k at peaks[k * N_PEAK + j]: contact force, bearing
 # load, largest ball load
@@ -185,6 +186,41 @@ def integrate_segment_into(y, t0, t1, P, I, U, rtol, atol, h, h_max, h_min, fixe
             if h < h_min:
                 return STEP_COLLAPSE, t, h, out_pos, n_rhs, n_steps, n_rej
     return OK, t, h, out_pos, n_rhs, n_steps, n_rej
+
+
+@njit_borrow
+def integrate_sensed(y, t0, t1, P, I, U, Z, rtol, atol, h, h_max, h_min, fixed, max_steps,
+                     t_out, Y_out, out_pos, work, aux):
+    """:func:`integrate_segment_into` from t0 to t1 with the sensor noise held per sensor sample
+    (physics/sensor.py): split at the n sample instants inside (t0, t1), the held sample
+    U_SENS_NOISE set to sensor.noise x ``Z[i]`` (standard normals, the AMB axes' order) from the
+    i-th of them on. Without noise it is one call of :func:`integrate_segment_into` (nothing split,
+    ``Z`` unread); like it, it allocates nothing (``aux``: the diagnostics scratch). Returns
+    what that returns (the counts summed over the pieces)."""
+    if not I[F_SENSOR] or P[P_SENS_SIGMA] == 0.0:
+        return integrate_segment_into(y, t0, t1, P, I, U, rtol, atol, h, h_max, h_min, fixed,
+                                      max_steps, t_out, Y_out, out_pos, work, aux)
+    rate = P[P_SENS_RATE]
+    k0, n = samples_inside(t0, t1, rate)
+    t = t0
+    h_next = h
+    n_rhs = n_steps = n_rej = 0
+    for i in range(n + 1):
+        ta = t1 if i == n else (k0 + 1 + i) / rate
+        if ta > t:
+            status, t, h_ret, out_pos, a, b, c = integrate_segment_into(
+                y, t, ta, P, I, U, rtol, atol, h_next, h_max, h_min, fixed, max_steps, t_out,
+                Y_out, out_pos, work, aux)
+            n_rhs += a
+            n_steps += b
+            n_rej += c
+            if status != OK:
+                return status, t, h_ret, out_pos, n_rhs, n_steps, n_rej
+            if not fixed:                  # a fixed step keeps its size (the last one is cut)
+                h_next = h_ret
+        if i < n:
+            hold_noise(Z[i], P, U)
+    return OK, t, h_next if not fixed else h, out_pos, n_rhs, n_steps, n_rej
 
 
 @njit_borrow

@@ -251,8 +251,14 @@ class Sensor:
                          " AMB plane; 0: no state", "A")
     noise: float = param(0.0, "m", 0.0, 1e-4,
                          "standard deviation of the displacement noise: one Gaussian sample per"
-                         " axis and control step, drawn by the environments (the drop driver has"
-                         " no noise source and refuses it)", "A")
+                         " axis at each sensor sample (sensor.sample_rate), held until the next,"
+                         " drawn by the environments (the drop driver has no noise source and"
+                         " refuses it)", "A")
+    sample_rate: float = param(1e4, "Hz", 1e3, 1e5,
+                               "sample rate f_s of the displacement sensors: the noise is one"
+                               " sample per axis at t = k / f_s, held until the next, whatever"
+                               " the consumer's step (10 kHz: every controller step of 0.1 ms"
+                               " or longer reads a fresh sample); used only with sensor.noise", "A")
 
 
 @dataclass(frozen=True)

@@ -21,9 +21,18 @@ frame and the environments' observations see of the displacement d of one AMB ax
   and 14 deg at pi/2. With tau <= 0.2 ms, w tau = 1 is 800 Hz, beyond the PID's crossover and
   the rotor's 167 Hz spin. Its poles (-3 +- i sqrt(3)) / tau are what limits the explicit
   integrator's step (h ~ tau), which a higher order would only make faster.
-* **Noise** n_k: one Gaussian sample per axis and control step, held over the step
-  (piecewise constant; the U entries ``U_SENS_NOISE``, drawn by the environments from their
-  ``np_random``, so the kernel stays deterministic given U).
+* **Noise** n_k: one Gaussian sample of standard deviation sigma = ``sensor.noise`` per axis
+  at each sensor sample instant t_k = k / f_s (f_s = ``sensor.sample_rate``), held until the
+  next (zero-order hold), whatever the step of the one who reads it: the built-in PID, the
+  supervisor's orbit frame and the observations all see the sample current at their time. The
+  held sample is the U entries ``U_SENS_NOISE``; a control step that spans sample instants is
+  integrated in pieces split there (:func:`physics.integrate.integrate_sensed`), the entries
+  set between pieces from standard normals the environments draw from their ``np_random``
+  (:func:`samples_inside` says how many), so the kernel stays deterministic given its inputs.
+
+The actuator's PID differentiates the sensed error d_s - ref through its derivative filter
+(physics/amb.py), so it sees both the delay and the held noise's steps; the linear AMB law
+(an idealised stiffness and damping) takes the delayed velocity without the noise.
 
 Off (both zero) the model has no sensing state and the kernel reads the true displacement.
 """
@@ -36,7 +45,9 @@ from .rotor import ST_AMB1, axis_motion
 
 #: states per AMB plane: q1, q2 of the x axis, then of the y axis (S1)
 STATES_PER_PLANE = 4
-SCENE_KEYS = ("sensor.delay", "sensor.noise")
+SCENE_KEYS = ("sensor.delay", "sensor.noise", "sensor.sample_rate")
+#: sample instants closer than this fraction of a sample period to a time count as at it
+SAMPLE_TOL = 1e-6
 #: the AMB axes whose displacement is sensed (the order of the delay states and noise controls)
 AXES = ("AMB1.x", "AMB1.y", "AMB2.x", "AMB2.y")
 
@@ -46,6 +57,8 @@ def declare(layout) -> None:
     delay state's slot, and the held noise samples ``sensor.noise`` + j [m] of AMB axis j that
     the sensed displacement carries until the next sample."""
     layout.params.add("sensor.delay", const="P_SENS_TAU")
+    layout.params.add("sensor.noise", const="P_SENS_SIGMA")
+    layout.params.add("sensor.sample_rate", const="P_SENS_RATE")
     layout.index.add("flag.sensor", const="F_SENSOR")
     layout.index.add("state.sensor", const="I_SENS")
     layout.controls.add("sensor.noise", len(AXES), const="U_SENS_NOISE")
@@ -54,6 +67,8 @@ def declare(layout) -> None:
 def pack(scene, P, I, layout) -> None:
     I[layout.index["flag.sensor"]] = scene.sensor.delay > 0.0 or scene.sensor.noise > 0.0
     P[layout.params["sensor.delay"]] = scene.sensor.delay
+    P[layout.params["sensor.noise"]] = scene.sensor.noise
+    P[layout.params["sensor.sample_rate"]] = scene.sensor.sample_rate
 
 
 def states(scene, I, layout, sizes, add) -> None:
@@ -87,6 +102,34 @@ def delayed(d, v, q1, q2, tau):
     """(d(t - tau), d'(t - tau)) of the (2,2) Padé approximant (S1), from the true displacement
     ``d`` and velocity ``v`` and the axis's delay states."""
     return d - q2, v - 12.0 / tau * (d - q1 - 0.5 * q2)
+
+
+@njit
+def sample_index(t, rate):
+    """Index k of the sensor sample current at time ``t`` (the last instant k / rate <= t)."""
+    return math.floor(t * rate + SAMPLE_TOL)
+
+
+@njit
+def samples_inside(t0, t1, rate):
+    """(k0, n): the sample current at t0 is k0, and n sample instants k / rate, k = k0 + 1 ...
+    k0 + n, lie strictly inside (t0, t1) (one at t1 is the next step's first)."""
+    k0 = sample_index(t0, rate)
+    return k0, math.ceil(t1 * rate - SAMPLE_TOL) - 1 - k0
+
+
+@njit
+def on_sample(t, rate):
+    """``t`` is a sensor sample instant."""
+    x = t * rate
+    return abs(x - round(x)) < SAMPLE_TOL
+
+
+@njit
+def hold_noise(z, P, U):
+    """Hold the sample sigma z (z: 4 standard normals, the AMB axes' order) in U_SENS_NOISE."""
+    for j in range(4):
+        U[U_SENS_NOISE + j] = P[P_SENS_SIGMA] * z[j]
 
 
 def steady_states(X: complex, omega: float, tau: float) -> tuple[complex, complex]:

@@ -208,7 +208,7 @@ def run_model(model: Model, compile_s: float = 0.0, progress: bool = False) -> R
     drop and the batches of :func:`physics.runs.sweep.run_chunk` both run this, so their numbers are identical."""
     if model.scene.sensor.noise > 0.0:
         raise SceneError(f"sensor.noise = {model.scene.sensor.noise:g} m: the drop driver has no "
-                         "noise source (the environments draw it per control step); set it to 0")
+                         "noise source (the environments draw its samples); set it to 0")
     t_end = model.scene.solver.t_end
     t_out = output_times(model)
     n_out = len(t_out)

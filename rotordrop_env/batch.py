@@ -98,7 +98,8 @@ class Batch:
         self.envs = envs
         n = len(envs)
         first = envs[0]
-        self.stack = Buffers(*first._b.dims, packed=first._b.packed, n_envs=n)
+        self.stack = Buffers(*first._b.dims, packed=first._b.packed, n_envs=n,
+                             n_noise=first._b.n_noise)
         for e, env in enumerate(envs):
             env._bind(self.stack.row(e))
         self._args = self.stack.args()
@@ -106,6 +107,7 @@ class Batch:
         self.relevitate = first._relevitate
         self.reward = first.reward_function
         self.sensed = any(env._sensing.active for env in envs)
+        self.noisy = any(env._sensing.noise > 0.0 for env in envs)
         self.rendering = first.render_mode is not None
         self.latency = np.zeros(n, dtype=np.int64)        # each env's observation latency
         self.values = np.zeros((n, K.N_V))                # the info numbers (rotordrop_env.info)
@@ -156,6 +158,9 @@ class Batch:
         e, err = K.first_bad_action(act, stack.C)
         if e >= 0:                                # before any env advances; single env's message
             self.envs[e]._action_error(err, a[e])
+        if self.noisy:                            # the sensor samples inside the step
+            for e in range(self.num_envs) if active is None else np.flatnonzero(active):
+                self.envs[e].draw_noise()
         if active is None:
             self._step_kernel()
         else:                                     # a few steps per episode: row by row

@@ -10,7 +10,7 @@ import numpy as np
 
 from .kernels import N_C, N_M, N_O
 
-FIELDS = ("act", "y", "P", "I", "U", "atol", "work", "t_sub", "Y_sub", "aux", "cur", "C", "M",
+FIELDS = ("act", "y", "P", "I", "U", "Z", "atol", "work", "t_sub", "Y_sub", "aux", "cur", "C", "M",
           "scale", "obs", "out")
 
 
@@ -18,18 +18,20 @@ class Buffers:
     """Arrays passed to the step kernels (see :mod:`rotordrop_env.kernels`), in kernel order."""
 
     def __init__(self, n_state: int, n_obs: int, n_act: int, n_sub: int, packed: dict[str, int],
-                 n_envs: int | None = None):
+                 n_envs: int | None = None, n_noise: int = 0):
         """``packed``: lengths of the physics' packed arrays ``P``, ``I``, ``U``, ``aux``
-        (:attr:`physics.model.Model.sizes`)."""
+        (:attr:`physics.model.Model.sizes`); ``n_noise``: the most sensor noise samples inside
+        one control step (rows of ``Z``, :meth:`rotordrop_env.sensors.Sensing.draw_step`)."""
         lead = () if n_envs is None else (n_envs,)
         shapes = dict(act=(n_act,), y=(n_state,), P=(packed["P"],), I=(packed["I"],),
-                      U=(packed["U"],), atol=(n_state,), work=(9, n_state), t_sub=(n_sub,),
+                      U=(packed["U"],), Z=(n_noise, 4), atol=(n_state,), work=(9, n_state), t_sub=(n_sub,),
                       Y_sub=(n_sub, n_state), aux=(packed["aux"],),
                       cur=(4,), C=(N_C,), M=(N_M,), scale=(n_obs,), obs=(n_obs,), out=(N_O,))
         for name in FIELDS:
             dtype = np.int64 if name == "I" else np.float64
             setattr(self, name, np.zeros(lead + shapes[name], dtype=dtype))
         self.dims = (n_state, n_obs, n_act, n_sub)
+        self.n_noise = n_noise
         self.packed = dict(packed)
 
     def row(self, e: int) -> "Buffers":
@@ -38,6 +40,7 @@ class Buffers:
         for name in FIELDS:
             setattr(view, name, getattr(self, name)[e])
         view.dims = self.dims
+        view.n_noise = self.n_noise
         view.packed = self.packed
         return view
 

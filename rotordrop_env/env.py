@@ -34,7 +34,7 @@ from .layout import observation_layout
 from .reward import Reward, make_reward
 from .scenario import (POWER_RETURN, POWER_RETURN_LIMITS, fault_state, layout_base, reset_options,
                        resolve_ranges, sample, scenario_report, scenario_scene)
-from .sensors import Sensing, check_delay, check_latency, check_noise
+from .sensors import Sensing, check_delay, check_latency, check_noise, check_sample_rate
 from .settings import (FIXED_SETTINGS, WEIGHT_SLOTS, SettingsGuard, check_choice,  # noqa: F401
                        check_flag, check_real, check_steps, check_unused_ranges, check_weights,
                        make_scene, sensing_scene)
@@ -68,7 +68,11 @@ class RotorDropEnv(SettingsGuard, EpisodeView, gym.Env):
                                             needs randomize=True, no range for a fixed key
     full_state                  False       observe the whole state vector (research)
     sensor_noise                0.0         std of the displacement sensors' Gaussian noise [m]
-                                            per control step (:mod:`rotordrop_env.sensors`)
+                                            per sensor sample (:mod:`rotordrop_env.sensors`)
+    sensor_sample_rate          None        the sensors' sample rate [Hz] in [1e3, 1e5]: one
+                                            noise sample per axis at t = k / rate, held until
+                                            the next (None: the scene's sensor.sample_rate,
+                                            10 kHz by default)
     sensor_delay                0.0         delay of the displacement sensors [s] (in the physics:
                                             the PID, the supervisor and the observations see it)
     obs_latency_steps           0           k or (low, high): the agent sees the measurement of
@@ -118,6 +122,7 @@ class RotorDropEnv(SettingsGuard, EpisodeView, gym.Env):
                  samples_per_step: int = 5, relevitation_hold: float = 0.02,
                  terminate_on_failure: bool = True, sensor_noise: float = 0.0,
                  obs_latency_steps: int | tuple[int, int] = 0, sensor_delay: float = 0.0,
+                 sensor_sample_rate: float | None = None,
                  w_whirl: float = 10.0,
                  w_contact: float = 0.1, w_displacement: float = 0.1, w_effort: float = 0.01,
                  w_success: float = 10.0, w_failure: float = 10.0, render_mode: str | None = None,
@@ -148,11 +153,14 @@ class RotorDropEnv(SettingsGuard, EpisodeView, gym.Env):
         self.randomize = check_flag("randomize", randomize)
         self.full_state = check_flag("full_state", full_state)
         noise, delay = check_noise(sensor_noise), check_delay(sensor_delay)
+        rate = check_sample_rate(sensor_sample_rate)
         self.obs_latency_steps = check_latency(obs_latency_steps)
-        self._make_scenes(name, scene, overrides, noise, delay, randomization, power_return_time)
+        self._make_scenes(name, scene, overrides, (noise, delay, rate), randomization,
+                          power_return_time)
         self._make_spaces()
         self._bind(Buffers(self.model.n_state, len(self.obs_names), self._n_act,
-                           int(samples_per_step), self.model.sizes))
+                           int(samples_per_step), self.model.sizes,
+                           n_noise=self._sensing.n_noise))
         self._configure_static(relevitation_hold)
         self._values = np.zeros(K.N_V)          # the info numbers (rotordrop_env.info)
         self._step_info = StepInfo(self._relevitate)
@@ -163,11 +171,13 @@ class RotorDropEnv(SettingsGuard, EpisodeView, gym.Env):
         self._made = True                   # from here on FIXED_SETTINGS cannot be assigned
 
     # ------------------------------------------------------------------------- set-up --
-    def _make_scenes(self, name, scene, overrides, noise, delay, randomization, power_return_time):
-        """The base scene (the task's and its interfaces' keys, the sensing), the scenario
-        ranges and the keys the user fixed, and the model of the fault state."""
+    def _make_scenes(self, name, scene, overrides, sensing, randomization, power_return_time):
+        """The base scene (the task's and its interfaces' keys, the ``sensing`` kwargs (noise,
+        delay, sample rate)), the scenario ranges and the keys the user fixed, and the model of
+        the fault state."""
         base = self.commands.scene(make_scene(scene, overrides), overrides, name, self.task.scene)
-        base, self.sensor_noise, self.sensor_delay = sensing_scene(base, noise, delay)
+        base, self.sensor_noise, self.sensor_delay, self.sensor_sample_rate = \
+            sensing_scene(base, *sensing)
         self.ranges, fixed = resolve_ranges(randomization, self._relevitate, name,
                                             self.task.randomization)
         check_unused_ranges(randomization, self.randomize, overrides, power_return_time)
@@ -190,7 +200,8 @@ class RotorDropEnv(SettingsGuard, EpisodeView, gym.Env):
         self._n_act = 1 if self._discrete else self.action_space.shape[0]
         self._sensing = Sensing(self.sensor_noise, self.obs_latency_steps, self.obs_names,
                                 self.obs_scale, self.base_scene.contact.clearance,
-                                self.model.control_index("sensor.noise"))
+                                self.model.control_index("sensor.noise"),
+                                self.sensor_sample_rate, self.dt)
 
     def _bind(self, buffers: Buffers) -> None:
         """Use these arrays (own ones, or a row of a batched VecEnv's stack) from the next reset."""
@@ -261,8 +272,14 @@ class RotorDropEnv(SettingsGuard, EpisodeView, gym.Env):
         if self._needs_reset or self._ended:
             self._check_steppable()
         load_action(action, self._b.act, self.action_space, self.action_names)
+        self.draw_noise()
         K.step_one(*self._args)
         return self._finish(action)
+
+    def draw_noise(self) -> None:
+        """Before a kernel step: the sensor noise samples inside it (:mod:`.sensors`)."""
+        if self._sensing.noise > 0.0:
+            self._sensing.draw_step(self._b.M[K.M_T], self._b.Z, self.np_random)
 
     def _check_open(self, what: str) -> None:
         if self._closed:

@@ -22,7 +22,7 @@ import numba
 import numpy as np
 
 from physics.jit import njit, njit_borrow, njit_parallel
-from physics.integrate import integrate_segment_into
+from physics.integrate import integrate_sensed
 from physics.model import (A_FR, A_QMAX, A_WS, F_SENSOR, I_AMB_FILT, I_AMB_INT, I_CS,
                            N_AUX_PLANE, P_CLR, ST_AMB1, ST_RB1, S_W, U_AMB_DIRECT, U_AMB_GAIN,
                            U_AMB_POWER, U_CS1, U_ICMD, U_REF0, U_REF_OFF, U_T_ON, amb_currents,
@@ -234,8 +234,10 @@ def observe_now(y, P, I, U, C, M, work, aux, cur, scale, obs):
 
 
 @njit_borrow
-def step_one(a, y, P, I, U, atol, work, t_sub, Y_sub, aux, cur, C, M, scale, obs, out):
-    """One control step of one environment. Results go to ``obs`` and ``out``; nothing raises:
+def step_one(a, y, P, I, U, Z, atol, work, t_sub, Y_sub, aux, cur, C, M, scale, obs, out):
+    """One control step of one environment (``Z``: standard normals of the sensor noise samples
+    inside the step, drawn by :meth:`rotordrop_env.sensors.Sensing.draw_step`; unread without
+    noise). Results go to ``obs`` and ``out``; nothing raises:
     ``out[O_ERR]`` flags a bad action (nothing is advanced), ``out[O_STATUS]`` an integrator
     failure (see physics.integrate status codes). It allocates nothing, so it is compiled without
     reference counting (:data:`physics.jit.njit_borrow`: its row views cost nothing; ~5 % of
@@ -255,8 +257,8 @@ def step_one(a, y, P, I, U, atol, work, t_sub, Y_sub, aux, cur, C, M, scale, obs
     for k in range(n_sub):
         t_sub[k] = t0 + dt * (k + 1) / n_sub
     t_sub[n_sub - 1] = t1
-    status, t_end, h, _, _, _, _ = integrate_segment_into(
-        y, t0, t1, P, I, U, C[C_RTOL], atol, M[M_H], C[C_HMAX], C[C_HMIN], C[C_FIXED] > 0.0,
+    status, t_end, h, _, _, _, _ = integrate_sensed(
+        y, t0, t1, P, I, U, Z, C[C_RTOL], atol, M[M_H], C[C_HMAX], C[C_HMIN], C[C_FIXED] > 0.0,
         int(C[C_MAXSTEPS]), t_sub, Y_sub, 0, work, aux)
     if status != 0:                             # y is at t_end: report where and with what step
         out[O_STATUS] = status
@@ -353,20 +355,20 @@ def step_one(a, y, P, I, U, atol, work, t_sub, Y_sub, aux, cur, C, M, scale, obs
 
 
 @njit_borrow
-def step_rows(A, Y, P, I, U, ATOL, WORK, TSUB, YSUB, AUX, CUR, C, M, SCALE, OBS, OUT):
+def step_rows(A, Y, P, I, U, Z, ATOL, WORK, TSUB, YSUB, AUX, CUR, C, M, SCALE, OBS, OUT):
     """:func:`step_one` for N environments (rows), one after the other on the calling thread
     (no parallel launch: the batch's choice when threads do not pay); without reference
     counting, as ``step_one``."""
     for e in range(Y.shape[0]):
-        step_one(A[e], Y[e], P[e], I[e], U[e], ATOL[e], WORK[e], TSUB[e], YSUB[e], AUX[e], CUR[e],
+        step_one(A[e], Y[e], P[e], I[e], U[e], Z[e], ATOL[e], WORK[e], TSUB[e], YSUB[e], AUX[e], CUR[e],
                  C[e], M[e], SCALE[e], OBS[e], OUT[e])
 
 
 @njit_parallel
-def step_batch(A, Y, P, I, U, ATOL, WORK, TSUB, YSUB, AUX, CUR, C, M, SCALE, OBS, OUT):
+def step_batch(A, Y, P, I, U, Z, ATOL, WORK, TSUB, YSUB, AUX, CUR, C, M, SCALE, OBS, OUT):
     """:func:`step_one` for N environments (rows), in parallel over environments."""
     for e in numba.prange(Y.shape[0]):
-        step_one(A[e], Y[e], P[e], I[e], U[e], ATOL[e], WORK[e], TSUB[e], YSUB[e], AUX[e], CUR[e],
+        step_one(A[e], Y[e], P[e], I[e], U[e], Z[e], ATOL[e], WORK[e], TSUB[e], YSUB[e], AUX[e], CUR[e],
                  C[e], M[e], SCALE[e], OBS[e], OUT[e])
 
 

@@ -10,12 +10,16 @@ true motion.
 * **Delay** τ = ``sensor_delay`` [s]: inside the physics (a Padé approximant per AMB axis); the
   kernel's observations x1 ... vy2 and orbit entries are the delayed ones.
 * **Noise**: the four displacements x1, y1, x2, y2 get independent Gaussian noise of standard
-  deviation σ = ``sensor_noise`` [m], one sample per control step; the same sample is what the
-  built-in PID and the supervisor's orbit frame see during the next control step (the U entries
-  ``sensor.noise``: a sample taken at t_n is held until t_n+1). The four velocities, which a
-  real machine estimates by differencing the displacement signal, get σ_v = √2 σ /
-  ``VELOCITY_ESTIMATE_DT`` (the noise of a difference over 1 ms, the same for every control
-  step; observations only). With ``command="supervisor"`` the orbit radius and rate are
+  deviation σ = ``sensor_noise`` [m], one sample per axis at each sensor sample instant
+  t_k = k / f_s (f_s = ``sensor_sample_rate``, the scene's ``sensor.sample_rate``), held until
+  the next, whatever the control step: :meth:`Sensing.draw_step` draws the samples strictly
+  inside a step before it (the kernel holds them in turn, the U entries ``sensor.noise``), the
+  measurement after the step draws the one at its end, if an instant falls there, and carries
+  the sample current then; the built-in PID and the supervisor's orbit frame read the same
+  samples. The four velocities, which a real machine estimates by differencing the displacement
+  signal, get independent noise of σ_v = √2 σ / ``VELOCITY_ESTIMATE_DT`` per observation (the
+  noise of a difference of two samples 1 ms apart, the same for every control step;
+  observations only). With ``command="supervisor"`` the orbit radius and rate are
   computed from the noisy values (the same formula as the kernel's). Spin speeds, damper states
   and coil currents are not noised.
 * **Latency**: the observation returned after control step n is the (noisy) measurement taken
@@ -24,7 +28,8 @@ true motion.
   own clock. Before the episode has k measurements, the first one is repeated.
 
 All draws come from the environment's ``np_random``; with σ = 0 and k = 0 nothing is drawn and
-the observations are bit-identical to an environment without these kwargs.
+the observations are bit-identical to an environment without these kwargs. At f_s = 1 /
+control_dt the draws are those of a noise held per control step.
 """
 from __future__ import annotations
 
@@ -34,6 +39,7 @@ import numbers
 import numpy as np
 
 from physics.jit import njit
+from physics.sensor import on_sample, samples_inside
 
 from .kernels import SUP_MIN_RADIUS
 from .layout import SUPERVISOR_OBS
@@ -42,6 +48,7 @@ from .layout import SUPERVISOR_OBS
 VELOCITY_ESTIMATE_DT = 1e-3
 NOISE_LIMITS = (0.0, 1e-4)          # sensor_noise [m] (the scene's sensor.noise range)
 DELAY_LIMITS = (0.0, 2e-3)          # sensor_delay [s] (the scene's sensor.delay range)
+RATE_LIMITS = (1e3, 1e5)            # sensor_sample_rate [Hz] (the scene's sensor.sample_rate range)
 LATENCY_LIMITS = (0, 100)           # obs_latency_steps [control steps]
 POSITIONS = ("x1", "y1", "x2", "y2")
 VELOCITIES = ("vx1", "vy1", "vx2", "vy2")
@@ -68,6 +75,14 @@ def check_delay(value) -> float:
                        "e.g. 1e-4 for 0.1 ms")
 
 
+def check_sample_rate(value) -> float | None:
+    """``sensor_sample_rate`` as a float in ``RATE_LIMITS`` (None: the scene's)."""
+    if value is None:
+        return None
+    return _check_real("sensor_sample_rate", value, RATE_LIMITS, "a sample rate in hertz",
+                       "e.g. 2e4 for 20 kHz")
+
+
 def check_latency(value) -> tuple[int, int]:
     """``obs_latency_steps`` (an integer k, or (low, high)) as (low, high) integers in
     ``LATENCY_LIMITS`` (one-line ValueError otherwise)."""
@@ -88,9 +103,14 @@ class Sensing:
     ``clearance`` [m] for the orbit's dead zone."""
 
     def __init__(self, noise: float, latency: tuple[int, int], obs_names, obs_scale,
-                 clearance: float, noise_control: int):
+                 clearance: float, noise_control: int, sample_rate: float = 1e4,
+                 control_dt: float = 1e-3):
         names = list(obs_names)
         self.noise, self.latency = noise, latency
+        self.rate, self.dt = sample_rate, control_dt
+        self.z = np.zeros(4)                    # standard normals of the held noise sample
+        self.fresh = True                       # a sample instant at the coming measurement
+        self.last_drawn = 0                     # samples inside the last step (draw_step)
         self.noise_control = noise_control      # first of the 4 noise controls in U
         self.active = noise > 0.0 or latency[1] > 0
         self.time_col = names.index("time")
@@ -112,13 +132,46 @@ class Sensing:
         self.k = 0
         self.n = 0                      # measurements taken this episode
 
+    @property
+    def n_noise(self) -> int:
+        """The most sensor samples strictly inside one control step (rows of the kernel's
+        ``Z``); 0 without noise."""
+        return math.ceil(self.dt * self.rate) + 1 if self.noise > 0.0 else 0
+
     def reset(self, true_obs: np.ndarray, rng: np.random.Generator,
               U: np.ndarray | None = None) -> np.ndarray:
-        """Start an episode: draw its latency k, take the first measurement."""
+        """Start an episode: draw its latency k, take the first measurement (with a fresh
+        noise sample: the sensor's sample current at the episode's start)."""
         lo, hi = self.latency
         self.k = int(rng.integers(lo, hi + 1)) if hi > lo else lo
         self.n = 0
+        self.fresh = True
         return self.step(true_obs, rng, U)
+
+    def draw_step(self, t0: float, Z: np.ndarray, rng: np.random.Generator) -> int:
+        """Before a control step from ``t0``: the standard normals of the noise samples at the
+        sensor's sample instants strictly inside the step into ``Z`` (the kernel holds them in
+        turn, :func:`physics.integrate.integrate_sensed`); a sample at the step's end is drawn
+        by the measurement after it. Returns their number (0, nothing drawn, without noise)."""
+        if self.noise == 0.0:
+            return 0
+        t1 = t0 + self.dt                       # as the kernel computes it
+        _, n = samples_inside(t0, t1, self.rate)
+        self.last_drawn = n
+        if n > 0:
+            Z[:n] = rng.standard_normal((n, 4))
+            self.z = Z[n - 1].copy()
+        self.fresh = bool(on_sample(t1, self.rate))
+        return n
+
+    def _draw(self, rng: np.random.Generator) -> np.ndarray:
+        """The measurement's standard normals: 4 of the displacement noise (a fresh sample at a
+        sample instant, else the held one), then 4 of the velocity estimates'."""
+        if self.fresh:
+            z = rng.standard_normal(len(self.cols))
+            self.z = z[:4].copy()
+            return z
+        return np.concatenate((self.z, rng.standard_normal(len(self.cols) - 4)))
 
     def step(self, true_obs: np.ndarray, rng: np.random.Generator,
              U: np.ndarray | None = None) -> np.ndarray:
@@ -128,7 +181,7 @@ class Sensing:
         if U is not None and (self.noise == 0.0 or self.orbit is None):
             # one compiled call, the same numbers as step_python (the supervisor's orbit
             # entries take the Python path)
-            z = rng.standard_normal(len(self.cols)) if self.noise > 0.0 else _NO_DRAW
+            z = self._draw(rng) if self.noise > 0.0 else _NO_DRAW
             out = np.empty(true_obs.shape[0], dtype=np.float32)
             _sense(true_obs, z, self._sigma, self._cols, U, self.noise_control, self.noise,
                    self.buffer, self.n, self.k, self.time_col, out)
@@ -153,7 +206,7 @@ class Sensing:
                  U: np.ndarray | None) -> np.ndarray:
         m = np.array(true_obs, dtype=np.float64)
         if self.noise > 0.0:
-            z = rng.standard_normal(len(self.cols))
+            z = self._draw(rng)
             m[self.cols] += self.sigma * z
             if U is not None:                   # x1, y1, x2, y2: the AMB axes' order
                 U[self.noise_control:self.noise_control + 4] = self.noise * z[:4]

@@ -74,21 +74,29 @@ def make_scene(scene, overrides) -> Scene:
                      "physics.Scene or its dict (Scene.to_dict(), as in a JSON env spec)")
 
 
-def sensing_scene(base: Scene, noise: float, delay: float) -> tuple[Scene, float, float]:
+def sensing_scene(base: Scene, noise: float, delay: float,
+                  rate: float | None = None) -> tuple[Scene, float, float, float]:
     """The scene with the sensing kwargs in its ``sensor`` group (the one sensing model of
-    physics/sensor.py), and the noise and delay in effect: a kwarg, else the scene's value; a
-    kwarg that contradicts the scene's non-zero value is refused."""
+    physics/sensor.py), and the noise, delay and sample rate in effect: a kwarg, else the
+    scene's value; a kwarg that contradicts the scene's own (non-zero, or for the sample rate
+    non-default) value is refused."""
+    default_rate = Scene().sensor.sample_rate
     values = {}
-    for key, given in (("sensor.noise", noise), ("sensor.delay", delay)):
+    # (key, kwarg value (0 or None: not given), the scene's value when it sets none)
+    for key, given, neutral in (("sensor.noise", noise, 0.0), ("sensor.delay", delay, 0.0),
+                                ("sensor.sample_rate", rate, default_rate)):
         scene_value = base.get(key)
-        kwarg = "sensor_" + key.split(".")[1]
-        if given > 0.0 and scene_value > 0.0 and given != scene_value:
+        kwarg = "sensor_" + key.split(".", 1)[1]
+        if not given:
+            values[key] = scene_value
+            continue
+        if scene_value != neutral and given != scene_value:
             raise ValueError(f"{kwarg} = {given:g} contradicts the scene's {key} = "
                              f"{scene_value:g}; give one of them")
-        values[key] = given or scene_value
+        values[key] = given
     if any(values[k] != base.get(k) for k in values):
         base = base.with_overrides(values)
-    return base, values["sensor.noise"], values["sensor.delay"]
+    return base, values["sensor.noise"], values["sensor.delay"], values["sensor.sample_rate"]
 
 
 def check_unused_ranges(randomization, randomize: bool, overrides, power_return_time) -> None:
@@ -117,7 +125,7 @@ FIXED_SETTINGS = frozenset(("control_dt", "dt", "episode_time", "n_steps", "rand
                             "power_return_time", "samples_per_step", "relevitation_hold",
                             "terminate_on_failure", "render_mode", "base_scene", "overrides",
                             "obs_names", "obs_scale", "action_names", "weights",
-                            "sensor_noise", "sensor_delay", "obs_latency_steps", "supervisor_authority",
+                            "sensor_noise", "sensor_delay", "sensor_sample_rate", "obs_latency_steps", "supervisor_authority",
                             "damping_action", "reward", "reward_kwargs", "reward_function",
                             "constraints", "task", "commands"))
 

@@ -42,7 +42,10 @@ EPISODES = {
                               [1.0, 0.5, 0.3, -0.2, 0.1, 0.4]),
     "full_discrete": ("RotorDrop-Full-v1", {"command": "discrete", "full_state": True},
                       [0.2, -0.3, 1.0]),
-    "full_supervisor": ("RotorDrop-Full-v1", {"command": "supervisor", "sensor_noise": 1e-6},
+    # the sensors sampling at the control rate: noise held per control step, as these hashes
+    # were recorded (a sample rate above it splits the step at the sample instants)
+    "full_supervisor": ("RotorDrop-Full-v1", {"command": "supervisor", "sensor_noise": 1e-6,
+                                              "sensor_sample_rate": 1e3},
                         [0.2, -0.3, 1.0, -0.5, 0.3, -0.2, 0.1, 0.4]),
 }
 

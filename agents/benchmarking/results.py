@@ -254,6 +254,13 @@ def seed_table(groups: list[dict]) -> list[str]:
     return out + [""]
 
 
+def sample_rate_phrase(d: dict) -> str:
+    """", noise sampled at 10 kHz" from a robust distribution record (empty for a record made
+    before the sensors had a sample rate: noise held per control step)."""
+    rate = d.get("sensor_sample_rate_hz")
+    return "" if rate is None else f", noise sampled at {rate / 1e3:g} kHz"
+
+
 def robust_section(report: dict, source: str) -> list[str]:
     d = report.get("distribution", {})
     seeds = d.get("scenario_seeds", [None, None])
@@ -261,7 +268,7 @@ def robust_section(report: dict, source: str) -> list[str]:
            f"`rotordrop benchmark --suite robust{' --quick' if report.get('quick') else ''}` "
            f"(data: `{source}`): {len(report['scenarios'])} drops of `RotorDrop-Full-v1` "
            f"(scenario seeds {seeds[0]}–{seeds[1]}) with {_f(1e6 * d.get('sensor_noise_m', 0), 'g')} µm "
-           f"sensor noise, "
+           f"sensor noise{sample_rate_phrase(d)}, "
            + (f"{'–'.join(f'{1e3 * v:g}' for v in d['sensor_delay_s'])} ms sensor delay (every "
               "controller), " if d.get("sensor_delay_s") else "")
            + f"{'–'.join(str(x) for x in d.get('latency_ms', []))} ms transport "

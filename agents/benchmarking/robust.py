@@ -5,7 +5,8 @@ Every scenario is one drop of ``RotorDrop-Full-v1`` drawn from :data:`ROBUST_RAN
 unbalance mass and phase, housing stiffness ± 30 %, spin speed, power return, coil current limit
 and coil lag; the support's initial damping from the environments' default range), under the one
 sensing model of physics/sensor.py that every controller, the built-in PID included, sees:
-displacement-sensor noise :data:`SENSOR_NOISE` (one sample per control step) and a sensor delay
+displacement-sensor noise :data:`SENSOR_NOISE` (one sample per axis at every sensor sample,
+:data:`SENSOR_SAMPLE_RATE`, held in between, whatever the controller's step) and a sensor delay
 drawn per scenario from :data:`SENSOR_DELAY_S` (the scene key ``sensor.delay``). On top of that
 a row in the ``supervisor`` seat (:mod:`agents.control.seats`) gets a transport latency of 0 or
 1 ms (:data:`LATENCY_MS`, drawn per scenario: one transfer to a supervisory computer, or none);
@@ -34,6 +35,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from physics.scene import Sensor
+
 from .benchmark import TASKS, Scenario, Validator, round_up
 
 ENV_ID = TASKS["full"]
@@ -50,6 +53,8 @@ ROBUST_RANGES: dict[str, tuple[float, float]] = {
 }
 SENSOR_NOISE = 1e-6                 # std of the displacement noise [m] (sensor.noise)
 SENSOR_DELAY_S = (5e-5, 2e-4)       # sensor delay [s] (sensor.delay), uniform per scenario
+SENSOR_SAMPLE_RATE = Sensor().sample_rate   # the sensors' sample rate [Hz] (sensor.sample_rate:
+                                            # the scene's default, which the suite's drops keep)
 LATENCY_MS = (0, 1)                 # the agent's own observation latency [ms], an integer
                                     # drawn per scenario
 POWER_GRID = 0.005                  # the power return is rounded up to this grid [s]
@@ -98,7 +103,7 @@ def distribution(suite, n: int) -> dict:
     """The robust distribution as benchmark.json records it (``n`` drops from the suite's seed)."""
     return dict(ranges={k: list(v) for k, v in ROBUST_RANGES.items()}, sensor_noise_m=SENSOR_NOISE,
                 latency_ms=list(LATENCY_MS), sensor_delay_s=list(SENSOR_DELAY_S),
-                power_grid_s=suite.power_grid, scenario_seeds=[suite.seed, suite.seed + n - 1])
+                sensor_sample_rate_hz=SENSOR_SAMPLE_RATE, power_grid_s=suite.power_grid, scenario_seeds=[suite.seed, suite.seed + n - 1])
 
 
 def validator_for(env_id: str, env_kwargs: dict | None = None) -> Validator:
@@ -187,6 +192,7 @@ def scenario_record(s: Scenario) -> dict:
 
 def robust_markdown(report: dict, scenario_rows: bool = True) -> str:
     from .benchmark import leaderboard_tables, score_sentence
+    from .results import sample_rate_phrase
     from .score import target_sentence
     d = report["distribution"]
     ranges = ", ".join(f"{k} {lo:g}-{hi:g}" for k, (lo, hi) in d["ranges"].items())
@@ -195,7 +201,8 @@ def robust_markdown(report: dict, scenario_rows: bool = True) -> str:
              f"{len(report['scenarios'])} drops of RotorDrop-Full-v1 (scenario seeds "
              f"{d['scenario_seeds'][0]}-{d['scenario_seeds'][1]}) drawn from: {ranges}; "
              f"displacement-sensor noise {1e6 * d['sensor_noise_m']:g} µm and delay "
-             f"{'-'.join(f'{1e3 * v:g}' for v in d.get('sensor_delay_s', [0.0]))} ms (every "
+             f"{'-'.join(f'{1e3 * v:g}' for v in d.get('sensor_delay_s', [0.0]))} ms"
+             f"{sample_rate_phrase(d)} (every "
              f"controller, the built-in PID included), transport latency "
              f"{d['latency_ms'][0]}-{d['latency_ms'][1]} ms for supervisor-seat rows (whole "
              f"control steps, rounded up; none in the controller seat); "

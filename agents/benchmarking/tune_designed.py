@@ -173,10 +173,11 @@ def tune_designed(suite, names: list[str] | None = None, episodes: int = LEARNED
         print(f"{name}: validation score {records[name]['start_validation_score']:.2f} -> "
               f"{records[name]['validation_score']:.2f} with {records[name]['gains']} "
               f"({scored} validation episodes, {records[name]['cost']['cpu_time_s']:.0f} CPU-s)")
-        if store:
+        if store:                   # re-read: one process per law may tune in parallel
             path = record_path(suite)
             path.parent.mkdir(parents=True, exist_ok=True)
-            path.write_text(json.dumps(records, indent=1, sort_keys=True) + "\n")
+            stored = {**load_records(suite), name: records[name]}
+            path.write_text(json.dumps(stored, indent=1, sort_keys=True) + "\n")
         if out is not None:
             Path(out).mkdir(parents=True, exist_ok=True)
             (Path(out) / f"tune-designed-{suite.name}.json").write_text(json.dumps(records, indent=1))
