@@ -28,7 +28,7 @@ a machine shared with other jobs) or by the wall clock (``--clock wall``).
   it is (mu = 0.25: drop, bounces, no whirl) and at mu = 0.5, which whirls backward (run on
   through the whirl with ``terminate_on_failure=False``; the physics is costliest there);
 * cost split (passive and damping env, each on one trajectory: the damping env's random actions
-  are replayed as the controls they set): physics alone (``integrate_segment_into`` over each 1 ms
+  are replayed as the controls they set): physics alone (``integrate_sensed`` over each 1 ms
   step, in one compiled loop), the step kernel (physics + sub-sampled monitors, reward,
   observation), the Python ``step`` and Gymnasium's wrappers, and the physics' share;
 * batched: ``BatchedRotorDropVecEnv`` with N envs of the damping env, with 1 numba thread (the
@@ -51,8 +51,8 @@ import numpy as np
 import rotordrop_env
 from physics._jit import njit
 from physics.scene import parse_assignment
-from physics.integrate import integrate_segment_into
-from physics.model import rhs
+from physics.integrate import integrate_sensed
+from physics.model import U_SENS_NOISE, rhs
 from rotordrop_env import kernels as K
 
 
@@ -131,15 +131,17 @@ def cost_split(env_id: str, kwargs: dict, episodes: int, seed: int = 0,
         return te or tr
 
     env.reset(seed=seed)                    # the controls of each step of one episode
-    controls, times, states = [], [], []
+    controls, noises, times, states = [], [], [], []
     while True:
         times.append(u._b.M[K.M_T])
         states.append(u._b.y.copy())
         done = kernel_step(acts[len(controls) % len(acts)])
         controls.append(u._b.U.copy())
+        noises.append(u._b.Z.copy())
         if done:
             break
     controls, times, states = np.array(controls), np.array(times), np.array(states)
+    noises = np.array(noises)
 
     def physics():
         env.reset(seed=seed)
@@ -149,7 +151,7 @@ def cost_split(env_id: str, kwargs: dict, episodes: int, seed: int = 0,
         work = np.empty((9, y.size))
         counts = np.zeros(3, dtype=np.int64)
         t0 = CLOCK()
-        status = _physics_loop(y, b.M[K.M_T], u.dt, controls, b.P, b.I, sv.rtol, b.atol,
+        status = _physics_loop(y, b.M[K.M_T], u.dt, controls, noises, b.P, b.I, sv.rtol, b.atol,
                                b.M[K.M_H], sv.max_step, sv.min_step, work, b.aux.copy(), counts)
         elapsed = CLOCK() - t0
         assert status == 0
@@ -177,15 +179,21 @@ def _rhs_loop(T, Y, controls, P, I, dy, aux):
 
 
 @njit
-def _physics_loop(y, t, dt, controls, P, I, rtol, atol, h, h_max, h_min, work, aux, counts):
-    """The physics alone: a control step of integrate_segment_into per row of ``controls`` (the
-    U of each step), in one compiled call; ``counts`` += its right-hand sides, steps and
+def _physics_loop(y, t, dt, controls, noises, P, I, rtol, atol, h, h_max, h_min, work, aux, counts):
+    """The physics alone: a control step of integrate_sensed per row of ``controls`` (the U of
+    each step, its sensor-noise entries held from the step before) and of ``noises`` (the
+    step's noise samples: the step is integrated in pieces at the sensor's sample instants, as
+    the environment does), in one compiled call; ``counts`` += its right-hand sides, steps and
     rejected steps."""
     no_t = np.empty(0)
     no_Y = np.empty((0, y.shape[0]))
+    U = controls[0].copy()
     for k in range(controls.shape[0]):
-        status, _, h, _, n_rhs, n_steps, n_rej = integrate_segment_into(
-            y, t, t + dt, P, I, controls[k], rtol, atol, h, h_max, h_min, False, 10**9, no_t,
+        for j in range(U.shape[0]):             # the step's controls, the held noise kept
+            if j < U_SENS_NOISE or j >= U_SENS_NOISE + 4:
+                U[j] = controls[k, j]
+        status, _, h, _, n_rhs, n_steps, n_rej = integrate_sensed(
+            y, t, t + dt, P, I, U, noises[k], rtol, atol, h, h_max, h_min, False, 10**9, no_t,
             no_Y, 0, work, aux)
         counts[0] += n_rhs
         counts[1] += n_steps
@@ -373,7 +381,7 @@ def seat_table(res: dict) -> str:
 
 def _print_split(env_id: str, split: dict) -> None:
     print(f"  cost split of one {env_id} step [µs] (same trajectory):")
-    print(f"    physics (integrate_segment_into)   {split['physics']:8.1f}")
+    print(f"    physics (integrate_sensed)         {split['physics']:8.1f}")
     print(f"    + monitors, reward, obs (kernel)   {split['kernel'] - split['physics']:8.1f}"
           f"   (kernel call {split['kernel']:.1f})")
     print(f"    + Python step()                    {split['unwrapped'] - split['kernel']:8.1f}"
