@@ -804,18 +804,65 @@ def standing(report: dict, task: str) -> str:
     return " ".join(out)
 
 
+#: docs/tasks.md's learning tables: key -> a `rotordrop benchmark --suite robust --only ...`
+#: report of learned seed groups beside their reference (``rotordrop results --learning KEY=FILE``)
+LEARNING = {"controller-seat": "learning-controller-seat.json"}
+
+
+def learning_table(report: dict) -> str:
+    """The learned configurations of a benchmark report (its seed groups) against the best
+    designed row there: per seed the test score ± SE and the difference to that row (paired
+    bootstrap), the seeds' mean ± std and mean − std, then the target line."""
+    board = {e["controller"]: e for e in report["leaderboard"]}
+    t = report["target"]
+    ref = t["best_designed"]
+    lines = [f"{len(report['scenarios'])} test drops of `--suite {report['suite']}`; reference: "
+             f"{_cited(board[ref])}; Δ: paired bootstrap against it.", "",
+             "| configuration | seat | seeds | test score ± SE per seed | Δ ± SE per seed | "
+             "mean ± std | mean − std |", "|---|---|---:|---|---|---:|---:|"]
+    for g in report["seed_groups"]:
+        rows = [board[m] for m in g["members"]]
+        lines.append(f"| {_common_name(g['members'])} | {rows[0].get('seat') or '-'} | "
+                     f"{len(rows)} | " + ", ".join(f"{e['score']:.2f} ± {e['score_se']:.2f}"
+                                                    for e in rows)
+                     + " | " + ", ".join(f"{e['diff_vs_reference']:+.2f} ± {e['diff_se']:.2f}"
+                                         for e in rows)
+                     + f" | {g['mean']:.2f} ± {g['std']:.2f} | {g['mean_minus_std']:.2f} |")
+    verdict = ("not judged: no configuration with "
+               f"{t['min_seeds']} seeds" if t["met"] is None else
+               f"best configuration {t['best_learned_score']:.2f} (mean − std) against "
+               f"{t['best_designed_score'] + t['margin']:.2f}: {'met' if t['met'] else 'not met'}")
+    lines += ["", f"Target (mean − std over ≥ {t['min_seeds']} seeds ≥ best designed "
+                  f"+{t['margin']:g}) on these drops: {verdict}."]
+    return "\n".join(lines)
+
+
+def _common_name(names: list[str]) -> str:
+    """The configuration's name: what its members' names share, up to a separator."""
+    import os
+    prefix = os.path.commonprefix(names).rstrip("-_@s0123456789") or names[0]
+    return f"`{prefix}`"
+
+
+def _regenerate(text: str, kind: str, key: str, block: str) -> str:
+    start, end = f"<!-- {kind}:{key}:start -->", f"<!-- {kind}:{key}:end -->"
+    pattern = re.compile(re.escape(start) + r".*?" + re.escape(end), flags=re.S)
+    return pattern.sub(lambda _: f"{start}\n{block}\n{end}", text)
+
+
 def tasks_text(root: Path = ROOT) -> str:
     """docs/tasks.md with each ``<!-- standing:KEY:start -->`` ... ``end`` block regenerated
-    from the committed leaderboards (:data:`STANDINGS`)."""
+    from the committed leaderboards (:data:`STANDINGS`), and each ``<!-- learning:KEY:... -->``
+    block from its learning report (:data:`LEARNING`)."""
     text = (root / TASKS).read_text()
     for key, (name, task) in STANDINGS.items():
         report = _load(root / DATA / name)
-        start, end = f"<!-- standing:{key}:start -->", f"<!-- standing:{key}:end -->"
-        pattern = re.compile(re.escape(start) + r".*?" + re.escape(end), flags=re.S)
-        if report is None or not pattern.search(text):
-            continue
-        block = standing(report, task)
-        text = pattern.sub(lambda _: f"{start}\n{block}\n{end}", text)
+        if report is not None:
+            text = _regenerate(text, "standing", key, standing(report, task))
+    for key, name in LEARNING.items():
+        report = _load(root / DATA / name)
+        if report is not None:
+            text = _regenerate(text, "learning", key, learning_table(report))
     return text
 
 
@@ -862,6 +909,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                                             "store as docs/data/oracle-nominal.json")
     p.add_argument("--oracle-robust", help="a `rotordrop oracle --suite robust` oracle.json to "
                                            "store as docs/data/oracle-robust.json")
+    p.add_argument("--learning", action="append", default=[], metavar="KEY=FILE",
+                   help="a `rotordrop benchmark --suite robust --only REF --policy RUN...` "
+                        "benchmark.json of learned seed groups, stored as the docs/data file of "
+                        f"KEY ({', '.join(f'{k}: {v}' for k, v in LEARNING.items())}) for "
+                        "docs/tasks.md's learning table (repeatable)")
     p.add_argument("--headroom", help="a `python -m agents.benchmarking.headroom` headroom.json of "
                                       "the robust leaderboard, stored as "
                                       "docs/data/headroom-robust.json")
@@ -879,7 +931,7 @@ def run(args) -> int:
     """Store the given benchmark output in docs/data and regenerate the pages (or ``--check``)."""
     root = Path(args.root)
     given = (args.nominal, args.robust, args.hard, args.oracle_nominal, args.oracle_robust,
-             args.oracle_budget, args.headroom, args.hard_run, args.hard_ref)
+             args.oracle_budget, args.headroom, args.hard_run, args.hard_ref, args.learning)
     if args.check and any(given):
         print("results: error: --check takes no data files", file=sys.stderr)
         return 2
@@ -901,6 +953,13 @@ def run(args) -> int:
             stored.append(store(src, root / DATA / name, keep=ORACLE_KEYS))
     if args.headroom:
         stored.append(store(args.headroom, root / DATA / "headroom-robust.json"))
+    for spec in args.learning:
+        key, _, src = spec.partition("=")
+        if key not in LEARNING or not src:
+            print(f"results: error: --learning {spec!r}: write KEY=FILE with KEY one of "
+                  f"{', '.join(LEARNING)}", file=sys.stderr)
+            return 2
+        stored.append(store(src, root / DATA / LEARNING[key], drop=DROPPED_KEYS))
     if args.oracle_budget:
         runs = [budget_run(json.loads(Path(p).read_text())) for p in args.oracle_budget]
         dest = root / DATA / "oracle-budget.json"

@@ -34,7 +34,7 @@ arguments a block may hold:
 ``zero_start``     ``true``: the policy's action mean starts at exactly zero (its last layer
                    zeroed, :func:`agents.learning.exploration.zero_action_mean`), so the
                    deterministic initial policy is a = 0: with ``residual``, the baseline itself
-                   (SAC's, TQC's and TD3's default initialisation put it a few tenths away)
+                   (SAC's, TQC's and TD3's default initialisation start it further away)
 ``frame_stack``    memory: the policy sees the last N (normalised) observations, newest last, as
                    rl-zoo3's ``frame_stack`` (``VecFrameStack``); the saved policy stacks them
                    itself (:class:`agents.sb3_policy.FrameStack`; default 1)

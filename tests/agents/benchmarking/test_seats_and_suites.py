@@ -280,3 +280,21 @@ def test_the_hard_table_ranks_only_equal_step_budgets_over_three_seeds():
     few["runs"] = [r for r in few["runs"] if not (r["algo"] == algo and r["seed"] != few["runs"][0]["seed"])]
     with pytest.raises(ValueError, match=f"{algo}: 1 seed"):
         hard_ranking(few, "nominal")
+
+
+def test_the_learning_table_quotes_each_seed_and_the_target_of_its_groups():
+    """docs/tasks.md's learning table (results.learning_table) comes from a report's seed
+    groups: every seed's score and difference with their SEs, mean ± std, mean − std and the
+    target line of the same data."""
+    from agents.benchmarking.results import learning_table
+    board, groups = _board_and_groups(3)
+    for i, e in enumerate(board):
+        e.update(score_se=0.5, diff_vs_reference=e["score"] - 60.0, diff_se=0.1 * i)
+    report = dict(suite="robust", scenarios=[{}] * 200, leaderboard=board, seed_groups=groups,
+                  target=target(board, groups))
+    text = learning_table(report)
+    assert "200 test drops" in text and "`whirl-brake` (controller seat) 60.00 ± 0.50" in text
+    (row,) = [line for line in text.splitlines() if line.startswith("| `ppo`")]
+    assert "| supervisor | 3 | 70.00 ± 0.50, 71.00 ± 0.50, 72.00 ± 0.50 |" in row
+    assert "+10.00 ± 0.20, +11.00 ± 0.30" in row and "| 71.00 ± 1.00 | 70.00 |" in row
+    assert text.endswith("best configuration 70.00 (mean − std) against 62.00: met.")
