@@ -806,7 +806,8 @@ def standing(report: dict, task: str) -> str:
 
 #: docs/tasks.md's learning tables: key -> a `rotordrop benchmark --suite robust --only ...`
 #: report of learned seed groups beside their reference (``rotordrop results --learning KEY=FILE``)
-LEARNING = {"controller-seat": "learning-controller-seat.json"}
+LEARNING = {"controller-seat-residual": "learning-controller-seat-residual.json",
+            "controller-seat-scratch": "learning-controller-seat-scratch.json"}
 
 
 def learning_table(report: dict) -> str:
