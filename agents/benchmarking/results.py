@@ -747,7 +747,11 @@ def store(src: str | Path, dest: Path, keep=None, drop=()) -> Path:
     report = json.loads(Path(src).read_text())
     if keep is not None:
         report = {k: report[k] for k in keep if k in report}
-    report = {k: v for k, v in report.items() if k not in drop}
+    return write_report({k: v for k, v in report.items() if k not in drop}, dest)
+
+
+def write_report(report: dict, dest: Path) -> Path:
+    """``report`` as docs/data writes JSON (sorted keys, one-space indent)."""
     dest.parent.mkdir(parents=True, exist_ok=True)
     dest.write_text(json.dumps(report, indent=1, sort_keys=True) + "\n")
     return dest
@@ -808,6 +812,15 @@ def standing(report: dict, task: str) -> str:
 #: report of learned seed groups beside their reference (``rotordrop results --learning KEY=FILE``)
 LEARNING = {"controller-seat-residual": "learning-controller-seat-residual.json",
             "controller-seat-scratch": "learning-controller-seat-scratch.json"}
+
+
+def store_learning(paths: list[str], dest: Path) -> Path:
+    """Benchmark reports of learned seed groups on the same drops (one, or several run apart:
+    :func:`agents.benchmarking.score.merged_groups`) stored as one learning report."""
+    from .score import merged_groups
+    reports = [json.loads(Path(p).read_text()) for p in paths]
+    report = reports[0] if len(reports) == 1 else merged_groups(reports)
+    return write_report({k: v for k, v in report.items() if k not in DROPPED_KEYS}, dest)
 
 
 def learning_table(report: dict) -> str:
@@ -910,9 +923,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                                             "store as docs/data/oracle-nominal.json")
     p.add_argument("--oracle-robust", help="a `rotordrop oracle --suite robust` oracle.json to "
                                            "store as docs/data/oracle-robust.json")
-    p.add_argument("--learning", action="append", default=[], metavar="KEY=FILE",
-                   help="a `rotordrop benchmark --suite robust --only REF --policy RUN...` "
-                        "benchmark.json of learned seed groups, stored as the docs/data file of "
+    p.add_argument("--learning", action="append", default=[], metavar="KEY=FILE[,FILE...]",
+                   help="`rotordrop benchmark --suite robust --only REF --policy RUN...` "
+                        "benchmark.json files of learned seed groups on the same drops (merged), "
+                        "stored as the docs/data file of "
                         f"KEY ({', '.join(f'{k}: {v}' for k, v in LEARNING.items())}) for "
                         "docs/tasks.md's learning table (repeatable)")
     p.add_argument("--headroom", help="a `python -m agents.benchmarking.headroom` headroom.json of "
@@ -957,10 +971,14 @@ def run(args) -> int:
     for spec in args.learning:
         key, _, src = spec.partition("=")
         if key not in LEARNING or not src:
-            print(f"results: error: --learning {spec!r}: write KEY=FILE with KEY one of "
-                  f"{', '.join(LEARNING)}", file=sys.stderr)
+            print(f"results: error: --learning {spec!r}: write KEY=FILE[,FILE...] with KEY one "
+                  f"of {', '.join(LEARNING)}", file=sys.stderr)
             return 2
-        stored.append(store(src, root / DATA / LEARNING[key], drop=DROPPED_KEYS))
+        try:
+            stored.append(store_learning(src.split(","), root / DATA / LEARNING[key]))
+        except (ValueError, KeyError) as exc:
+            print(f"results: error: --learning {key}: {exc}", file=sys.stderr)
+            return 2
     if args.oracle_budget:
         runs = [budget_run(json.loads(Path(p).read_text())) for p in args.oracle_budget]
         dest = root / DATA / "oracle-budget.json"

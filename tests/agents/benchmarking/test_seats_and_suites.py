@@ -298,3 +298,29 @@ def test_the_learning_table_quotes_each_seed_and_the_target_of_its_groups():
     assert "| supervisor | 3 | 70.00 ± 0.50, 71.00 ± 0.50, 72.00 ± 0.50 |" in row
     assert "+10.00 ± 0.20, +11.00 ± 0.30" in row and "| 71.00 ± 1.00 | 70.00 |" in row
     assert text.endswith("best configuration 70.00 (mean − std) against 62.00: met.")
+
+
+def test_reports_of_the_same_drops_merge_into_one_seed_group():
+    """Seeds scored in separate benchmark runs on the same drops (score.merged_groups): the
+    reference kept once, the seeds grouped by their recorded configuration, the target judged
+    on the merged group as if they had run together; other drops or a row whose numbers differ
+    are refused."""
+    from agents.benchmarking.score import merged_groups
+    board, groups = _board_and_groups(3)
+    whole = target(board, groups)
+    common = dict(suite="robust", score="severity", bootstrap={"seed": 0}, scenarios=[{"seed": 1}])
+    ref = [e for e in board if e["kind"] == "designed"]
+    parts = [dict(common, leaderboard=ref + [e for e in board if e["controller"] in names])
+             for names in (("ppo@s0", "ppo@s1"), ("ppo@s2",))]
+    merged = merged_groups(parts)
+    (g,) = merged["seed_groups"]
+    assert sorted(g["members"]) == ["ppo@s0", "ppo@s1", "ppo@s2"]
+    assert g["mean_minus_std"] == pytest.approx(groups[0]["mean_minus_std"])
+    assert merged["target"]["met"] == whole["met"] is True
+    assert [e["controller"] for e in merged["leaderboard"]].count("whirl-brake") == 1
+    with pytest.raises(ValueError, match="differ in scenarios"):
+        merged_groups([parts[0], dict(parts[1], scenarios=[{"seed": 2}])])
+    other = [dict(e, score=e["score"] + 1) if e["controller"] == "whirl-brake" else e
+             for e in parts[1]["leaderboard"]]
+    with pytest.raises(ValueError, match="row whirl-brake scores"):
+        merged_groups([parts[0], dict(parts[1], leaderboard=other)])
