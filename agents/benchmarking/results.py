@@ -830,8 +830,10 @@ def learning_table(report: dict) -> str:
     board = {e["controller"]: e for e in report["leaderboard"]}
     t = report["target"]
     ref = t["best_designed"]
-    lines = [f"{len(report['scenarios'])} test drops of `--suite {report['suite']}`; reference: "
-             f"{_cited(board[ref])}; Δ: paired bootstrap against it.", "",
+    r = board[ref]
+    lines = [f"{len(report['scenarios'])} test drops of `--suite {report['suite']}`; reference "
+             f"`{ref}` on the same drops: {r['score']:.2f} ± {r['score_se']:.2f} "
+             f"({r.get('seat') or '-'} seat); Δ: paired bootstrap against it.", "",
              "| configuration | seat | seeds | test score ± SE per seed | Δ ± SE per seed | "
              "mean ± std | mean − std |", "|---|---|---:|---|---|---:|---:|"]
     for g in report["seed_groups"]:

@@ -293,7 +293,7 @@ def test_the_learning_table_quotes_each_seed_and_the_target_of_its_groups():
     report = dict(suite="robust", scenarios=[{}] * 200, leaderboard=board, seed_groups=groups,
                   target=target(board, groups))
     text = learning_table(report)
-    assert "200 test drops" in text and "`whirl-brake` (controller seat) 60.00 ± 0.50" in text
+    assert "200 test drops" in text and "`whirl-brake` on the same drops: 60.00 ± 0.50 (controller" in text
     (row,) = [line for line in text.splitlines() if line.startswith("| `ppo`")]
     assert "| supervisor | 3 | 70.00 ± 0.50, 71.00 ± 0.50, 72.00 ± 0.50 |" in row
     assert "+10.00 ± 0.20, +11.00 ± 0.30" in row and "| 71.00 ± 1.00 | 70.00 |" in row
