@@ -152,7 +152,7 @@ def cmd_benchmark(args) -> int:
                   max_scenarios=args.scenarios, episodes=args.episodes, progress=not args.quiet,
                   plots=not args.no_plots, power_return=_power_return_s(args),
                   backend=Backend.from_args(args), env_id=args.env, names=args.name,
-                  score=args.score)
+                  score=args.score, only=args.only)
     except ERRORS as exc:
         return _fail("benchmark", exc)
     return 0
@@ -382,6 +382,10 @@ def _register_benchmark(sub) -> None:
     p.add_argument("--name", action="append", default=None,
                    help="the leaderboard name of a --policy model given by path (repeatable: one "
                         "per model, in order; default name@run)")
+    p.add_argument("--only", action="append", default=None, metavar="ROW",
+                   help="a drawn suite (--suite robust) with only these baselines or shipped "
+                        "policies (repeatable), beside the --policy extras and the passive "
+                        "reference: a subset of the leaderboard, same drops and bootstrap")
     p.add_argument("--power-return-ms", type=float, default=None,
                    help="power-return delay of the re-levitation tasks [ms] (default: the "
                         "environments' 50 ms; the 'power back at 0.15 s' scenario keeps its own)")

@@ -229,16 +229,27 @@ def _entries(policies: list[LearnedPolicy], controllers=(), tasks=None, suite=No
 
 def robust_entries(policies: list[str] | None, env_id: str | None = None,
                    names: list[str] | None = None, suite=None,
-                   quick: bool = False) -> tuple[list[Entry], dict]:
+                   quick: bool = False, only: list[str] | None = None) -> tuple[list[Entry], dict]:
     """The Full-task entries of a drawn suite: every baseline with channels there (with its
     constants tuned on ``suite``, if it has a record; none without a suite), the shipped Full policies
     (with ``quick`` and ``policies`` given: only those asked for), the ``--policy`` extras (see
-    :func:`extras` for ``env_id`` and ``names``); and the learned ones by name."""
+    :func:`extras` for ``env_id`` and ``names``); and the learned ones by name. ``only``
+    (``--only NAME``): of the baselines and shipped policies just those named (the ``--policy``
+    extras and ``passive``, the score's reference, always run); a name that is neither is a
+    ValueError naming the rows."""
     extra, custom = extras(policies or [], env_id, names)
     loaded = [p for p in [load_shipped(n) for n in shipped_names(policies, quick)] + extra
               if p.env_id == TASKS["full"]]
     entries = check_unique_names([e for e in _entries(loaded, custom, ("full",), suite)
                                   if e.task == "full"])
+    if only:
+        kept = {"passive", *only, *(p.name for p in extra), *(c.name for c in custom)}
+        unknown = sorted(set(only) - {e.name for e in entries})
+        if unknown:
+            raise ValueError(f"--only {', '.join(unknown)}: not a row of the suite (rows: "
+                             f"{', '.join(e.name for e in entries)})")
+        loaded = [p for p in loaded if p.name in kept]
+        entries = [e for e in entries if e.name in kept]
     for e in [e for e in entries if e.name in {c.name for c in custom}]:
         check_actor(TASKS[e.task], e.make, e.env_kwargs)
     return entries, {p.name: p for p in loaded}

@@ -754,7 +754,11 @@ def store(src: str | Path, dest: Path, keep=None, drop=()) -> Path:
     report = json.loads(Path(src).read_text())
     if keep is not None:
         report = {k: report[k] for k in keep if k in report}
-    report = {k: v for k, v in report.items() if k not in drop}
+    return write_report({k: v for k, v in report.items() if k not in drop}, dest)
+
+
+def write_report(report: dict, dest: Path) -> Path:
+    """``report`` as docs/data writes JSON (sorted keys, one-space indent)."""
     dest.parent.mkdir(parents=True, exist_ok=True)
     dest.write_text(json.dumps(report, indent=1, sort_keys=True) + "\n")
     return dest
@@ -811,18 +815,77 @@ def standing(report: dict, task: str) -> str:
     return " ".join(out)
 
 
+#: docs/tasks.md's learning tables: key -> a `rotordrop benchmark --suite robust --only ...`
+#: report of learned seed groups beside their reference (``rotordrop results --learning KEY=FILE``)
+LEARNING = {"controller-seat-residual": "learning-controller-seat-residual.json",
+            "controller-seat-scratch": "learning-controller-seat-scratch.json"}
+
+
+def store_learning(paths: list[str], dest: Path) -> Path:
+    """Benchmark reports of learned seed groups on the same drops (one, or several run apart:
+    :func:`agents.benchmarking.score.merged_groups`) stored as one learning report."""
+    from .score import merged_groups
+    reports = [json.loads(Path(p).read_text()) for p in paths]
+    report = reports[0] if len(reports) == 1 else merged_groups(reports)
+    return write_report({k: v for k, v in report.items() if k not in DROPPED_KEYS}, dest)
+
+
+def learning_table(report: dict) -> str:
+    """The learned configurations of a benchmark report (its seed groups) against the best
+    designed row there: per seed the test score ± SE and the difference to that row (paired
+    bootstrap), the seeds' mean ± std and mean − std, then the target line."""
+    board = {e["controller"]: e for e in report["leaderboard"]}
+    t = report["target"]
+    ref = t["best_designed"]
+    r = board[ref]
+    lines = [f"{len(report['scenarios'])} test drops of `--suite {report['suite']}`; reference "
+             f"`{ref}` on the same drops: {r['score']:.2f} ± {r['score_se']:.2f} "
+             f"({r.get('seat') or '-'} seat); Δ: paired bootstrap against it.", "",
+             "| configuration | seat | seeds | test score ± SE per seed | Δ ± SE per seed | "
+             "mean ± std | mean − std |", "|---|---|---:|---|---|---:|---:|"]
+    for g in report["seed_groups"]:
+        rows = [board[m] for m in g["members"]]
+        lines.append(f"| {_common_name(g['members'])} | {rows[0].get('seat') or '-'} | "
+                     f"{len(rows)} | " + ", ".join(f"{e['score']:.2f} ± {e['score_se']:.2f}"
+                                                    for e in rows)
+                     + " | " + ", ".join(f"{e['diff_vs_reference']:+.2f} ± {e['diff_se']:.2f}"
+                                         for e in rows)
+                     + f" | {g['mean']:.2f} ± {g['std']:.2f} | {g['mean_minus_std']:.2f} |")
+    verdict = ("not judged: no configuration with "
+               f"{t['min_seeds']} seeds" if t["met"] is None else
+               f"best configuration {t['best_learned_score']:.2f} (mean − std) against "
+               f"{t['best_designed_score'] + t['margin']:.2f}: {'met' if t['met'] else 'not met'}")
+    lines += ["", f"Target (mean − std over ≥ {t['min_seeds']} seeds ≥ best designed "
+                  f"+{t['margin']:g}) on these drops: {verdict}."]
+    return "\n".join(lines)
+
+
+def _common_name(names: list[str]) -> str:
+    """The configuration's name: what its members' names share, up to a separator."""
+    import os
+    prefix = os.path.commonprefix(names).rstrip("-_@s0123456789") or names[0]
+    return f"`{prefix}`"
+
+
+def _regenerate(text: str, kind: str, key: str, block: str) -> str:
+    start, end = f"<!-- {kind}:{key}:start -->", f"<!-- {kind}:{key}:end -->"
+    pattern = re.compile(re.escape(start) + r".*?" + re.escape(end), flags=re.S)
+    return pattern.sub(lambda _: f"{start}\n{block}\n{end}", text)
+
+
 def tasks_text(root: Path = ROOT) -> str:
     """docs/tasks.md with each ``<!-- standing:KEY:start -->`` ... ``end`` block regenerated
-    from the committed leaderboards (:data:`STANDINGS`)."""
+    from the committed leaderboards (:data:`STANDINGS`), and each ``<!-- learning:KEY:... -->``
+    block from its learning report (:data:`LEARNING`)."""
     text = (root / TASKS).read_text()
     for key, (name, task) in STANDINGS.items():
         report = _load(root / DATA / name)
-        start, end = f"<!-- standing:{key}:start -->", f"<!-- standing:{key}:end -->"
-        pattern = re.compile(re.escape(start) + r".*?" + re.escape(end), flags=re.S)
-        if report is None or not pattern.search(text):
-            continue
-        block = standing(report, task)
-        text = pattern.sub(lambda _: f"{start}\n{block}\n{end}", text)
+        if report is not None:
+            text = _regenerate(text, "standing", key, standing(report, task))
+    for key, name in LEARNING.items():
+        report = _load(root / DATA / name)
+        if report is not None:
+            text = _regenerate(text, "learning", key, learning_table(report))
     return text
 
 
@@ -869,6 +932,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                                             "store as docs/data/oracle-nominal.json")
     p.add_argument("--oracle-robust", help="a `rotordrop oracle --suite robust` oracle.json to "
                                            "store as docs/data/oracle-robust.json")
+    p.add_argument("--learning", action="append", default=[], metavar="KEY=FILE[,FILE...]",
+                   help="`rotordrop benchmark --suite robust --only REF --policy RUN...` "
+                        "benchmark.json files of learned seed groups on the same drops (merged), "
+                        "stored as the docs/data file of "
+                        f"KEY ({', '.join(f'{k}: {v}' for k, v in LEARNING.items())}) for "
+                        "docs/tasks.md's learning table (repeatable)")
     p.add_argument("--headroom", help="a `python -m agents.benchmarking.headroom` headroom.json of "
                                       "the robust leaderboard, stored as "
                                       "docs/data/headroom-robust.json")
@@ -886,7 +955,7 @@ def run(args) -> int:
     """Store the given benchmark output in docs/data and regenerate the pages (or ``--check``)."""
     root = Path(args.root)
     given = (args.nominal, args.robust, args.hard, args.oracle_nominal, args.oracle_robust,
-             args.oracle_budget, args.headroom, args.hard_run, args.hard_ref)
+             args.oracle_budget, args.headroom, args.hard_run, args.hard_ref, args.learning)
     if args.check and any(given):
         print("results: error: --check takes no data files", file=sys.stderr)
         return 2
@@ -908,6 +977,17 @@ def run(args) -> int:
             stored.append(store(src, root / DATA / name, keep=ORACLE_KEYS))
     if args.headroom:
         stored.append(store(args.headroom, root / DATA / "headroom-robust.json"))
+    for spec in args.learning:
+        key, _, src = spec.partition("=")
+        if key not in LEARNING or not src:
+            print(f"results: error: --learning {spec!r}: write KEY=FILE[,FILE...] with KEY one "
+                  f"of {', '.join(LEARNING)}", file=sys.stderr)
+            return 2
+        try:
+            stored.append(store_learning(src.split(","), root / DATA / LEARNING[key]))
+        except (ValueError, KeyError) as exc:
+            print(f"results: error: --learning {key}: {exc}", file=sys.stderr)
+            return 2
     if args.oracle_budget:
         runs = [budget_run(json.loads(Path(p).read_text())) for p in args.oracle_budget]
         dest = root / DATA / "oracle-budget.json"

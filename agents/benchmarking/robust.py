@@ -130,11 +130,13 @@ def training_env_kwargs(control_dt: float = 0.005) -> dict:
 def robust_benchmark(out, quick: bool = False, policies: list[str] | None = None,
                      max_scenarios: int | None = None, progress: bool = True, plots: bool = True,
                      backend=None, env_id: str | None = None, names: list[str] | None = None,
-                     score: str | None = None, *, suite) -> dict:
+                     score: str | None = None, only: list[str] | None = None, *,
+                     suite) -> dict:
     """``rotordrop benchmark --suite robust``: every row of the suite's task (baselines, shipped
     and ``--policy`` policies), each in its seat (:mod:`agents.control.seats`), on the drawn
     scenarios of ``suite`` (a :class:`~agents.benchmarking.suites.DrawnSuite`, default the
-    robust one; module doc); writes benchmark.json, leaderboard.md and the plots into ``out``
+    robust one; module doc); ``only``: a subset of the rows
+    (:func:`agents.benchmarking.benchmark.robust_entries`); writes benchmark.json, leaderboard.md and the plots into ``out``
     in the nominal benchmark's format."""
     import time
     from pathlib import Path
@@ -154,7 +156,8 @@ def robust_benchmark(out, quick: bool = False, policies: list[str] | None = None
     if max_scenarios is not None:
         n = max(1, min(n, max_scenarios))
     scenarios = suite.scenarios(n)
-    entries, learned = robust_entries(policies, env_id, names, suite=suite, quick=quick)
+    entries, learned = robust_entries(policies, env_id, names, suite=suite, quick=quick,
+                                      only=only)
     with backend.session() as session:
         bar = tqdm(total=len(entries) * n, desc="robust suite", unit="ep", disable=not progress)
         rows = entry_rows(session, entries, scenarios, (0.0,), bar)
@@ -167,6 +170,7 @@ def robust_benchmark(out, quick: bool = False, policies: list[str] | None = None
         e["kind"] = "learned" if e["controller"] in learned else "designed"
     groups = seed_groups(board, learned)
     report = dict(suite=suite.name, quick=quick, partial=max_scenarios is not None,
+                  only=sorted(only) if only else None,
                   score=score, bootstrap=bootstrap_record(), episode_time_s=EPISODE_TIME,
                   distribution=suite.describe(suite, n),
                   scenarios=[scenario_record(s) for s in scenarios], rows=rows, leaderboard=board,

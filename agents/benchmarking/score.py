@@ -238,23 +238,39 @@ def attach_bootstrap(entries: list[dict], costs, passive, reference: int, cluste
 
 def seed_groups(board: list[dict], learned: dict) -> list[dict]:
     """Learned rows trained with the same algorithm and hyperparameters (the seeds of one
-    configuration): mean, standard deviation (over seeds, ddof = 1) and mean − std of their
-    scores; groups of one row are left out. A seed counts once: a shipped policy benchmarked
-    beside the run it was shipped from (same seed) is one member, the first listed."""
+    configuration): :func:`groups_of` with each policy's configuration (algorithm, env id,
+    hyperparameters) and seed."""
+    import hashlib
     import json
-    keys: dict[str, list[str]] = {}
-    seeds: dict[str, set] = {}
-    repeats: dict[str, list[str]] = {}
+    configs = {}
     for name, pol in learned.items():
         key = json.dumps([pol.algo, pol.env_id, pol.meta.get("hyperparams") or pol.env_kwargs],
                          sort_keys=True, default=str)
-        seed, seen = pol.meta.get("seed"), seeds.setdefault(key, set())
+        configs[name] = (hashlib.sha1(key.encode()).hexdigest()[:12], pol.meta.get("seed"))
+    return groups_of(board, configs)
+
+
+def groups_of(board: list[dict], configs: dict) -> list[dict]:
+    """The seed groups of ``board``'s rows named in ``configs`` (name -> (configuration key,
+    seed)): mean, standard deviation (over seeds, ddof = 1) and mean − std of their scores;
+    groups of one row are left out. A seed counts once: a shipped policy benchmarked beside the
+    run it was shipped from (same seed) is one member, the first listed. Each learned row gets
+    its ``configuration`` and ``seed`` (so reports on the same drops can be merged,
+    :func:`merged_groups`) and each member its seeds' spread."""
+    keys: dict[str, list[str]] = {}
+    seeds: dict[str, set] = {}
+    repeats: dict[str, list[str]] = {}
+    for name, (key, seed) in configs.items():
+        seen = seeds.setdefault(key, set())
         if seed is not None and seed in seen:
             repeats.setdefault(key, []).append(name)
             continue
         seen.add(seed)
         keys.setdefault(key, []).append(name)
     score = {e["controller"]: e["score"] for e in board}
+    for e in board:
+        if e["controller"] in configs:
+            e.update(configuration=configs[e["controller"]][0], seed=configs[e["controller"]][1])
     out = []
     for key, names in keys.items():
         if len(names) < 2:
@@ -269,6 +285,34 @@ def seed_groups(board: list[dict], learned: dict) -> list[dict]:
             if e["controller"] in g["members"] + g["repeats"]:
                 e.update(seeds=len(g["members"]), seed_mean=g["mean"], seed_std=g["std"])
     return out
+
+
+def merged_groups(reports: list[dict]) -> dict:
+    """One report of the leaderboards of ``reports`` (benchmark.json dicts of one drawn suite:
+    the same drops, score and bootstrap, e.g. seeds scored in separate runs): their rows (a
+    name seen twice, e.g. the reference, kept once: the same drops give it the same numbers),
+    the seed groups over the learned rows' recorded ``configuration`` and ``seed``, and the
+    target. ValueError when the reports' drops, score or bootstrap differ, or a row's numbers
+    differ between them."""
+    first = reports[0]
+    same = ("suite", "score", "bootstrap", "scenarios")
+    for r in reports[1:]:
+        for k in same:
+            if r.get(k) != first.get(k):
+                raise ValueError(f"the reports differ in {k}: merge reports of the same drops only")
+    board: dict[str, dict] = {}
+    for r in reports:
+        for e in r["leaderboard"]:
+            seen = board.setdefault(e["controller"], e)
+            if abs(seen["score"] - e["score"]) > 1e-9:
+                raise ValueError(f"row {e['controller']} scores {seen['score']:.4f} and "
+                                 f"{e['score']:.4f} in two reports of the same drops")
+    rows = sorted(board.values(), key=lambda e: -e["score"])
+    configs = {e["controller"]: (e["configuration"], e.get("seed")) for e in rows
+               if e.get("kind") == "learned" and e.get("configuration")}
+    groups = groups_of(rows, configs)
+    return {**{k: first.get(k) for k in same}, "leaderboard": rows, "seed_groups": groups,
+            "target": target(rows, groups)}
 
 
 #: a target is judged on a configuration of at least this many seeds (mean − std over them)

@@ -91,6 +91,9 @@ class NominalSuite(Suite):
 
     def run(self, out, **options) -> dict:
         from .benchmark import benchmark
+        if options.pop("only", None):
+            raise ValueError(f"--only applies to a drawn suite (one episode per drop), not to "
+                             f"--suite {self.name}")
         return benchmark(out, **options)
 
 
@@ -195,16 +198,18 @@ def run_suite(suite: str, out, quick: bool = False, policies: list[str] | None =
               max_scenarios: int | None = None, episodes: int | None = None,
               progress: bool = True, plots: bool = True, power_return: float | None = None,
               backend=None, env_id: str | None = None, names: list[str] | None = None,
-              score: str | None = None, registry: SuiteRegistry | None = None) -> dict:
+              score: str | None = None, registry: SuiteRegistry | None = None,
+              only: list[str] | None = None) -> dict:
     """``rotordrop benchmark --suite SUITE``: the suite of that name in ``registry`` (default
     :data:`SUITES`) runs itself (:meth:`Suite.run`): the nominal one
     :func:`agents.benchmarking.benchmark.benchmark`, a drawn one
     :func:`agents.benchmarking.robust.robust_benchmark` (where ``episodes`` and
     ``power_return`` do not apply: its scenarios draw the power return, one episode each).
-    ``score``: :data:`agents.benchmarking.score.SCORES` (default the first)."""
+    ``score``: :data:`agents.benchmarking.score.SCORES` (default the first); ``only``: the
+    baselines and shipped policies to run (drawn suites; ``passive`` and ``policies`` always)."""
     from .score import DEFAULT_SCORE, check_score
     score = check_score(score if score is not None else DEFAULT_SCORE)
     chosen = (registry or SUITES).get(suite, "benchmark")
     return chosen.run(out, quick=quick, policies=policies, max_scenarios=max_scenarios,
                       episodes=episodes, progress=progress, plots=plots, power_return=power_return,
-                      backend=backend, env_id=env_id, names=names, score=score)
+                      backend=backend, env_id=env_id, names=names, score=score, only=only)

@@ -63,6 +63,30 @@ def set_action_log_std(policy, action_names, log_std: dict) -> None:
             param[list(action_names).index(name)] = v
 
 
+def zero_action_mean(policy) -> None:
+    """Zero the last layer of ``policy``'s action mean (config key ``zero_start``): PPO's
+    ``action_net``, the ``mu`` head of SAC, TQC, CrossQ and TD3 (and TD3's target actor), so
+    the deterministic action is 0 for every observation until training moves it (the layer's
+    gradients are the features', not zero). ConfigError for a policy without such a layer."""
+    import torch
+    heads = [getattr(policy, "action_net", None)]
+    for actor in (getattr(policy, "actor", None), getattr(policy, "actor_target", None)):
+        heads.append(getattr(actor, "mu", None))
+    layers = [_last_linear(h) for h in heads if h is not None]
+    if not layers or None in layers:
+        raise ConfigError(f"zero_start: {type(policy).__name__} has no action-mean layer to zero")
+    with torch.no_grad():
+        for layer in layers:
+            layer.weight.zero_()
+            layer.bias.zero_()
+
+
+def _last_linear(module):
+    import torch
+    linear = [m for m in module.modules() if isinstance(m, torch.nn.Linear)]
+    return linear[-1] if linear else None
+
+
 class ActionSpread(BaseCallback):
     """Sets the initial log std of the named action entries when training starts from scratch
     (rl-zoo3: ``callback: - agents.learning.exploration.ActionSpread: {log_std: {...}}``; in

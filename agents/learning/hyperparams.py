@@ -31,6 +31,10 @@ arguments a block may hold:
                    phases the benchmark does not use) instead of the highest evaluation reward
 ``action_log_std`` PPO: initial log std of named action entries, e.g. ``{gain: -1.0}``; the
                    others keep ``log_std_init`` (:mod:`agents.learning.exploration`)
+``zero_start``     ``true``: the policy's action mean starts at exactly zero (its last layer
+                   zeroed, :func:`agents.learning.exploration.zero_action_mean`), so the
+                   deterministic initial policy is a = 0: with ``residual``, the baseline itself
+                   (SAC's, TQC's and TD3's default initialisation start it further away)
 ``frame_stack``    memory: the policy sees the last N (normalised) observations, newest last, as
                    rl-zoo3's ``frame_stack`` (``VecFrameStack``); the saved policy stacks them
                    itself (:class:`agents.sb3_policy.FrameStack`; default 1)
@@ -86,7 +90,7 @@ CONTRIB_ALGOS = tuple(a for a, (module, _) in ALGO_CLASSES.items() if module == 
 META_KEYS = ("n_timesteps", "n_envs", "policy", "policy_kwargs", "normalize", "env_kwargs",
              "eval_freq", "n_eval_episodes", "checkpoint_freq", "noise_type", "noise_std",
              "reward", "reward_kwargs", "residual", "residual_scale", "validation",
-             "action_log_std", "frame_stack")
+             "action_log_std", "frame_stack", "zero_start")
 REWARDS = ("env", "kpi")
 #: evaluation and checkpoint intervals [environment steps] and evaluation episodes of a run
 #: when neither the command line nor the config sets them (rl-zoo3's eval_freq too)
@@ -459,8 +463,9 @@ def split(hp: dict) -> tuple[dict, dict]:
             raise ConfigError(f"residual_scale must be a number, got {meta['residual_scale']!r}") from exc
         if not 0.0 < meta["residual_scale"] <= 2.0:
             raise ConfigError(f"residual_scale must be in (0, 2], got {meta['residual_scale']}")
-    if not isinstance(meta.setdefault("validation", False), bool):
-        raise ConfigError(f"validation must be true or false, got {meta['validation']!r}")
+    for flag in ("validation", "zero_start"):
+        if not isinstance(meta.setdefault(flag, False), bool):
+            raise ConfigError(f"{flag} must be true or false, got {meta[flag]!r}")
     if "action_log_std" in meta:
         from .exploration import check_action_log_std
         meta["action_log_std"] = check_action_log_std(meta["action_log_std"])

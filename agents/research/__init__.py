@@ -1,10 +1,12 @@
-"""``rotordrop research whirl-bound | tune-whirl-brake | tune-designed``: research probes of the re-levitation
+"""``rotordrop research whirl-bound | tune-whirl-brake | tune-designed | seat-oracle``: research probes of the re-levitation
 task (docs/agents.md), kept apart from the speed scripts in ``benchmarks/``.
 
 ``whirl-bound`` (:mod:`agents.research.whirl_bound`) searches the AMB current sequence with the
 fewest backward-whirl revolutions in a known scenario, an empirical lower bound for feedback
 control; ``tune-whirl-brake`` (:mod:`agents.research.tune_whirl_brake`) tunes the gains of the
-``whirl-brake`` baseline on scenarios the benchmark does not use. Registration is light: the
+``whirl-brake`` baseline on scenarios the benchmark does not use; ``seat-oracle``
+(:mod:`agents.research.seat_oracle`) scores each test drop by the best of a pool of
+``whirl-brake`` gain sets in the law's seat (a searched plan that knows the drop). Registration is light: the
 environments are imported by the handlers.
 """
 from __future__ import annotations
@@ -58,6 +60,24 @@ def register(subparsers) -> None:
     q.add_argument("--quiet", action="store_true", help="no progress bar")
     q.set_defaults(func=cmd_tune_designed)
 
+    q = sub.add_parser("seat-oracle", help="per test drop, the best of a pool of whirl-brake "
+                                           "gain sets in its seat (inside the AMB controller): "
+                                           "a searched plan that knows the drop, against the "
+                                           "tuned law (seat_oracle.json)")
+    q.add_argument("--suite", default="robust", help="a drawn suite (default robust)")
+    q.add_argument("--scenarios", type=at_least(1), default=50,
+                   help="its first test drops (default 50)")
+    q.add_argument("--draws", type=at_least(0), default=8,
+                   help="gain sets drawn around the tuned gains, besides the tuned, the class "
+                        "defaults and whirl-brake-robust's (default 8)")
+    q.add_argument("--spread", type=float, default=0.1,
+                   help="std of a draw as a fraction of each gain's tuning range (default 0.1)")
+    q.add_argument("--seed", type=at_least(0), default=0, help="seed of the draws")
+    q.add_argument("--out", default="out/seat-oracle")
+    q.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_backend_args(q, resume=False)
+    q.set_defaults(func=cmd_seat_oracle)
+
     q = sub.add_parser("tune-whirl-brake", help="tune the whirl-brake baseline's gains by "
                                                 "cross-entropy search on a tuning set (tune.json)")
     q.add_argument("--env", default="RotorDrop-Relevitate-v1",
@@ -82,6 +102,11 @@ def cmd_tune_designed(args) -> int:
 
 def cmd_whirl_bound(args) -> int:
     from .whirl_bound import run
+    return _usage_errors(run, args)
+
+
+def cmd_seat_oracle(args) -> int:
+    from .seat_oracle import run
     return _usage_errors(run, args)
 
 

@@ -4,8 +4,9 @@ validation score and of the evaluation backward-whirl rate against environment s
     python -m agents.training.learning_curves --group ppo=runs/ppo-scratch-0,runs/ppo-scratch-1 \\
         --group sac=runs/sac-scratch-0 --out docs/img/learning-scratch.png
 
-Writes the PNG and a CSV next to it (label, steps, number of runs, mean and std of each
-quantity). Runs of one label are aligned on the evaluation steps they share (the shortest run
+Writes the PNG (mean ± std per label, each run as a thin line) and two CSVs next to it: the
+mean and std per label (label, steps, number of runs, mean and std of each quantity) and, in
+``<name>-runs.csv``, every run's own values (label, run, steps, each quantity). Runs of one label are aligned on the evaluation steps they share (the shortest run
 decides the end). ``--quantity KEY`` (repeatable) plots other entries of the learning curve,
 e.g. ``--quantity mean_relevitated --quantity mean_reward`` (:data:`TITLES` names the usual).
 """
@@ -59,12 +60,18 @@ def write(groups: dict[str, list[str]], out: Path, quantities=QUANTITIES) -> lis
     fig, axes = plt.subplots(len(quantities), 1, figsize=(7, 3 * len(quantities)), sharex=True,
                              squeeze=False)
     axes = axes[:, 0]
-    rows = []
+    rows, per_run = [], []
     for i, (label, runs) in enumerate(groups.items()):
         data = aggregate(runs, quantities)
         steps = data["steps"]
+        for r, run in enumerate(runs):
+            per_run += [[label, str(run), int(s)] + [f"{data[k][r, j]:.6g}" for k, _ in quantities]
+                        for j, s in enumerate(steps)]
         for ax, (key, title) in zip(axes, quantities):
             mean, std = _nan_stats(data[key])
+            if len(runs) > 1:
+                for values in data[key]:
+                    ax.plot(steps, values, color=f"C{i % 10}", linewidth=0.6, alpha=0.45)
             # markers: a run that evaluated once (a short wall-clock budget) still shows; past
             # ten curves the colours repeat with another line style
             ax.plot(steps, mean, color=f"C{i % 10}", linestyle=("-", "--", ":")[i // 10 % 3],
@@ -89,7 +96,12 @@ def write(groups: dict[str, list[str]], out: Path, quantities=QUANTITIES) -> lis
         w.writerow(["label", "timesteps", "runs"] + [f"{k}_{s}" for k, _ in quantities
                                                      for s in ("mean", "std")])
         w.writerows(rows)
-    return [out, csv_path]
+    runs_path = out.with_name(f"{out.stem}-runs.csv")
+    with runs_path.open("w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["label", "run", "timesteps"] + [k for k, _ in quantities])
+        w.writerows(per_run)
+    return [out, csv_path, runs_path]
 
 
 def main(argv=None) -> int:

@@ -278,12 +278,16 @@ def _new_model(algo: str, meta: dict, algo_kwargs: dict, venv, seed: int, out: P
     if algo == "td3" and "noise_type" in meta:
         algo_kwargs["action_noise"] = _action_noise(meta, venv.action_space.shape[0])
     try:
-        return algo_class(algo)(meta.get("policy", "MlpPolicy"), venv, seed=seed, device="cpu",
-                                 tensorboard_log=str(out / "tb"), verbose=verbose, **algo_kwargs)
+        model = algo_class(algo)(meta.get("policy", "MlpPolicy"), venv, seed=seed, device="cpu",
+                                  tensorboard_log=str(out / "tb"), verbose=verbose, **algo_kwargs)
     except ConfigError:
         raise
     except (AssertionError, TypeError, ValueError, KeyError) as exc:
         raise ConfigError(f"{algo} hyperparameters: {exc}") from exc
+    if meta.get("zero_start"):
+        from ..learning.exploration import zero_action_mean
+        zero_action_mean(model.policy)
+    return model
 
 
 def _resumed_model(algo: str, env_id: str, ckpt: tuple, norm, venv, out: Path, verbose: int):

@@ -280,3 +280,47 @@ def test_the_hard_table_ranks_only_equal_step_budgets_over_three_seeds():
     few["runs"] = [r for r in few["runs"] if not (r["algo"] == algo and r["seed"] != few["runs"][0]["seed"])]
     with pytest.raises(ValueError, match=f"{algo}: 1 seed"):
         hard_ranking(few, "nominal")
+
+
+def test_the_learning_table_quotes_each_seed_and_the_target_of_its_groups():
+    """docs/tasks.md's learning table (results.learning_table) comes from a report's seed
+    groups: every seed's score and difference with their SEs, mean ± std, mean − std and the
+    target line of the same data."""
+    from agents.benchmarking.results import learning_table
+    board, groups = _board_and_groups(3)
+    for i, e in enumerate(board):
+        e.update(score_se=0.5, diff_vs_reference=e["score"] - 60.0, diff_se=0.1 * i)
+    report = dict(suite="robust", scenarios=[{}] * 200, leaderboard=board, seed_groups=groups,
+                  target=target(board, groups))
+    text = learning_table(report)
+    assert "200 test drops" in text and "`whirl-brake` on the same drops: 60.00 ± 0.50 (controller" in text
+    (row,) = [line for line in text.splitlines() if line.startswith("| `ppo`")]
+    assert "| supervisor | 3 | 70.00 ± 0.50, 71.00 ± 0.50, 72.00 ± 0.50 |" in row
+    assert "+10.00 ± 0.20, +11.00 ± 0.30" in row and "| 71.00 ± 1.00 | 70.00 |" in row
+    assert text.endswith("best configuration 70.00 (mean − std) against 62.00: met.")
+
+
+def test_reports_of_the_same_drops_merge_into_one_seed_group():
+    """Seeds scored in separate benchmark runs on the same drops (score.merged_groups): the
+    reference kept once, the seeds grouped by their recorded configuration, the target judged
+    on the merged group as if they had run together; other drops or a row whose numbers differ
+    are refused."""
+    from agents.benchmarking.score import merged_groups
+    board, groups = _board_and_groups(3)
+    whole = target(board, groups)
+    common = dict(suite="robust", score="severity", bootstrap={"seed": 0}, scenarios=[{"seed": 1}])
+    ref = [e for e in board if e["kind"] == "designed"]
+    parts = [dict(common, leaderboard=ref + [e for e in board if e["controller"] in names])
+             for names in (("ppo@s0", "ppo@s1"), ("ppo@s2",))]
+    merged = merged_groups(parts)
+    (g,) = merged["seed_groups"]
+    assert sorted(g["members"]) == ["ppo@s0", "ppo@s1", "ppo@s2"]
+    assert g["mean_minus_std"] == pytest.approx(groups[0]["mean_minus_std"])
+    assert merged["target"]["met"] == whole["met"] is True
+    assert [e["controller"] for e in merged["leaderboard"]].count("whirl-brake") == 1
+    with pytest.raises(ValueError, match="differ in scenarios"):
+        merged_groups([parts[0], dict(parts[1], scenarios=[{"seed": 2}])])
+    other = [dict(e, score=e["score"] + 1) if e["controller"] == "whirl-brake" else e
+             for e in parts[1]["leaderboard"]]
+    with pytest.raises(ValueError, match="row whirl-brake scores"):
+        merged_groups([parts[0], dict(parts[1], leaderboard=other)])

@@ -98,3 +98,36 @@ def test_a_policy_without_a_per_entry_log_std_is_refused():
                 policy_kwargs=dict(net_arch=[8]))
     with pytest.raises(ConfigError, match="needs a policy with one state-independent log std"):
         model.learn(64, callback=ActionSpread(SPREAD))
+
+
+@pytest.mark.parametrize("algo", ["sac", "ppo"])
+def test_zero_start_makes_the_untrained_residual_policy_its_baseline(tmp_path, algo):
+    """zero_start: the deterministic action of an untrained model is exactly 0 for any
+    observation, so a residual policy on max-damping commands C_max (damper action 1) at every
+    step; SAC's default initialisation does not (its mean head starts a few tenths away)."""
+    from agents.learning.policies import LearnedPolicy
+    from agents.control.plant import Plant, make_env
+    ppo_only = "  n_steps: 64\n  batch_size: 64\n  n_epochs: 1\n"
+    body = (TINY.replace(ppo_only, "  learning_starts: 1000\n") if algo == "sac" else TINY)
+    env = make_env("RotorDrop-Damping-v1", episode_time=0.02)
+    obs = np.stack([env.observation_space.sample() for _ in range(6)])
+    acts = {}
+    for zero in (True, False):
+        cfg = tmp_path / f"{zero}.yaml"
+        cfg.write_text(body + "  residual: max-damping\n  residual_scale: 1.0\n  learning_rate: 1.0e-12\n"
+                       + f"  zero_start: {str(zero).lower()}\n")
+        res = train("RotorDrop-Damping-v1", algo, tmp_path / f"run{zero}", timesteps=64,
+                    config=cfg, progress=False, eval_freq=0)
+        pol = LearnedPolicy.load(res.model_path)
+        acts[zero] = pol.bound(Plant.from_env(env)).predict(obs)[0]
+    np.testing.assert_array_equal(acts[True], 1.0)
+    if algo == "sac":
+        assert np.abs(acts[False] - 1.0).max() > 0.01
+
+
+def test_zero_start_must_be_a_flag(tmp_path):
+    cfg = tmp_path / "t.yaml"
+    cfg.write_text(TINY + "  zero_start: yes please\n")
+    with pytest.raises(ConfigError, match="zero_start must be true or false"):
+        train("RotorDrop-Damping-v1", "ppo", tmp_path / "run", timesteps=64, config=cfg,
+              progress=False)

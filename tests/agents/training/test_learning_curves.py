@@ -29,6 +29,10 @@ def test_mean_and_std_over_seeds_on_shared_steps(tmp_path):
     assert float(first["validation_score_mean"]) == 20.0
     assert float(first["validation_score_std"]) == 10.0
     assert [r["label"] for r in rows].count("sac") == 3
+    per_run = list(csv.DictReader((tmp_path / "lc-runs.csv").open()))
+    assert [(r["run"], r["timesteps"], float(r["validation_score"])) for r in per_run
+            if r["label"] == "ppo"] == [(a, "1000", 10.0), (a, "2000", 20.0), (b, "1000", 30.0),
+                                        (b, "2000", 40.0)]
     assert (tmp_path / "lc.png").stat().st_size > 0
 
 
