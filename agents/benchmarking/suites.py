@@ -22,6 +22,10 @@ from typing import Callable
 
 from .benchmark import round_up
 
+#: the Recover suites' env kwargs: the paper machine, exact sensing; machines drawn from the
+#: task's ranges (friction, unbalance, support, speed) with 2 µm sensor noise and 50 µs delay
+RECOVER_NOMINAL: dict = {}
+RECOVER_ROBUST: dict = {"randomize": True, "sensor_noise": 2e-6, "sensor_delay": 5e-5}
 #: what a command may run a suite for
 PURPOSES = ("benchmark", "tune", "oracle")
 
@@ -128,6 +132,22 @@ class DrawnSuite(Suite):
         return robust_benchmark(out, suite=self, **options)
 
 
+@dataclass(frozen=True)
+class RecoverSuite(Suite):
+    """Events of the ``Recover`` task, one per seed, drawn by the environment itself from its
+    event distribution (and, with ``randomize`` in ``env_kwargs``, its machine ranges); run
+    by :func:`agents.benchmarking.recover.recover_benchmark`. ``env_kwargs``: the suite's env
+    kwargs beyond each law's seat (sensing, randomisation)."""
+    env_kwargs: dict = field(default_factory=dict, compare=False)
+
+    def validation(self) -> list:
+        return list(self.validation_seeds())
+
+    def run(self, out, **options) -> dict:
+        from .recover import recover_benchmark
+        return recover_benchmark(out, suite=self, **options)
+
+
 class SuiteRegistry:
     """Suites by name. ``get(name, purpose)`` is the one place a name is looked up;
     :meth:`copy` gives a registry to add to without touching this one (tests, how-tos)."""
@@ -184,6 +204,14 @@ def _registry() -> SuiteRegistry:
         DrawnSuite("full", "drops of the Full task drawn by its own sampler from the oracle's "
                            "ranges (agents.research.oracle)", ("oracle",), seed=10_000,
                    env_id=TASKS["full"], power_grid=0.005),
+        RecoverSuite("recover", "events of the Recover task on the paper machine "
+                                "(agents.benchmarking.recover)", seed=60_000, size=200,
+                     quick_size=40, validation_seed=61_000, validation_size=60,
+                     env_id="RotorDrop-Recover-v1", env_kwargs=RECOVER_NOMINAL),
+        RecoverSuite("recover-robust", "events of the Recover task on machines drawn from the "
+                                       "task's ranges, with sensor noise and delay",
+                     seed=62_000, size=200, quick_size=40, validation_seed=63_000,
+                     validation_size=60, env_id="RotorDrop-Recover-v1", env_kwargs=RECOVER_ROBUST),
     ])
 
 

@@ -455,6 +455,131 @@ class WhirlBrakeSupervisor(InnerLoop):
         return out
 
 
+class ContactWatch:
+    """Persistent contact, as a law sees it from its sensors: per environment the fraction of
+    time the sensed orbit at either AMB plane lies beyond ``r_contact`` x clearance (the rotor
+    at its retainer bearing), low-pass filtered over ``revolutions`` spin revolutions; persistent
+    above ``fraction``. ``free``: the time since the orbit was last beyond it [s]."""
+
+    def __init__(self, plant: Plant, r_contact: float, revolutions: float, fraction: float):
+        self.plant, self.r_contact, self.revolutions = plant, r_contact, revolutions
+        self.fraction = fraction
+        self.level = np.zeros(0)
+        self.free = np.zeros(0)
+
+    def reset(self, n: int, which: np.ndarray | None) -> None:
+        if which is None or len(self.level) != n:
+            self.level, self.free = np.zeros(n), np.zeros(n)
+        else:
+            self.level[which] = self.free[which] = 0.0
+
+    def update(self, obs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(persistent, r / clearance at the larger of the two planes) after this observation."""
+        p = self.plant
+        pos = p.positions(obs)
+        r = np.hypot(pos[:, 0::2], pos[:, 1::2]).max(axis=1) / p.clearance
+        touching = r > self.r_contact
+        period = 2.0 * np.pi / np.maximum(np.abs(p.get(obs, "rotor_speed")), 1.0)
+        gain = np.minimum(p.control_dt / (self.revolutions * period), 1.0)
+        self.level += gain * (touching - self.level)
+        self.free = np.where(touching, 0.0, self.free + p.control_dt)
+        return self.level > self.fraction, r
+
+
+class SyncPhaseSearch(InnerLoop):
+    """Synchronous compensation with a phase search (supervisor seat, over the built-in PID).
+
+    On persistent contact (:class:`ContactWatch`: the sensed orbit beyond ``r_contact`` x
+    clearance for more than ``fraction`` of the last ``revolutions`` revolutions) it commands a
+    reference offset of amplitude ``amplitude`` x clearance at the angle φ from the sensed
+    orbit's radius (along the forward orbit for φ = 90°), on both AMB planes. The offset is
+    evaluated continuously inside the physics step in the frame of the sensed orbit, so for a
+    synchronous orbit it is a synchronous, spin-locked reference of phase φ relative to the
+    displacement, whatever the supervisor's step. The phase is searched over ``phases`` (deg,
+    in order), ``dwell`` revolutions each, until the orbit has stayed inside ``r_contact`` for
+    ``release`` revolutions; then the offset is removed and the watch starts again. φ = 180°
+    first: a pure pull towards the centre (a stiffer synchronous suspension)."""
+
+    name = "sync-phase-search"
+    sensors = True
+    GAINS = dict(amplitude=0.5, dwell=6.0, release=6.0, r_contact=0.85, revolutions=4.0,
+                 fraction=0.5, phases=(180.0, 135.0, 225.0, 90.0, 270.0))
+
+    def __init__(self, plant: Plant, **gains):
+        super().__init__(plant, gain=0.0, offset_r=0.0)
+        unknown = set(gains) - set(self.GAINS)
+        if unknown:
+            raise TypeError(f"unknown {self.name} constants {sorted(unknown)}; known: "
+                            f"{sorted(self.GAINS)}")
+        self.g = g = {**self.GAINS, **gains}
+        supervisor_action("amplitude", g["amplitude"])
+        self.phases = np.radians(np.asarray(g["phases"], dtype=np.float64))
+        self.watch = ContactWatch(plant, g["r_contact"], g["revolutions"], g["fraction"])
+        self.active = np.zeros(0, dtype=bool)
+        self.k = np.zeros(0, dtype=np.int64)
+        self.since = np.zeros(0)
+
+    def reset(self, n, which=None):
+        super().reset(n, which)
+        self.watch.reset(n, which)
+        if which is None or len(self.active) != n:
+            self.active, self.k, self.since = np.zeros(n, bool), np.zeros(n, np.int64), np.zeros(n)
+        else:
+            self.active[which] = False
+            self.k[which] = 0
+
+    def commands(self, obs):
+        out = super().commands(obs)
+        g, p = self.g, self.plant
+        persistent, _ = self.watch.update(obs)
+        rev = 2.0 * np.pi / np.maximum(np.abs(p.get(obs, "rotor_speed")), 1.0)
+        start = persistent & ~self.active
+        self.k[start] = 0
+        self.since[start] = self.t[start]
+        self.active |= start
+        done = self.active & (self.watch.free >= g["release"] * rev)
+        self.active &= ~done
+        self.watch.level[done] = 0.0
+        turn = self.active & (self.t - self.since >= g["dwell"] * rev)
+        self.k[turn] = (self.k[turn] + 1) % len(self.phases)
+        self.since[turn] = self.t[turn]
+        out["offsets"] = self.offsets(self.active, self.phases[self.k])
+        return out
+
+    def offsets(self, active: np.ndarray, phi: np.ndarray) -> np.ndarray:
+        """(n, 4) offsets of amplitude A at angle ``phi`` from the orbit radius where
+        ``active`` (radial, tangential of plane 1, then 2)."""
+        a = np.where(active, self.g["amplitude"], 0.0)
+        per_plane = np.stack([a * np.cos(phi), a * np.sin(phi)], axis=1)
+        return np.tile(per_plane, 2)
+
+
+class SyncMotionCompensation(SyncPhaseSearch):
+    """Synchronous motion compensation (supervisor seat, over the built-in PID): on persistent
+    contact (as ``sync-phase-search``) a reference offset against the sensed synchronous orbit
+    on each AMB plane, proportional to it: radial offset −``gain`` x r / clearance (clipped to
+    the supervisor's range), so that the PID's synchronous force grows with the orbit it has to
+    pull back into the clearance, plus the tangential offset ``lead`` x that (its phase lead
+    against the contact's friction drive). It is removed once the orbit has stayed inside
+    ``r_contact`` for ``release`` revolutions."""
+
+    name = "sync-motion-comp"
+    GAINS = dict(SyncPhaseSearch.GAINS, gain=0.6, lead=0.0, phases=(180.0,))
+
+    def offsets(self, active, phi):
+        p = self.plant
+        pos = self._obs_pos / p.clearance
+        r = np.hypot(pos[:, 0::2], pos[:, 1::2])                # (n, 2) per plane
+        radial = np.clip(-self.g["gain"] * r, -1.0, 0.0)
+        tang = np.clip(-self.g["lead"] * radial, -1.0, 1.0)
+        out = np.stack([radial, tang], axis=2).reshape(-1, 4)
+        return np.where(active[:, None], out, 0.0)
+
+    def commands(self, obs):
+        self._obs_pos = self.plant.positions(obs)
+        return super().commands(obs)
+
+
 _ROT90 = np.array([-1.0, 1.0, -1.0, 1.0])
 
 
@@ -465,7 +590,8 @@ def _rot90(v: np.ndarray) -> np.ndarray:
 
 BASELINES: dict[str, type[Controller]] = {c.name: c for c in (
     Passive, MaxDamping, WhirlSwitch, PidRelevitate, BuiltinRelevitate, WhirlBrake, InnerLoop,
-    InnerLoopLift, WhirlBrakeSupervisor, WhirlBrakeRobust)}
+    InnerLoopLift, WhirlBrakeSupervisor, WhirlBrakeRobust, SyncPhaseSearch,
+    SyncMotionCompensation)}
 
 
 def command_for(cls: type[Controller]) -> str | None:
