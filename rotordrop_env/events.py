@@ -51,10 +51,10 @@ class EventRanges:
     (low, high) uniform range per drawn quantity. The defaults are the ``Recover`` task's."""
     kinds: tuple[str, ...] = EVENT_KINDS
     delay: tuple[float, float] = (0.005, 0.005)
-    shock_peak_g: tuple[float, float] = (5.0, 20.0)
+    shock_peak_g: tuple[float, float] = (2.0, 8.0)
     shock_duration: tuple[float, float] = (0.006, 0.018)
     shock_angle_deg: tuple[float, float] = (0.0, 360.0)
-    unbalance_me: tuple[float, float] = (3e-3, 15e-3)
+    unbalance_me: tuple[float, float] = (3e-3, 12e-3)
     unbalance_angle_deg: tuple[float, float] = (0.0, 360.0)
     load_peak: tuple[float, float] = (1000.0, 4000.0)
     load_duration: tuple[float, float] = (0.005, 0.03)
