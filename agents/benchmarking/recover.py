@@ -26,7 +26,8 @@ ENV_ID = "RotorDrop-Recover-v1"
 #: the reference row: the built-in PID, left alone
 REFERENCE = "inner-loop"
 #: the designed rows, each run in its seat
-DESIGNED = ("inner-loop", "sync-phase-search", "sync-motion-comp", "pid-relevitate", "whirl-brake")
+DESIGNED = ("inner-loop", "sync-phase-search", "sync-motion-comp", "pid-relevitate",
+            "sync-current-search", "whirl-brake")
 BOOTSTRAP = 1000
 
 

@@ -8,8 +8,9 @@ import pytest
 from agents.benchmarking.recover import (DESIGNED, ENV_ID, paired_bootstrap, rate,
                                          recover_benchmark, recover_markdown)
 from agents.benchmarking.suites import SUITES, RecoverSuite, SuiteRegistry
-from agents.control.controllers import (BASELINES, SyncMotionCompensation, SyncPhaseSearch,
-                                        controller_env_kwargs)
+from agents.control.controllers import (BASELINES, PidRelevitate, SyncCurrentSearch,
+                                        SyncMotionCompensation, SyncPhaseSearch,
+                                        controller_env_kwargs, make_controller)
 from agents.control.plant import plant_of
 from agents.control.seats import seat_of
 
@@ -38,7 +39,7 @@ def _drive(law, plant, r, seconds):
         obs[:, plant.index("time")] = (law.t[0] if law.n else 0.0) / plant.obs_scale[
             plant.index("time")]
         action, _ = law.predict(obs, episode_start=np.array([law.n == 0]))
-    return action[0, 2:]
+    return action[0, -4:]
 
 
 def test_phase_search_waits_for_persistent_contact_cycles_phases_and_releases(plant):
@@ -47,10 +48,12 @@ def test_phase_search_waits_for_persistent_contact_cycles_phases_and_releases(pl
     rev = 60.0 / 10000
     assert np.all(_drive(law, plant, 0.5, 0.05) == 0.0)        # inside r_contact: nothing
     law = SyncPhaseSearch(plant)
-    off = _drive(law, plant, 0.95, g["revolutions"] * rev)    # in contact: detected
+    # in contact: detected within a revolution (the watch's level passes its fraction)
+    assert np.all(_drive(law, plant, 0.95, 0.5 * rev) == 0.0)
+    off = _drive(law, plant, 0.95, 0.5 * rev)
     a = g["amplitude"]
     np.testing.assert_allclose(off, [-a, 0.0, -a, 0.0], atol=1e-6)    # φ = 180°: inward
-    off = _drive(law, plant, 0.95, (g["dwell"] + 1) * rev)    # dwell over: next phase, 135°
+    off = _drive(law, plant, 0.95, g["dwell"] * rev)          # dwell over: the next phase
     phi = np.radians(g["phases"][1])
     np.testing.assert_allclose(off, np.tile([a * np.cos(phi), a * np.sin(phi)], 2), atol=1e-6)
     # contact gone for the release time: the offset is removed
@@ -61,6 +64,29 @@ def test_motion_compensation_pulls_in_proportion_to_the_orbit(plant):
     law = SyncMotionCompensation(plant)
     off = _drive(law, plant, 0.9, 10 * 60.0 / 10000)
     np.testing.assert_allclose(off, [-law.g["gain"] * 0.9, 0.0] * 2, atol=1e-6)
+
+
+def test_current_search_adds_a_turned_synchronous_current_on_contact():
+    plant = plant_of(ENV_ID, command="continuous", control_dt=2e-4, episode_time=0.3)
+    law = SyncCurrentSearch(plant)
+    calm = SyncCurrentSearch(plant)
+    rev = 60.0 / 10000
+    base = _drive(calm, plant, 0.95, 0.1 * rev)[None]          # before any detection
+    cur = _drive(law, plant, 0.95, 1.0 * rev)                  # detected: φ = 180°
+    assert law.search.active[0] and law.search.k[0] == 0
+    pid = PidRelevitate(plant)
+    pid_cur = _drive(pid, plant, 0.95, 1.0 * rev)
+    # the PID part is pid-relevitate's; the extra current is −A x̂ on both planes (x̂ = +x)
+    np.testing.assert_allclose(cur - pid_cur, [-law.g["amplitude"], 0.0] * 2, atol=1e-6)
+    assert base.shape == (1, 4)
+
+
+def test_the_recovery_laws_run_in_the_recover_task_only():
+    plant = plant_of("RotorDrop-Full-v1", command="supervisor", episode_time=0.01)
+    for cls in (SyncPhaseSearch, SyncMotionCompensation):
+        assert not cls.supports(plant)
+        with pytest.raises(ValueError, match="in RotorDrop-Recover-v1"):
+            make_controller(cls, plant)
 
 
 def test_every_designed_row_runs_in_its_seat():
