@@ -48,9 +48,11 @@ def test_phase_search_waits_for_persistent_contact_cycles_phases_and_releases(pl
     rev = 60.0 / 10000
     assert np.all(_drive(law, plant, 0.5, 0.05) == 0.0)        # inside r_contact: nothing
     law = SyncPhaseSearch(plant)
-    # in contact: detected within a revolution (the watch's level passes its fraction)
-    assert np.all(_drive(law, plant, 0.95, 0.5 * rev) == 0.0)
-    off = _drive(law, plant, 0.95, 0.5 * rev)
+    # in contact: detected when the watch's level, 1 - exp(-t / (revolutions rev)), passes
+    # its fraction
+    t_detect = -g["revolutions"] * np.log(1.0 - g["fraction"]) * rev
+    assert np.all(_drive(law, plant, 0.95, t_detect - 0.2 * rev) == 0.0)
+    off = _drive(law, plant, 0.95, 0.4 * rev)
     a = g["amplitude"]
     np.testing.assert_allclose(off, [-a, 0.0, -a, 0.0], atol=1e-6)    # φ = 180°: inward
     off = _drive(law, plant, 0.95, g["dwell"] * rev)          # dwell over: the next phase
@@ -72,10 +74,11 @@ def test_current_search_adds_a_turned_synchronous_current_on_contact():
     calm = SyncCurrentSearch(plant)
     rev = 60.0 / 10000
     base = _drive(calm, plant, 0.95, 0.1 * rev)[None]          # before any detection
-    cur = _drive(law, plant, 0.95, 1.0 * rev)                  # detected: φ = 180°
+    t = (-law.g["revolutions"] * np.log(1.0 - law.g["fraction"]) + 0.5) * rev
+    cur = _drive(law, plant, 0.95, t)                          # detected: φ = 180°
     assert law.search.active[0] and law.search.k[0] == 0
     pid = PidRelevitate(plant)
-    pid_cur = _drive(pid, plant, 0.95, 1.0 * rev)
+    pid_cur = _drive(pid, plant, 0.95, t)
     # the PID part is pid-relevitate's; the extra current is −A x̂ on both planes (x̂ = +x)
     np.testing.assert_allclose(cur - pid_cur, [-law.g["amplitude"], 0.0] * 2, atol=1e-6)
     assert base.shape == (1, 4)
