@@ -140,3 +140,25 @@ def test_the_benchmark_writes_its_report_and_table(tmp_path):
     for ev in stored["events"]["inner-loop"]:
         assert ev["recovered"] + ev["ended"] + ev["persistent"] == 1
     assert "`sync-motion-comp` | supervisor" in recover_markdown(report)
+
+
+def test_results_store_a_recovery_leaderboard_and_generate_its_block(tmp_path):
+    """`rotordrop results --recover FILE` stores the report in docs/data and tasks.md's
+    recover block becomes its standing sentence and table, generated from the data."""
+    from agents.benchmarking import results
+    suite = RecoverSuite("recover", "two events", seed=60_000, size=2, quick_size=2,
+                         validation_seed=61_000, validation_size=2, env_id=ENV_ID,
+                         env_kwargs={"episode_time": 0.06})
+    recover_benchmark(tmp_path / "run", suite, policies=["sync-phase-search"], progress=False)
+    root = tmp_path / "root"
+    (root / "docs" / "data").mkdir(parents=True)
+    (root / "docs" / "tasks.md").write_text("# Tasks\n\n<!-- recover:recover:start -->\n"
+                                            "<!-- recover:recover:end -->\n")
+    stored = results.store(tmp_path / "run" / "benchmark.json",
+                           root / "docs" / "data" / results.RECOVER_BOARDS["recover"])
+    report = json.loads(stored.read_text())
+    text = results.recover_blocks((root / "docs" / "tasks.md").read_text(), root)
+    assert "test events 60000-60001 (2 events" in text
+    assert results.recover_standing(report) in text and recover_markdown(report) in text
+    ref = next(r for r in report["board"] if r["controller"] == "inner-loop")
+    assert f"recovers {100 * ref['recovered']['value']:.1f} ± " in text
