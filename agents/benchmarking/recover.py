@@ -1,6 +1,11 @@
 """The recovery benchmark (``RotorDrop-Recover-v1``): the designed laws, each in its seat, on a
 suite's events, scored by recovery, time to recover and contact severity.
 
+Without its event, is an event's machine contact-free? :func:`calm_levitation` answers for
+each event (the reference on the same machine, the event moved past the episode's end): after
+a transient event (a shock, a load) on such a machine a contact-free steady state exists, the
+one the PID held before the event.
+
 An event is *recovered* when the episode ends with the rotor levitated without contact for the
 task's hold (50 ms: ``kpi_relevitated``) and no physical event ended it (stator contact, a
 bearing overload, a contact past its law's validity). An unrecovered event that nothing ended is
@@ -91,6 +96,22 @@ def run_row(name: str, seeds, env_kwargs: dict) -> tuple[list[dict], float]:
     return [event_record(e) for e in eps], time.process_time() - t0
 
 
+def calm_levitation(suite, seeds) -> list[bool]:
+    """Per event of ``seeds``: whether the reference (the built-in PID) holds the event's
+    machine contact-free for the task's hold at the end of an episode *without* the event (its
+    start moved past the episode's end; the machine draw is the same, it comes first)."""
+    events = {**(suite.env_kwargs.get("events") or {}), "delay": (1.0, 1.0)}
+    records, _ = run_row(REFERENCE, seeds, {**suite.env_kwargs, "events": events})
+    return [r["recovered"] for r in records]
+
+
+def add_calm(report: dict, suite) -> dict:
+    """The report with ``calm``: :func:`calm_levitation` of its events."""
+    a, b = report["seeds"]
+    report["calm"] = calm_levitation(suite, range(a, b + 1))
+    return report
+
+
 def recover_benchmark(out, suite, quick: bool = False, policies: list[str] | None = None,
                       progress: bool = True, max_scenarios: int | None = None,
                       validation: bool = False, **_ignored) -> dict:
@@ -117,9 +138,10 @@ def recover_benchmark(out, suite, quick: bool = False, policies: list[str] | Non
         board.append({"controller": name, "seat": seat_of(controller_class(name)).name,
                       "cpu_s": cost[name], **s})
     board.sort(key=lambda r: (-r["recovered"]["value"], r["peak_contact_force_N"]["mean"]))
-    report = {"env_id": ENV_ID, "suite": suite.name, "seeds": [seeds.start, seeds.stop - 1],
-              "env_kwargs": suite.env_kwargs, "reference": REFERENCE, "board": board,
-              "events": rows, "cpu_s_total": sum(cost.values())}
+    report = add_calm({"env_id": ENV_ID, "suite": suite.name,
+                       "seeds": [seeds.start, seeds.stop - 1], "env_kwargs": suite.env_kwargs,
+                       "reference": REFERENCE, "board": board, "events": rows,
+                       "cpu_s_total": sum(cost.values())}, suite)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     write_json(out / "benchmark.json", report)

@@ -840,9 +840,16 @@ def recover_standing(report: dict) -> str:
     ev = report["events"]
     none = sum(not any(ev[n][i]["recovered"] for n in ev) for i in range(len(ev[ref["controller"]])))
     pers = ref["persistent"]
+    calm = report.get("calm") or [False] * len(ev[ref["controller"]])
+    stuck = [c for e, c in zip(ev[ref["controller"]], calm) if e["persistent"]]
+    transient = sum(c and e["event"] in ("shock", "load")
+                    for e, c in zip(ev[ref["controller"]], calm) if e["persistent"])
     return (f"The standard PID (`{ref['controller']}`) recovers {100 * ref['recovered']['value']:.1f} "
             f"± {100 * ref['recovered']['se']:.1f} % of the events and leaves "
-            f"{100 * pers['value']:.1f} ± {100 * pers['se']:.1f} % in persistent contact; the best "
+            f"{100 * pers['value']:.1f} ± {100 * pers['se']:.1f} % in persistent contact "
+            f"({transient} of those {len(stuck)} after a shock or a transient load on a machine the "
+            "PID holds contact-free without the event: a contact-free steady state exists for "
+            "them); the best "
             f"row, `{best['controller']}` ({best['seat']} seat), recovers "
             f"{100 * best['recovered']['value']:.1f} ± {100 * best['recovered']['se']:.1f} % "
             f"({100 * d['delta']:+.1f} ± {100 * d['se']:.1f} points against the PID, paired "

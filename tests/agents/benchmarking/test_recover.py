@@ -135,6 +135,7 @@ def test_the_benchmark_writes_its_report_and_table(tmp_path):
     assert [r["controller"] for r in report["board"]].count("inner-loop") == 1   # the reference
     stored = json.loads((tmp_path / "benchmark.json").read_text())
     assert stored["seeds"] == [60_000, 60_002] and len(stored["events"]["inner-loop"]) == 3
+    assert stored["calm"] == [True] * 3          # the paper machine levitates without its event
     ref = next(r for r in report["board"] if r["controller"] == "inner-loop")
     assert ref["vs_reference"]["recovered"] == {"delta": 0.0, "se": 0.0, "ci95": [0.0, 0.0]}
     for ev in stored["events"]["inner-loop"]:
