@@ -5,7 +5,7 @@
     envs = gym.make_vec("RotorDrop-Damping-v1", num_envs=16, vectorization_mode="vector_entry_point")
 
 Ids: ``RotorDrop-Passive-v1``, ``RotorDrop-Damping-v1``, ``RotorDrop-Relevitate-v1``,
-``RotorDrop-Full-v1`` (see docs/environments.md), one declaration each in
+``RotorDrop-Full-v1``, ``RotorDrop-Recover-v1`` (see docs/environments.md), one declaration each in
 :mod:`rotordrop_env.tasks` (``TASKS``, where a new task is registered). Each id's ``vector_entry_point`` is the
 batched Gymnasium vector environment (:mod:`rotordrop_env.vector`); ``BatchedRotorDropVecEnv`` /
 ``make_batched`` are the same batch as a Stable-Baselines3 ``VecEnv``. In a process that has not

@@ -38,7 +38,8 @@ from .sensors import Sensing, check_delay, check_latency, check_noise, check_sam
 from .settings import (FIXED_SETTINGS, WEIGHT_SLOTS, SettingsGuard, check_choice,  # noqa: F401
                        check_flag, check_real, check_steps, check_unused_ranges, check_weights,
                        make_scene, sensing_scene)
-from .tasks import DAMPING, FULL, PASSIVE, RELEVITATE, Task, resolve_task
+from .events import EventRanges
+from .tasks import DAMPING, FULL, PASSIVE, RECOVER, RELEVITATE, Task, resolve_task
 from .view import EpisodeView
 
 
@@ -86,7 +87,11 @@ class RotorDropEnv(SettingsGuard, EpisodeView, gym.Env):
                                             the zero action is full damping)
     power_return_time           task's      AMB tasks: power returns [s after fault] (0.05)
     samples_per_step            5           monitor samples per control step (dense output)
-    relevitation_hold           0.02        re-levitated after this long in the success region [s]
+    relevitation_hold           task's      re-levitated (recovered) after this long in the
+                                            success region [s] (0.02; Recover: 0.05)
+    events                      task's      Recover: the event distribution, a dict of the
+                                            :class:`rotordrop_env.events.EventRanges` fields
+                                            to change (e.g. {"kinds": ("shock",)})
     constraints                 task's      the episode constraints that end an episode (names
                                             or objects of :mod:`rotordrop_env.constraints`; all
                                             three by default)
@@ -119,7 +124,7 @@ class RotorDropEnv(SettingsGuard, EpisodeView, gym.Env):
                  control_dt: float = 1e-3, episode_time: float = 0.3, randomize: bool = False,
                  randomization: dict | None = None, full_state: bool = False,
                  command: str | None = None, power_return_time: float | None = None,
-                 samples_per_step: int = 5, relevitation_hold: float = 0.02,
+                 samples_per_step: int = 5, relevitation_hold: float | None = None,
                  terminate_on_failure: bool = True, sensor_noise: float = 0.0,
                  obs_latency_steps: int | tuple[int, int] = 0, sensor_delay: float = 0.0,
                  sensor_sample_rate: float | None = None,
@@ -128,9 +133,12 @@ class RotorDropEnv(SettingsGuard, EpisodeView, gym.Env):
                  w_success: float = 10.0, w_failure: float = 10.0, render_mode: str | None = None,
                  supervisor_authority: float = 1.0, damping_action: str = "linear",
                  reward: str | Reward | None = None, reward_kwargs: dict | None = None,
-                 constraints=None, task: Task | None = None):
+                 constraints=None, task: Task | None = None, events: dict | None = None):
         self.task = task = resolve_task(type(self), task)
         name = type(self).__name__ if self.task is type(self).task else f"{task.name} task"
+        self.events = check_events(task, name, events, power_return_time)
+        if relevitation_hold is None:
+            relevitation_hold = task.relevitation_hold
         self.commands = Commands.of(task.commands, name, command, damping_action,
                                     supervisor_authority, power_return_time, task.command,
                                     task.power_return_time)
@@ -227,6 +235,7 @@ class RotorDropEnv(SettingsGuard, EpisodeView, gym.Env):
         for name, slot in WEIGHT_SLOTS.items():
             C[slot] = self.weights[name]
         C[K.C_HOLD] = hold
+        C[K.C_UNLATCHED] = 0.0 if self.task.latched else 1.0
         C[K.C_FULL] = 1.0 if self.full_state else 0.0
         b.scale[:] = self.obs_scale
 
@@ -235,6 +244,7 @@ class RotorDropEnv(SettingsGuard, EpisodeView, gym.Env):
         self._check_open("reset")
         super().reset(seed=seed)
         values = sample(self.ranges, self.np_random, self.fixed_keys) if self.randomize else {}
+        event = self._draw_event(values)
         values.update(reset_options(options, self._relevitate))
         scene = scenario_scene(self.base_scene, values)
         fs = fault_state(scene)
@@ -247,9 +257,11 @@ class RotorDropEnv(SettingsGuard, EpisodeView, gym.Env):
         pr = values.get(POWER_RETURN, self.power_return_time)
         if pr is not None:
             check_real(POWER_RETURN, pr, *POWER_RETURN_LIMITS)
-        start_episode(b, fs, self.n_steps, self.dt, pr, self.constraints)
+        start_episode(b, fs, self.n_steps, self.dt, pr, self.constraints, self.task.amb_on,
+                      self.task.success_radius)
         self._scenario = scenario_report(self.ranges, values, scene, b.C[K.C_T_POWER]
                                          - b.C[K.C_T_FAULT] if pr is not None else None)
+        self._scenario.update(event)
         self._needs_reset = False
         self._ended = self._warned = False
         if self.render_mode is not None:            # record from the first step of the episode
@@ -260,6 +272,18 @@ class RotorDropEnv(SettingsGuard, EpisodeView, gym.Env):
         else:
             obs = b.obs.astype(np.float32)
         return obs, self._info()
+
+    def _draw_event(self, values: dict) -> dict:
+        """The task's event (:mod:`rotordrop_env.events`), its scene keys added to ``values``;
+        the report's ``event`` and ``event_time`` (after the episode start) [s]. Drawn after the
+        machine, so that the machine's draws do not depend on the event's."""
+        if self.events is None:
+            return {}
+        radius = scenario_scene(self.base_scene, values).unbalance.radius
+        ev = self.events.draw(self.np_random, fault_state(self.base_scene).t_fault, self.dt,
+                              radius)
+        values.update(ev.pop("keys"))
+        return ev
 
     @property
     def scenario(self) -> dict:
@@ -358,11 +382,13 @@ class RotorDropEnv(SettingsGuard, EpisodeView, gym.Env):
 
 
 def start_episode(b: Buffers, fs, n_steps: int, dt: float, power_return: float | None,
-                  constraints: tuple) -> None:
+                  constraints: tuple, amb_on: bool = False, success_radius: float = 0.5) -> None:
     """The kernel arrays ``b`` at the fault of the fault state ``fs``: the episode's constants
     (the solver settings are the fault state's integrator's, so the episode continues exactly
     as ``rotordrop drop`` would; the ``constraints`` that end it), its state, controls and
-    monitor, and the reset observation."""
+    monitor, and the reset observation. ``amb_on``: no fault, the AMBs stay powered and the
+    built-in PID keeps levitating (its states and reference continue from the levitated run);
+    ``success_radius``: the success region's radius / clearance."""
     scene, integ = fs.scene, fs.integrator
     C = b.C
     t_fault = fs.t_fault
@@ -379,20 +405,36 @@ def start_episode(b: Buffers, fs, n_steps: int, dt: float, power_return: float |
     C[K.C_F_REF] = static_weight_share(scene)
     C[K.C_CS_MIN], C[K.C_CS_MAX] = scene.support.damping_min, scene.support.damping_max
     C[K.C_ILIM] = scene.amb.current_limit
-    C[K.C_RELEV_RADIUS] = 0.5 * scene.contact.clearance
+    C[K.C_RELEV_RADIUS] = success_radius * scene.contact.clearance
     C[K.C_P_COEF] = pressure_coef(fs.model, scene)
     constraints_.configure(C, scene, constraints)
     b.y[:] = fs.y
     b.P[:] = fs.model.P
     b.I[:] = fs.model.I
-    b.U[:] = fs.model.controls(False)
+    b.U[:] = fs.model.controls(amb_on)
     b.M[:] = 0.0
+    if amb_on:
+        b.M[K.M_POWER] = b.M[K.M_CTRL_ON] = 1.0
     b.M[K.M_T] = fs.t_fault
     b.M[K.M_H] = fs.integrator.h
     b.M[K.M_OK_START] = -1.0
     b.M[K.M_RELEV_T] = math.nan
     b.out[:] = 0.0                              # the reset info: nothing has happened yet
     K.observe_now(b.y, b.P, b.I, b.U, b.C, b.M, b.work, b.aux, b.cur, b.scale, b.obs)
+
+
+def check_events(task: Task, name: str, events, power_return_time) -> EventRanges | None:
+    """The env kwarg ``events`` of a task with events (:class:`EventRanges`); ValueError for
+    ``events`` on a task without, and for ``power_return_time`` on a task whose AMBs stay on."""
+    if task.amb_on and power_return_time is not None:
+        raise ValueError(f"power_return_time = {power_return_time!r} does not apply to the "
+                         f"{name}: its AMBs stay powered from the start")
+    if task.events is None:
+        if events is not None:
+            raise ValueError(f"events = {events!r} applies to the tasks with an event (Recover), "
+                             f"not {name}")
+        return None
+    return EventRanges.of(events, task.events)
 
 
 def pressure_coef(model, scene) -> float:

@@ -34,7 +34,7 @@ FLOAT_KEYS = ("contact_force_N", *("reward_" + t for t in REWARD_TERMS), "time_s
               *COST_TERMS, "kpi_whirl_revolutions", "kpi_peak_whirl_revolutions",
               "kpi_peak_contact_force_N", "kpi_max_displacement_um", "kpi_relevitation_time_s",
               "kpi_control_effort", "kpi_max_ball_load_N", "kpi_max_contact_pressure_MPa",
-              "kpi_time_within_validity_s")
+              "kpi_time_within_validity_s", "kpi_friction_energy_J")
 assert len(FLOAT_KEYS) == K.N_V_FLOAT
 #: the bool entries and their V_* values ("relevitated": re-levitation environments only)
 _BOOLS = (("backward_whirl", K.V_WHIRL), ("relevitated", K.V_RELEV),

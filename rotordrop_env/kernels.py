@@ -23,7 +23,7 @@ import numpy as np
 
 from physics.jit import njit, njit_borrow, njit_parallel
 from physics.integrate import integrate_sensed
-from physics.model import (A_FR, A_QMAX, A_WS, F_SENSOR, I_AMB_FILT, I_AMB_INT, I_CS,
+from physics.model import (A_FR, A_PFRIC, A_QMAX, A_WS, F_SENSOR, I_AMB_FILT, I_AMB_INT, I_CS,
                            N_AUX_PLANE, P_CLR, ST_AMB1, ST_RB1, S_W, U_AMB_DIRECT, U_AMB_GAIN,
                            U_AMB_POWER, U_CS1, U_ICMD, U_REF0, U_REF_OFF, U_T_ON, amb_currents,
                            axis_motion, delayed_motion, rhs, sensed_motion, sleeve_motion)
@@ -36,16 +36,17 @@ from .slots import (  # noqa: F401
     C_FIXED, C_MAXSTEPS, C_W_WHIRL, C_W_CONTACT, C_W_DISP, C_W_EFFORT, C_W_SUCCESS,
     C_W_FAILURE, C_F_REF, C_GAP, C_LOAD_RATING, C_HOLD, C_FULL, C_CS_MIN, C_CS_MAX, C_ILIM,
     C_RELEV_RADIUS, C_WHIRL_RADIUS, C_WHIRL_REVS, C_SUP_OFFSET, C_SUP_OCTAVES, C_P_COEF,
-    C_PEN_BOUND, C_STATOR_BOUND, C_ENDS, N_C, LEV_NONE, LEV_DISCRETE, LEV_CONTINUOUS,
+    C_PEN_BOUND, C_STATOR_BOUND, C_ENDS, C_UNLATCHED, N_C, LEV_NONE, LEV_DISCRETE, LEV_CONTINUOUS,
     LEV_SUPERVISOR, DAMP_NONE, DAMP_LINEAR, DAMP_FROM_MAX, SUP_MIN_RADIUS, MONITOR, M_T, M_H,
     M_REV1, M_REV2, M_WHIRL, M_PEAK_F, M_MAX_DISP, M_OK_START, M_RELEV, M_RELEV_T, M_EFFORT,
     M_CTRL_ON, M_POWER, M_REV_PEAK, M_PEAK_Q, M_STATOR, M_OVERLOAD, M_BEYOND, M_LEFT_T, M_PHI,
-    N_M, OUTPUTS, O_REWARD, O_R_WHIRL, O_R_CONTACT, O_R_DISP, O_R_EFFORT, O_R_SUCCESS,
+    M_FRICTION, N_M, OUTPUTS, O_REWARD, O_R_WHIRL, O_R_CONTACT, O_R_DISP, O_R_EFFORT, O_R_SUCCESS,
     O_R_FAILURE, O_FORCE, O_TERM, O_TRUNC, O_STATUS, O_ERR, O_STATOR, O_OVERLOAD, O_RELEV,
     O_BEYOND, N_O, ERR_NONE, ERR_NAN, ERR_RANGE, INFO, V_FORCE, V_R_WHIRL, V_R_CONTACT,
     V_R_DISP, V_R_EFFORT, V_R_SUCCESS, V_R_FAILURE, V_TIME, V_COST, V_COST_STATOR,
     V_COST_OVERLOAD, V_COST_VALIDITY, V_WHIRL_REVS, V_WHIRL, V_PEAK_REVS, V_PEAK_F,
     V_MAX_DISP_UM, V_RELEV_T, V_RELEV, V_EFFORT, V_BALL_Q, V_PRESSURE_MPA, V_TIME_VALID,
+    V_FRICTION,
     N_V_FLOAT, N_V, V_STATOR, V_OVERLOAD, V_BEYOND, MISSING)
 
 ACTION_TOL = 1e-6            # actions may exceed [-1, 1] by this much (float32 round-off)
@@ -289,6 +290,7 @@ def step_one(a, y, P, I, U, Z, atol, work, t_sub, Y_sub, aux, cur, C, M, scale, 
         for k in range(2):
             fr = aux[k * N_AUX_PLANE + A_FR]
             f_step = max(f_step, fr)
+            M[M_FRICTION] += abs(aux[k * N_AUX_PLANE + A_PFRIC]) * dts    # rectangle rule
             q_step = max(q_step, aux[k * N_AUX_PLANE + A_QMAX])
             px, py, pvx, pvy = axis_motion(ys, P, I, ST_RB1 + k)
             sx, sy, svx, svy = sleeve_motion(ys, I, k)
@@ -309,17 +311,18 @@ def step_one(a, y, P, I, U, Z, atol, work, t_sub, Y_sub, aux, cur, C, M, scale, 
             if past_bound:
                 beyond = True
         latch_validity(beyond, ts, M)
-        if lev != LEV_NONE and M[M_RELEV] == 0.0:
+        if lev != LEV_NONE and (M[M_RELEV] == 0.0 or C[C_UNLATCHED] > 0.0):
             if ok:
                 if M[M_OK_START] < 0.0:
                     M[M_OK_START] = ts
-                if ts - M[M_OK_START] >= C[C_HOLD] - 1e-12:
+                if M[M_RELEV] == 0.0 and ts - M[M_OK_START] >= C[C_HOLD] - 1e-12:
                     M[M_RELEV] = 1.0
                     M[M_RELEV_T] = M[M_OK_START] - C[C_T_FAULT]
                     out[O_R_SUCCESS] = C[C_W_SUCCESS]
                     out[O_RELEV] = 1.0
             else:
                 M[M_OK_START] = -1.0
+                M[M_RELEV] = 0.0            # unlatched: the success is lost again (else it is 0)
     # aux now holds the diagnostics at t1 (last sub-sample)
     if lev != LEV_NONE:
         amb_currents(t1, y, P, I, U, cur)
@@ -404,6 +407,7 @@ def info_values(out, M, C, v):
         v[V_PRESSURE_MPA] = MISSING
     # time after the fault within the contact laws' validity (all of it until a bound is passed)
     v[V_TIME_VALID] = (M[M_LEFT_T] if M[M_BEYOND] > 0.0 else M[M_T]) - C[C_T_FAULT]
+    v[V_FRICTION] = M[M_FRICTION]
     v[V_WHIRL] = M[M_WHIRL]
     v[V_RELEV] = M[M_RELEV]
     v[V_STATOR] = M[M_STATOR]

@@ -127,7 +127,7 @@ FIXED_SETTINGS = frozenset(("control_dt", "dt", "episode_time", "n_steps", "rand
                             "obs_names", "obs_scale", "action_names", "weights",
                             "sensor_noise", "sensor_delay", "sensor_sample_rate", "obs_latency_steps", "supervisor_authority",
                             "damping_action", "reward", "reward_kwargs", "reward_function",
-                            "constraints", "task", "commands"))
+                            "constraints", "task", "commands", "events"))
 
 
 def _weight(name: str, doc: str) -> property:

@@ -33,6 +33,9 @@ CONFIG = Slots("configuration")
 #: C[C_ENDS + j] > 0: constraint j of :data:`rotordrop_env.constraints.CONSTRAINTS` ends the
 #: episode when it is violated (it is monitored, and its cost reported, either way)
 C_ENDS = CONFIG.add("ends", 3)
+#: C[C_UNLATCHED] > 0: the success region's verdict is the present one (a task with
+#: ``latched=False``: lost again on contact), else latched at the first success
+C_UNLATCHED = CONFIG.add("unlatched")
 N_C = CONFIG.freeze().size
 #: C[C_P_COEF]: Hertz contact pressure [Pa] = C_P_COEF x cbrt(ball load [N]), < 0 without
 #: Sopanen-Mikkola balls (read by the info builder, not by the kernels)
@@ -46,10 +49,11 @@ SUP_MIN_RADIUS = 0.05
 MONITOR = Slots("monitor")
 (M_T, M_H, M_REV1, M_REV2, M_WHIRL, M_PEAK_F, M_MAX_DISP, M_OK_START, M_RELEV,
  M_RELEV_T, M_EFFORT, M_CTRL_ON, M_POWER, M_REV_PEAK, M_PEAK_Q, M_STATOR, M_OVERLOAD,
- M_BEYOND, M_LEFT_T, M_PHI) = MONITOR.add_each(
+ M_BEYOND, M_LEFT_T, M_PHI, M_FRICTION) = MONITOR.add_each(
     "t", "h", "revolutions1", "revolutions2", "whirl", "peak_force", "max_displacement",
     "ok_start", "relevitated", "relevitation_time", "effort", "controller_on", "power",
-    "peak_revolutions", "peak_ball_load", "stator", "overload", "beyond", "left_time", "phi")
+    "peak_revolutions", "peak_ball_load", "stator", "overload", "beyond", "left_time", "phi",
+    "friction_energy")
 N_M = MONITOR.freeze().size
 #: M[M_PHI]: the KPI reward's potential after the last step (rotordrop_env.reward; 0 at reset)
 
@@ -68,11 +72,12 @@ ERR_NONE, ERR_NAN, ERR_RANGE = 0, 1, 2
 INFO = Slots("info value")
 (V_FORCE, V_R_WHIRL, V_R_CONTACT, V_R_DISP, V_R_EFFORT, V_R_SUCCESS, V_R_FAILURE, V_TIME,
  V_COST, V_COST_STATOR, V_COST_OVERLOAD, V_COST_VALIDITY, V_WHIRL_REVS, V_PEAK_REVS, V_PEAK_F,
- V_MAX_DISP_UM, V_RELEV_T, V_EFFORT, V_BALL_Q, V_PRESSURE_MPA, V_TIME_VALID) = INFO.add_each(
+ V_MAX_DISP_UM, V_RELEV_T, V_EFFORT, V_BALL_Q, V_PRESSURE_MPA, V_TIME_VALID,
+ V_FRICTION) = INFO.add_each(
     "force", "r_whirl", "r_contact", "r_displacement", "r_effort", "r_success", "r_failure",
     "time", "cost", "cost_stator", "cost_overload", "cost_validity", "whirl_revolutions",
     "peak_revolutions", "peak_force", "max_displacement_um", "relevitation_time", "effort",
-    "ball_load", "pressure_mpa", "time_valid")
+    "ball_load", "pressure_mpa", "time_valid", "friction_energy")
 N_V_FLOAT = INFO.size
 V_WHIRL, V_RELEV, V_STATOR, V_OVERLOAD, V_BEYOND = INFO.add_each(
     "whirl", "relevitated", "stator", "overload", "beyond")

@@ -11,7 +11,7 @@ interfaces (:mod:`rotordrop_env.layout`). Declaring and registering tasks import
     with TASKS.temporary(catch):                 # or TASKS.register(catch) for the session
         env = gymnasium.make("RotorDrop-Catch-v0")
 
-:data:`TASKS` holds the four shipped tasks; ``rotordrop_env.ENV_IDS`` is derived from it.
+:data:`TASKS` holds the shipped tasks; ``rotordrop_env.ENV_IDS`` is derived from it.
 """
 from __future__ import annotations
 
@@ -19,6 +19,8 @@ import re
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any, Mapping
+
+from .events import EventRanges
 
 ENV_MODULE, VECTOR_MODULE = "rotordrop_env.env", "rotordrop_env.vector"
 DAMPER, AMB = "damper", "amb"
@@ -57,7 +59,14 @@ class Task:
     ``randomization``: its scenario draw with ``randomize=True``, ranges over
     :data:`rotordrop_env.scenario.DEFAULT_RANGES` (None leaves a default key out);
     ``env_class``: the name of its own class in :mod:`rotordrop_env.env` (the shipped tasks),
-    else the environment is ``RotorDropEnv(task=...)``."""
+    else the environment is ``RotorDropEnv(task=...)``. ``amb_on``: the AMBs stay powered and
+    the built-in PID levitates from the episode start (no fault; the AMB commands act from the
+    first step); ``events``: the event drawn per episode
+    (:class:`rotordrop_env.events.EventRanges`, None: no event); ``relevitation_hold``: the
+    default of the env kwarg; ``latched``: False makes the success region's verdict the
+    present one (contact-free for the hold *now*, lost again on contact) instead of latched at
+    its first success; ``success_radius``: the success region's radius (fraction of the
+    clearance; within it and without contact at both retainer planes)."""
     name: str
     commands: tuple[str, ...] = ()
     version: int = 1
@@ -69,6 +78,11 @@ class Task:
     randomization: Mapping[str, Any] = field(default_factory=dict)
     summary: str = ""
     env_class: str | None = None
+    amb_on: bool = False
+    events: Any = None
+    relevitation_hold: float = 0.02
+    latched: bool = True
+    success_radius: float = 0.5
 
     def __post_init__(self):
         if not re.fullmatch(r"[A-Z][A-Za-z0-9]*", str(self.name)):
@@ -118,6 +132,14 @@ RELEVITATE = Task("Relevitate", commands=(AMB,), env_class="RelevitateEnv",
                   summary="AMB reactivation after the power returns")
 FULL = Task("Full", commands=(DAMPER, AMB), env_class="FullEnv",
             summary="semi-active damping and AMB reactivation together")
+
+
+RECOVER = Task("Recover", commands=(AMB,), command="supervisor", power_return_time=0.0,
+               amb_on=True, events=EventRanges(), relevitation_hold=0.05, latched=False,
+               scene={"amb.off_time": 0.01}, success_radius=1.0,
+               randomization={"power_return_time": None},
+               summary="recovery with the AMBs on after a shock, a sudden unbalance or a "
+                       "transient load")
 
 
 class TaskRegistry(dict):
@@ -171,7 +193,7 @@ class TaskRegistry(dict):
 
 
 #: the shipped tasks (and any registered in this process)
-TASKS = TaskRegistry(PASSIVE, DAMPING, RELEVITATE, FULL)
+TASKS = TaskRegistry(PASSIVE, DAMPING, RELEVITATE, FULL, RECOVER)
 
 
 def resolve_task(env_class: type, task: Task | None) -> Task:

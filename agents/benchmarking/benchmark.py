@@ -55,10 +55,12 @@ WHIRL_MARGINS = (0.05, 0.10, 0.15)
 
 def _env_tasks() -> tuple[dict[str, str], tuple[str, ...]]:
     """The benchmark tasks as the environments declare them (:func:`agents.control.plant.task_flags`):
-    every registered id whose env controls something, keyed by the task in the id
-    (``RotorDrop-Full-v1``: ``full``), and the ids whose env re-levitates."""
+    every registered drop task whose env controls something, keyed by the task in the id
+    (``RotorDrop-Full-v1``: ``full``), and the ids whose env re-levitates. A task whose AMBs
+    stay on (Recover) is no drop: its own suites score it (:mod:`agents.benchmarking.recover`)."""
     from rotordrop_env import ENV_IDS
-    flags = {env_id: task_flags(env_id) for env_id in ENV_IDS}
+    from rotordrop_env.tasks import TASKS as DECLARED
+    flags = {env_id: task_flags(env_id) for env_id in ENV_IDS if not DECLARED[env_id].amb_on}
     return ({env_id.split("-")[1].lower(): env_id for env_id, f in flags.items() if any(f)},
             tuple(env_id for env_id, (_, relevitate) in flags.items() if relevitate))
 

@@ -873,11 +873,63 @@ def _regenerate(text: str, kind: str, key: str, block: str) -> str:
     return pattern.sub(lambda _: f"{start}\n{block}\n{end}", text)
 
 
+#: the Recover suites' leaderboards: suite -> its file in docs/data (tasks.md's
+#: ``<!-- recover:SUITE:start -->`` blocks)
+RECOVER_BOARDS = {"recover": "leaderboard-recover.json",
+                  "recover-robust": "leaderboard-recover-robust.json"}
+
+
+def recover_blocks(text: str, root: Path) -> str:
+    """``text`` with each ``<!-- recover:SUITE:start -->`` ... ``end`` block the table of the
+    committed recovery leaderboard of that suite (:func:`agents.benchmarking.recover.recover_markdown`)."""
+    from .recover import recover_markdown
+    for suite, name in RECOVER_BOARDS.items():
+        report = _load(root / DATA / name)
+        if report is None:
+            continue
+        a, b = report["seeds"]
+        block = (f"`rotordrop benchmark --suite {suite}`: test events {a}-{b} "
+                 f"({len(report['events'][report['reference']])} events, "
+                 f"{report['cpu_s_total'] / 60:.1f} CPU-minutes; `{DATA.as_posix()}/{name}`). "
+                 + recover_standing(report) + "\n\n" + recover_markdown(report))
+        text = _regenerate(text, "recover", suite, block)
+    return text
+
+
+def recover_standing(report: dict) -> str:
+    """The sentence tasks.md states a recovery leaderboard's standing in: what the reference
+    (the standard PID) leaves in persistent contact, the best designed row against it, and
+    what no row recovers."""
+    board = {r["controller"]: r for r in report["board"]}
+    ref = board[report["reference"]]
+    best = report["board"][0]
+    d = best["vs_reference"]["recovered"]
+    ev = report["events"]
+    none = sum(not any(ev[n][i]["recovered"] for n in ev) for i in range(len(ev[ref["controller"]])))
+    pers = ref["persistent"]
+    calm = report.get("calm") or [False] * len(ev[ref["controller"]])
+    stuck = [c for e, c in zip(ev[ref["controller"]], calm) if e["persistent"]]
+    transient = sum(c and e["event"] in ("shock", "load")
+                    for e, c in zip(ev[ref["controller"]], calm) if e["persistent"])
+    return (f"The standard PID (`{ref['controller']}`) recovers {100 * ref['recovered']['value']:.1f} "
+            f"± {100 * ref['recovered']['se']:.1f} % of the events and leaves "
+            f"{100 * pers['value']:.1f} ± {100 * pers['se']:.1f} % in persistent contact "
+            f"({transient} of those {len(stuck)} after a shock or a transient load on a machine the "
+            "PID holds contact-free without the event: a contact-free steady state exists for "
+            "them); the best "
+            f"row, `{best['controller']}` ({best['seat']} seat), recovers "
+            f"{100 * best['recovered']['value']:.1f} ± {100 * best['recovered']['se']:.1f} % "
+            f"({100 * d['delta']:+.1f} ± {100 * d['se']:.1f} points against the PID, paired "
+            f"bootstrap over events); {none} of {len(ev[ref['controller']])} events "
+            f"({100 * none / len(ev[ref['controller']]):.1f} %) are recovered by no row.")
+
+
 def tasks_text(root: Path = ROOT) -> str:
     """docs/tasks.md with each ``<!-- standing:KEY:start -->`` ... ``end`` block regenerated
-    from the committed leaderboards (:data:`STANDINGS`), and each ``<!-- learning:KEY:... -->``
-    block from its learning report (:data:`LEARNING`)."""
-    text = (root / TASKS).read_text()
+    from the committed leaderboards (:data:`STANDINGS`), each ``<!-- learning:KEY:... -->``
+    block from its learning report (:data:`LEARNING`), and the Recover task's tables
+    (:func:`recover_blocks`)."""
+    text = recover_blocks((root / TASKS).read_text(), root)
     for key, (name, task) in STANDINGS.items():
         report = _load(root / DATA / name)
         if report is not None:
@@ -916,6 +968,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                                      "docs/data/leaderboard-nominal.json")
     p.add_argument("--robust", help="a `rotordrop benchmark --suite robust` benchmark.json to "
                                     "store as docs/data/leaderboard-robust.json")
+    p.add_argument("--recover", help="a `rotordrop benchmark --suite recover` benchmark.json to "
+                                     "store as docs/data/leaderboard-recover.json")
+    p.add_argument("--recover-robust", help="a `rotordrop benchmark --suite recover-robust` "
+                                            "benchmark.json to store as "
+                                            "docs/data/leaderboard-recover-robust.json")
     p.add_argument("--hard", action="append", default=[],
                    help="a `rotordrop evaluate` kpis.json of the hard benchmark to store as "
                         "docs/data/hard-<policy>.json (repeatable)")
@@ -954,8 +1011,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def run(args) -> int:
     """Store the given benchmark output in docs/data and regenerate the pages (or ``--check``)."""
     root = Path(args.root)
+    recover = {"recover": getattr(args, "recover", None),
+               "recover-robust": getattr(args, "recover_robust", None)}
     given = (args.nominal, args.robust, args.hard, args.oracle_nominal, args.oracle_robust,
-             args.oracle_budget, args.headroom, args.hard_run, args.hard_ref, args.learning)
+             args.oracle_budget, args.headroom, args.hard_run, args.hard_ref, args.learning,
+             *recover.values())
     if args.check and any(given):
         print("results: error: --check takes no data files", file=sys.stderr)
         return 2
@@ -971,6 +1031,9 @@ def run(args) -> int:
         stored.append(store(args.nominal, root / DATA / "leaderboard-nominal.json", drop=DROPPED_KEYS))
     if args.robust:
         stored.append(store(args.robust, root / DATA / "leaderboard-robust.json", drop=DROPPED_KEYS))
+    for suite, src in recover.items():
+        if src:
+            stored.append(store(src, root / DATA / RECOVER_BOARDS[suite]))
     for src, name in ((args.oracle_nominal, "oracle-nominal.json"),
                       (args.oracle_robust, "oracle-robust.json")):
         if src:

@@ -76,6 +76,8 @@ class Controller:
     #: where it runs (:data:`agents.control.seats.SEATS`: ``controller`` or ``supervisor``;
     #: None: from its channels, :func:`agents.control.seats.seat_of`)
     seat: str | None = None
+    #: the env ids it is designed for (None: any with its channels), e.g. the recovery laws
+    env_ids: tuple[str, ...] | None = None
 
     def __init__(self, plant: Plant):
         if self.sensors:
@@ -89,7 +91,8 @@ class Controller:
 
     @classmethod
     def supports(cls, plant: Plant) -> bool:
-        return all(c in plant.channels for c in cls.needs)
+        return all(c in plant.channels for c in cls.needs) and (
+            cls.env_ids is None or plant.env_id in cls.env_ids)
 
     def reset(self, n: int, which: np.ndarray | None = None) -> None:
         """Start new episodes (all of them, or those flagged in ``which``)."""
@@ -455,6 +458,205 @@ class WhirlBrakeSupervisor(InnerLoop):
         return out
 
 
+class ContactWatch:
+    """Persistent contact, as a law sees it from its sensors: per environment the fraction of
+    time the sensed orbit at either AMB plane lies beyond ``r_contact`` x clearance (the rotor
+    at its retainer bearing), low-pass filtered over ``revolutions`` spin revolutions; persistent
+    above ``fraction``. ``free``: the time since the orbit was last beyond it [s]."""
+
+    def __init__(self, plant: Plant, r_contact: float, revolutions: float, fraction: float):
+        self.plant, self.r_contact, self.revolutions = plant, r_contact, revolutions
+        self.fraction = fraction
+        self.level = np.zeros(0)
+        self.free = np.zeros(0)
+
+    def reset(self, n: int, which: np.ndarray | None) -> None:
+        if which is None or len(self.level) != n:
+            self.level, self.free = np.zeros(n), np.zeros(n)
+        else:
+            self.level[which] = self.free[which] = 0.0
+
+    def update(self, obs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(persistent, r / clearance at the larger of the two planes) after this observation."""
+        p = self.plant
+        pos = p.positions(obs)
+        r = np.hypot(pos[:, 0::2], pos[:, 1::2]).max(axis=1) / p.clearance
+        touching = r > self.r_contact
+        period = 2.0 * np.pi / np.maximum(np.abs(p.get(obs, "rotor_speed")), 1.0)
+        gain = np.minimum(p.control_dt / (self.revolutions * period), 1.0)
+        self.level += gain * (touching - self.level)
+        self.free = np.where(touching, 0.0, self.free + p.control_dt)
+        return self.level > self.fraction, r
+
+
+class PhaseSearch:
+    """The state machine of the synchronous laws, per environment: idle until
+    :class:`ContactWatch` reports persistent contact; then active, at the phase ``phases[k]``
+    (deg, in order), ``dwell`` revolutions each (cycling), until the sensed orbit has stayed
+    inside ``r_contact`` for ``release`` revolutions; then idle again, the watch restarted.
+    ``step(obs, t)`` -> (active, φ [rad]) per environment."""
+
+    def __init__(self, plant: Plant, g: dict):
+        self.plant, self.g = plant, g
+        self.phases = np.radians(np.asarray(g["phases"], dtype=np.float64))
+        self.watch = ContactWatch(plant, g["r_contact"], g["revolutions"], g["fraction"])
+        self.active = np.zeros(0, dtype=bool)
+        self.k = np.zeros(0, dtype=np.int64)
+        self.since = np.zeros(0)
+
+    def reset(self, n: int, which: np.ndarray | None) -> None:
+        self.watch.reset(n, which)
+        if which is None or len(self.active) != n:
+            self.active, self.k, self.since = np.zeros(n, bool), np.zeros(n, np.int64), np.zeros(n)
+        else:
+            self.active[which] = False
+            self.k[which] = 0
+
+    def step(self, obs: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        g = self.g
+        persistent, _ = self.watch.update(obs)
+        rev = 2.0 * np.pi / np.maximum(np.abs(self.plant.get(obs, "rotor_speed")), 1.0)
+        start = persistent & ~self.active
+        self.k[start] = 0
+        self.since[start] = t[start]
+        self.active |= start
+        done = self.active & (self.watch.free >= g["release"] * rev)
+        self.active &= ~done
+        self.watch.level[done] = 0.0
+        turn = self.active & (t - self.since >= g["dwell"] * rev)
+        self.k[turn] = (self.k[turn] + 1) % len(self.phases)
+        self.since[turn] = t[turn]
+        return self.active, self.phases[self.k]
+
+
+def law_constants(law, gains: dict) -> dict:
+    """``law``'s class constants ``GAINS`` updated by ``gains``; TypeError naming unknown ones."""
+    unknown = set(gains) - set(law.GAINS)
+    if unknown:
+        raise TypeError(f"unknown {law.name} constants {sorted(unknown)}; known: "
+                        f"{sorted(law.GAINS)}")
+    return {**law.GAINS, **gains}
+
+
+#: the tasks the recovery laws are designed for (their contact watch assumes the AMBs on)
+RECOVERY_TASKS = ("RotorDrop-Recover-v1",)
+#: the synchronous laws' watch and search constants (revolutions, fractions of the clearance).
+#: The watch's ``fraction`` and ``revolutions`` were chosen on the ``recover`` suite's
+#: validation events (seeds 61 000-61 059) between (0.2, 4) and (0.6, 8) with
+#: ``sync-phase-search`` and ``sync-motion-comp``: the eager watch acts on contacts the PID
+#: ends by itself and recovers fewer events (0.10 and 0.08 against 0.23 and 0.10)
+SEARCH = dict(dwell=4.0, release=6.0, r_contact=0.8, revolutions=8.0, fraction=0.6,
+              phases=(180.0, 225.0, 270.0, 315.0, 0.0, 45.0, 90.0, 135.0))
+
+
+class Searching:
+    """Mixin of the synchronous laws: their constants (``GAINS`` updated by the keyword
+    arguments) and their :class:`PhaseSearch`, reset with the episodes."""
+
+    def start_search(self, plant: Plant, gains: dict) -> None:
+        self.g = law_constants(self, gains)
+        self.search = PhaseSearch(plant, self.g)
+
+    def reset(self, n, which=None):
+        super().reset(n, which)
+        self.search.reset(n, which)
+
+
+class SyncPhaseSearch(Searching, InnerLoop):
+    """Synchronous compensation with a phase search (supervisor seat, over the built-in PID).
+
+    On persistent contact (:class:`ContactWatch`: the sensed orbit beyond ``r_contact`` x
+    clearance for more than ``fraction`` of the last ``revolutions`` revolutions) it commands a
+    reference offset of amplitude ``amplitude`` x clearance at the angle φ from the sensed
+    orbit's radius (along the forward orbit for φ = 90°), on both AMB planes. The offset is
+    evaluated continuously inside the physics step in the frame of the sensed orbit, so for a
+    synchronous orbit it is a synchronous, spin-locked reference of phase φ relative to the
+    displacement, whatever the supervisor's step. The phase is searched over ``phases`` (deg,
+    in order), ``dwell`` revolutions each, until the orbit has stayed inside ``r_contact`` for
+    ``release`` revolutions; then the offset is removed and the watch starts again
+    (:class:`PhaseSearch`). φ = 180° first: a pure pull towards the centre (a stiffer
+    synchronous suspension). The watch's constants were chosen on validation events
+    (:data:`SEARCH`); the others are set by reasoning and a few trial runs."""
+
+    name = "sync-phase-search"
+    sensors = True
+    env_ids = RECOVERY_TASKS
+    GAINS = dict(SEARCH, amplitude=0.25)
+
+    def __init__(self, plant: Plant, **gains):
+        super().__init__(plant, gain=0.0, offset_r=0.0)
+        self.start_search(plant, gains)
+        supervisor_action("amplitude", self.g.get("amplitude", 0.0))
+
+    def commands(self, obs):
+        out = super().commands(obs)
+        active, phi = self.search.step(obs, self.t)
+        out["offsets"] = self.offsets(obs, active, phi)
+        return out
+
+    def offsets(self, obs, active: np.ndarray, phi: np.ndarray) -> np.ndarray:
+        """(n, 4) offsets of amplitude A at angle ``phi`` from the orbit radius where
+        ``active`` (radial, tangential of plane 1, then 2)."""
+        a = np.where(active, self.g["amplitude"], 0.0)
+        per_plane = np.stack([a * np.cos(phi), a * np.sin(phi)], axis=1)
+        return np.tile(per_plane, 2)
+
+
+class SyncCurrentSearch(Searching, PidRelevitate):
+    """Synchronous current compensation with a phase search (controller seat, raw currents):
+    the own PID of ``pid-relevitate`` plus, on persistent contact (:class:`PhaseSearch`), a
+    current of ``amplitude`` x the current limit on each AMB plane along the sensed
+    displacement turned by φ (φ = 180°: towards the centre; 90°: along the forward orbit).
+    Sampled at the controller's 0.1-0.2 ms step it is a spin-locked synchronous force of phase
+    φ relative to the displacement of a synchronous orbit, which the magnets apply whatever
+    their PID's saturation. The watch's constants are the supervisor laws' (:data:`SEARCH`);
+    ``amplitude`` and the phases are set by reasoning and a few trial runs (untuned)."""
+
+    name = "sync-current-search"
+    env_ids = RECOVERY_TASKS
+    GAINS = dict(SEARCH, amplitude=0.6)
+
+    def __init__(self, plant: Plant, **gains):
+        super().__init__(plant)
+        self.start_search(plant, gains)
+
+    def commands(self, obs):
+        out = super().commands(obs)
+        active, phi = self.search.step(obs, self.t)
+        pos = self.plant.positions(obs)
+        r = np.repeat(np.hypot(pos[:, 0::2], pos[:, 1::2]), 2, axis=1)
+        unit = pos / np.maximum(r, 1e-12)
+        c, s = np.cos(phi)[:, None], np.sin(phi)[:, None]
+        spin = self.plant.spin_sign(obs)[:, None]
+        turned = c * unit + s * spin * _rot90(unit)
+        extra = np.where(active[:, None], self.g["amplitude"] * turned, 0.0)
+        out["currents"] = np.clip(out["currents"] + extra, -1.0, 1.0)
+        return out
+
+
+class SyncMotionCompensation(SyncPhaseSearch):
+    """Synchronous motion compensation (supervisor seat, over the built-in PID): on persistent
+    contact (as ``sync-phase-search``) a reference offset against the sensed synchronous orbit
+    on each AMB plane, proportional to it: radial offset −``gain`` x r / clearance (clipped to
+    the supervisor's range), so that the PID's synchronous force grows with the orbit it has to
+    pull back into the clearance, plus the tangential offset ``lead`` x that (its phase lead
+    against the contact's friction drive). It is removed once the orbit has stayed inside
+    ``r_contact`` for ``release`` revolutions. The watch's ``fraction`` and ``revolutions`` as
+    chosen on validation events (:data:`SEARCH`); ``gain`` and ``r_contact`` set by reasoning."""
+
+    name = "sync-motion-comp"
+    GAINS = dict(SEARCH, gain=0.3, r_contact=0.7, lead=0.0, phases=(180.0,))
+
+    def offsets(self, obs, active, phi):
+        p = self.plant
+        pos = p.positions(obs) / p.clearance
+        r = np.hypot(pos[:, 0::2], pos[:, 1::2])                # (n, 2) per plane
+        radial = np.clip(-self.g["gain"] * r, -1.0, 0.0)
+        tang = np.clip(-self.g["lead"] * radial, -1.0, 1.0)
+        out = np.stack([radial, tang], axis=2).reshape(-1, 4)
+        return np.where(active[:, None], out, 0.0)
+
+
 _ROT90 = np.array([-1.0, 1.0, -1.0, 1.0])
 
 
@@ -465,7 +667,8 @@ def _rot90(v: np.ndarray) -> np.ndarray:
 
 BASELINES: dict[str, type[Controller]] = {c.name: c for c in (
     Passive, MaxDamping, WhirlSwitch, PidRelevitate, BuiltinRelevitate, WhirlBrake, InnerLoop,
-    InnerLoopLift, WhirlBrakeSupervisor, WhirlBrakeRobust)}
+    InnerLoopLift, WhirlBrakeSupervisor, WhirlBrakeRobust, SyncPhaseSearch,
+    SyncMotionCompensation, SyncCurrentSearch)}
 
 
 def command_for(cls: type[Controller]) -> str | None:
@@ -561,8 +764,10 @@ def make_controller(cls: type[Controller], plant: Plant) -> Controller:
     """``cls(plant)`` after checking that the environment has the channels it needs; an error
     in the constructor (say an argument without default) is a :class:`ControllerError`."""
     if not cls.supports(plant):
-        raise ValueError(f"controller {cls.name!r} needs action channels {cls.needs}, which "
-                         f"{plant.env_id} does not have (it has {', '.join(plant.channels)})")
+        where = "" if cls.env_ids is None else f" in {', '.join(cls.env_ids)}"
+        raise ValueError(f"controller {cls.name!r} needs action channels {cls.needs}{where}, "
+                         f"which {plant.env_id} does not have (it has "
+                         f"{', '.join(plant.channels)})")
     with blame(cls, f"{cls.__name__}(plant)"):
         return cls(plant)
 

@@ -18,7 +18,8 @@ VARIANTS = [("RotorDrop-Passive-v1", {}), ("RotorDrop-Damping-v1", {}),
             ("RotorDrop-Relevitate-v1", {"command": "discrete"}),
             ("RotorDrop-Relevitate-v1", {"command": "continuous"}),
             ("RotorDrop-Full-v1", {"command": "discrete"}),
-            ("RotorDrop-Full-v1", {"command": "continuous"})]
+            ("RotorDrop-Full-v1", {"command": "continuous"}),
+            ("RotorDrop-Recover-v1", {}), ("RotorDrop-Recover-v1", {"command": "continuous"})]
 
 
 @pytest.mark.parametrize("env_id,kwargs", VARIANTS, ids=lambda v: v if isinstance(v, str) else

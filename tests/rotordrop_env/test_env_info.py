@@ -15,14 +15,22 @@ from rotordrop_env.reward import KPI_WEIGHTS, kpi_potential
 
 from helpers import run_env_checkers
 
-MODES = [(i, None) for i in rotordrop_env.ENV_IDS if "Relevitate" not in i and "Full" not in i] + \
-    [(i, c) for i in rotordrop_env.ENV_IDS if "Relevitate" in i or "Full" in i for c in COMMANDS]
+_AMB = ("Relevitate", "Full", "Recover")
+MODES = [(i, None) for i in rotordrop_env.ENV_IDS if not any(a in i for a in _AMB)] + \
+    [(i, c) for i in rotordrop_env.ENV_IDS if any(a in i for a in _AMB) for c in COMMANDS]
+#: Recover: a hard early shock, so that the overloaded episode ends within its 12 ms
+EARLY_SHOCK = {"events": {"kinds": ("shock",), "shock_peak_g": (20.0, 20.0),
+                          "shock_duration": (0.006, 0.006), "delay": (0.001, 0.001)}}
 #: a low static load rating: the drop overloads the bearing within ~10 ms (a terminated end)
 OVERLOAD = {"bearing.static_load_rating": 1500.0}
 
 
 def _kw(command, **kw):
     return dict(kw, command=command) if command else kw
+
+
+def _event(env_id):
+    return EARLY_SHOCK if "Recover" in env_id else {}
 
 
 def _check_values(info: dict, where: str) -> None:
@@ -40,7 +48,8 @@ def test_info_has_the_same_numpy_keys_at_reset_and_every_step_and_no_nan(env_id,
     ends = []
     for max_steps, overrides in ((None, OVERLOAD), (3, None), (None, None)):
         env = gym.make(env_id, episode_time=0.012, overrides=overrides,
-                       max_episode_steps=max_steps, **_kw(command))
+                       max_episode_steps=max_steps,
+                       **_kw(command, **(_event(env_id) if overrides else {})))
         env.action_space.seed(0)
         _, info = env.reset(seed=1)
         keys = set(info)

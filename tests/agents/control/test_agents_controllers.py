@@ -15,7 +15,8 @@ ENVS = [("RotorDrop-Damping-v1", {}), ("RotorDrop-Relevitate-v1", {"command": "d
         ("RotorDrop-Full-v1", {"command": "discrete", **LEV}),
         ("RotorDrop-Full-v1", {"command": "continuous", **LEV}),
         ("RotorDrop-Relevitate-v1", {"command": "supervisor", **LEV}),
-        ("RotorDrop-Full-v1", {"command": "supervisor", **LEV})]
+        ("RotorDrop-Full-v1", {"command": "supervisor", **LEV}),
+        ("RotorDrop-Recover-v1", {}), ("RotorDrop-Recover-v1", {"command": "continuous"})]
 
 
 @pytest.mark.parametrize("env_id,kw", ENVS)

@@ -1,0 +1,175 @@
+"""The recovery benchmark (``RotorDrop-Recover-v1``): the designed laws, each in its seat, on a
+suite's events, scored by recovery, time to recover and contact severity.
+
+Without its event, is an event's machine contact-free? :func:`calm_levitation` answers for
+each event (the reference on the same machine, the event moved past the episode's end): after
+a transient event (a shock, a load) on such a machine a contact-free steady state exists, the
+one the PID held before the event.
+
+An event is *recovered* when the episode ends with the rotor levitated without contact for the
+task's hold (50 ms: ``kpi_relevitated``) and no physical event ended it (stator contact, a
+bearing overload, a contact past its law's validity). An unrecovered event that nothing ended is
+in contact within its last 50 ms: **persistent contact**. The time to recover is the start of
+the final contact-free period after the event's start; severity is the peak contact force, the
+backward-whirl revolutions and the friction energy. Every rate has its binomial SE and Wilson
+95 % interval; every difference against the reference row (the standard PID, ``inner-loop``:
+the built-in PID with no command) has its paired bootstrap SE over the events.
+"""
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from ..control.controllers import controller_class, controller_env_kwargs, make_controller
+from ..control.seats import seat_of
+from .rollout import run_episodes
+from .score import write_json
+
+ENV_ID = "RotorDrop-Recover-v1"
+#: the reference row: the built-in PID, left alone
+REFERENCE = "inner-loop"
+#: the designed rows, each run in its seat
+DESIGNED = ("inner-loop", "sync-phase-search", "sync-motion-comp", "pid-relevitate",
+            "sync-current-search", "whirl-brake")
+BOOTSTRAP = 1000
+
+
+def event_record(ep) -> dict:
+    """One event's outcome from its episode (:class:`~agents.benchmarking.rollout.Episode`)."""
+    k, sc = ep.kpis, ep.scenario or {}
+    ended = bool(k["stator_contact"] or k["beyond_validity"] or k["bearing_overload"])
+    recovered = bool(k["relevitated"]) and not ended
+    t_rec = k.get("relevitation_time_s")
+    return {"seed": ep.seed, "event": sc.get("event"), "event_time_s": sc.get("event_time"),
+            "recovered": recovered, "ended": ended, "persistent": not recovered and not ended,
+            "time_to_recover_s": (max(t_rec - sc.get("event_time", 0.0), 0.0)
+                                  if recovered and t_rec is not None else None),
+            "peak_contact_force_N": k["peak_contact_force_N"],
+            "whirl_revolutions": k["peak_whirl_revolutions"],
+            "friction_energy_J": k["friction_energy_J"], "touched": k["peak_contact_force_N"] > 0}
+
+
+def rate(x: np.ndarray) -> dict:
+    """A proportion with its binomial SE and Wilson 95 % interval."""
+    n, p = len(x), float(np.mean(x)) if len(x) else math.nan
+    z = 1.96
+    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    return {"value": p, "se": math.sqrt(p * (1 - p) / n), "wilson95": [centre - half, centre + half]}
+
+
+def paired_bootstrap(a: np.ndarray, b: np.ndarray, rng: np.random.Generator) -> dict:
+    """mean(a − b) over paired events with its bootstrap SE and 95 % percentile interval."""
+    d = np.asarray(a, float) - np.asarray(b, float)
+    idx = rng.integers(0, len(d), size=(BOOTSTRAP, len(d)))
+    boot = d[idx].mean(axis=1)
+    return {"delta": float(d.mean()), "se": float(boot.std(ddof=1)),
+            "ci95": [float(np.percentile(boot, 2.5)), float(np.percentile(boot, 97.5))]}
+
+
+def row_summary(records: list[dict], ref: list[dict], seed: int = 0) -> dict:
+    """A row's figures against the reference row's ``ref`` (the same events, in order)."""
+    rng = np.random.default_rng(seed)
+    col = lambda rs, key: np.array([float(r[key]) for r in rs])     # noqa: E731
+    times = [r["time_to_recover_s"] for r in records if r["time_to_recover_s"] is not None]
+    out = {"events": len(records), "recovered": rate(col(records, "recovered")),
+           "persistent": rate(col(records, "persistent")), "ended": rate(col(records, "ended")),
+           "time_to_recover_ms_median": 1e3 * float(np.median(times)) if times else None}
+    for key in ("peak_contact_force_N", "whirl_revolutions", "friction_energy_J"):
+        v = col(records, key)
+        out[key] = {"mean": float(v.mean()), "se": float(v.std(ddof=1) / math.sqrt(len(v)))}
+    out["vs_reference"] = {key: paired_bootstrap(col(records, key), col(ref, key), rng)
+                           for key in ("recovered", "peak_contact_force_N", "friction_energy_J")}
+    return out
+
+
+def run_row(name: str, seeds, env_kwargs: dict) -> tuple[list[dict], float]:
+    """A designed law's events in its seat: (records, CPU seconds)."""
+    cls = controller_class(name)
+    if cls is None:
+        raise ValueError(f"{name!r} is not a designed law (a baseline controller name)")
+    kw = {**env_kwargs, **controller_env_kwargs(cls, ENV_ID)}
+    t0 = time.process_time()
+    eps = run_episodes(ENV_ID, lambda plant: make_controller(cls, plant), seeds, kw)
+    return [event_record(e) for e in eps], time.process_time() - t0
+
+
+def calm_levitation(suite, seeds) -> list[bool]:
+    """Per event of ``seeds``: whether the reference (the built-in PID) holds the event's
+    machine contact-free for the task's hold at the end of an episode *without* the event (its
+    start moved past the episode's end; the machine draw is the same, it comes first)."""
+    events = {**(suite.env_kwargs.get("events") or {}), "delay": (1.0, 1.0)}
+    records, _ = run_row(REFERENCE, seeds, {**suite.env_kwargs, "events": events})
+    return [r["recovered"] for r in records]
+
+
+def add_calm(report: dict, suite) -> dict:
+    """The report with ``calm``: :func:`calm_levitation` of its events."""
+    a, b = report["seeds"]
+    report["calm"] = calm_levitation(suite, range(a, b + 1))
+    return report
+
+
+def recover_benchmark(out, suite, quick: bool = False, policies: list[str] | None = None,
+                      progress: bool = True, max_scenarios: int | None = None,
+                      validation: bool = False, **_ignored) -> dict:
+    """``rotordrop benchmark --suite recover | recover-robust``: every designed law (or
+    ``policies``) in its seat on the suite's test events (``validation``: its validation
+    events), the report written to ``out/benchmark.json`` and ``out/leaderboard.md``."""
+    from pathlib import Path
+    n = suite.quick_size if quick else suite.size
+    if max_scenarios is not None:
+        n = min(n, max_scenarios)
+    seeds = suite.validation_seeds() if validation else suite.test_seeds(n)
+    names = list(policies or DESIGNED)
+    if REFERENCE not in names:
+        names.insert(0, REFERENCE)
+    rows, cost = {}, {}
+    for name in names:
+        rows[name], cost[name] = run_row(name, seeds, suite.env_kwargs)
+        if progress:
+            print(f"{name}: {sum(r['recovered'] for r in rows[name])}/{len(seeds)} recovered "
+                  f"({cost[name]:.1f} CPU s)", flush=True)
+    board = []
+    for name in names:
+        s = row_summary(rows[name], rows[REFERENCE])
+        board.append({"controller": name, "seat": seat_of(controller_class(name)).name,
+                      "cpu_s": cost[name], **s})
+    board.sort(key=lambda r: (-r["recovered"]["value"], r["peak_contact_force_N"]["mean"]))
+    report = add_calm({"env_id": ENV_ID, "suite": suite.name,
+                       "seeds": [seeds.start, seeds.stop - 1], "env_kwargs": suite.env_kwargs,
+                       "reference": REFERENCE, "board": board, "events": rows,
+                       "cpu_s_total": sum(cost.values())}, suite)
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    write_json(out / "benchmark.json", report)
+    (out / "leaderboard.md").write_text(recover_markdown(report) + "\n")
+    return report
+
+
+def _pct(r: dict) -> str:
+    lo, hi = r["wilson95"]
+    return f"{100 * r['value']:.1f} ± {100 * r['se']:.1f} [{100 * lo:.0f}, {100 * hi:.0f}]"
+
+
+def recover_markdown(report: dict) -> str:
+    """The leaderboard table of a recovery benchmark report."""
+    ref = report["reference"]
+    head = ("| rank | controller | seat | recovered % ± SE [Wilson 95 %] | Δ recovered vs "
+            f"`{ref}` ± SE | persistent contact % | ended (stator / validity) % | "
+            "time to recover, median [ms] | peak contact force [kN] | Δ vs ref ± SE [kN] | "
+            "backward-whirl rev. | friction energy [J] |")
+    lines = [head, "|---:|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for i, r in enumerate(report["board"], 1):
+        d, df = r["vs_reference"]["recovered"], r["vs_reference"]["peak_contact_force_N"]
+        t = r["time_to_recover_ms_median"]
+        lines.append(
+            f"| {i} | `{r['controller']}` | {r['seat']} | {_pct(r['recovered'])} | "
+            f"{100 * d['delta']:+.1f} ± {100 * d['se']:.1f} | {100 * r['persistent']['value']:.1f} | "
+            f"{100 * r['ended']['value']:.1f} | {'—' if t is None else f'{t:.1f}'} | "
+            f"{r['peak_contact_force_N']['mean'] / 1e3:.2f} | "
+            f"{df['delta'] / 1e3:+.2f} ± {df['se'] / 1e3:.2f} | "
+            f"{r['whirl_revolutions']['mean']:.2f} | {r['friction_energy_J']['mean']:.2f} |")
+    return "\n".join(lines)
