@@ -821,12 +821,23 @@ LEARNING = {"controller-seat-residual": "learning-controller-seat-residual.json"
             "controller-seat-scratch": "learning-controller-seat-scratch.json"}
 
 
-def store_learning(paths: list[str], dest: Path) -> Path:
+def store_learning(paths: list[str], dest: Path, prefix: str | None = None) -> Path:
     """Benchmark reports of learned seed groups on the same drops (one, or several run apart:
-    :func:`agents.benchmarking.score.merged_groups`) stored as one learning report."""
-    from .score import merged_groups
+    :func:`agents.benchmarking.score.merged_groups`) stored as one learning report; with
+    ``prefix``, only the learned rows and seed groups whose names start with it (one run that
+    scored several configurations gives each table its own, the target judged on them)."""
+    from .score import merged_groups, target
     reports = [json.loads(Path(p).read_text()) for p in paths]
     report = reports[0] if len(reports) == 1 else merged_groups(reports)
+    if prefix:
+        board = [e for e in report["leaderboard"]
+                 if e["kind"] != "learned" or e["controller"].startswith(prefix)]
+        groups = [g for g in report["seed_groups"]
+                  if all(m.startswith(prefix) for m in g["members"])]
+        if not groups:
+            raise ValueError(f"no seed group of rows named {prefix}* in {', '.join(paths)}")
+        report = {**report, "leaderboard": board, "seed_groups": groups,
+                  "target": {**report["target"], **target(board, groups, report["target"]["margin"])}}
     return write_report({k: v for k, v in report.items() if k not in DROPPED_KEYS}, dest)
 
 
@@ -989,10 +1000,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                                             "store as docs/data/oracle-nominal.json")
     p.add_argument("--oracle-robust", help="a `rotordrop oracle --suite robust` oracle.json to "
                                            "store as docs/data/oracle-robust.json")
-    p.add_argument("--learning", action="append", default=[], metavar="KEY=FILE[,FILE...]",
+    p.add_argument("--learning", action="append", default=[], metavar="KEY=FILE[,FILE...][:PREFIX]",
                    help="`rotordrop benchmark --suite robust --only REF --policy RUN...` "
-                        "benchmark.json files of learned seed groups on the same drops (merged), "
-                        "stored as the docs/data file of "
+                        "benchmark.json files of learned seed groups on the same drops (merged; "
+                        "with :PREFIX only the rows named PREFIX*), stored as the docs/data file of "
                         f"KEY ({', '.join(f'{k}: {v}' for k, v in LEARNING.items())}) for "
                         "docs/tasks.md's learning table (repeatable)")
     p.add_argument("--headroom", help="a `python -m agents.benchmarking.headroom` headroom.json of "
@@ -1042,12 +1053,13 @@ def run(args) -> int:
         stored.append(store(args.headroom, root / DATA / "headroom-robust.json"))
     for spec in args.learning:
         key, _, src = spec.partition("=")
+        src, _, prefix = src.partition(":")
         if key not in LEARNING or not src:
-            print(f"results: error: --learning {spec!r}: write KEY=FILE[,FILE...] with KEY one "
-                  f"of {', '.join(LEARNING)}", file=sys.stderr)
+            print(f"results: error: --learning {spec!r}: write KEY=FILE[,FILE...][:PREFIX] with "
+                  f"KEY one of {', '.join(LEARNING)}", file=sys.stderr)
             return 2
         try:
-            stored.append(store_learning(src.split(","), root / DATA / LEARNING[key]))
+            stored.append(store_learning(src.split(","), root / DATA / LEARNING[key], prefix or None))
         except (ValueError, KeyError) as exc:
             print(f"results: error: --learning {key}: {exc}", file=sys.stderr)
             return 2

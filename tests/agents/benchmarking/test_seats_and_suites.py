@@ -324,3 +324,33 @@ def test_reports_of_the_same_drops_merge_into_one_seed_group():
              for e in parts[1]["leaderboard"]]
     with pytest.raises(ValueError, match="row whirl-brake scores"):
         merged_groups([parts[0], dict(parts[1], leaderboard=other)])
+
+
+def test_one_run_of_two_configurations_stores_each_learning_table_apart(tmp_path):
+    """``rotordrop results --learning KEY=FILE:PREFIX``: a benchmark run that scored two
+    configurations stores, per table, only the rows and seed group named PREFIX*, its target
+    judged on that group (the weaker configuration's table says 'not met' although the other's
+    group meets it); a prefix naming no group is refused."""
+    import json
+
+    from agents.benchmarking.results import store_learning
+    board, groups = _board_and_groups(3)
+    weak = [dict(e, controller=e["controller"].replace("ppo", "sac"), score=e["score"] - 20.0)
+            for e in board if e["kind"] == "learned"]
+    from types import SimpleNamespace
+    pols = {e["controller"]: SimpleNamespace(algo="sac", env_id="F", env_kwargs={},
+                                             meta={"hyperparams": {"g": 2}, "seed": i})
+            for i, e in enumerate(weak)}
+    groups = groups + seed_groups(weak, pols)
+    board = board + weak
+    src = tmp_path / "benchmark.json"
+    src.write_text(json.dumps(dict(suite="robust", scenarios=[{}] * 4, leaderboard=board,
+                                   seed_groups=groups, target=target(board, groups))))
+    assert json.loads(src.read_text())["target"]["met"] is True
+    sac = json.loads(store_learning([str(src)], tmp_path / "sac.json", "sac").read_text())
+    assert [g["members"] for g in sac["seed_groups"]] == [["sac@s0", "sac@s1", "sac@s2"]]
+    assert {e["controller"] for e in sac["leaderboard"]} == {"whirl-brake", "inner-loop",
+                                                              "sac@s0", "sac@s1", "sac@s2"}
+    assert sac["target"]["met"] is False and sac["target"]["best_learned_score"] == pytest.approx(50.0)
+    with pytest.raises(ValueError, match="no seed group of rows named td3"):
+        store_learning([str(src)], tmp_path / "td3.json", "td3")
