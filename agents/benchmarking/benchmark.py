@@ -339,15 +339,24 @@ def check_unique_names(entries: list[Entry]) -> list[Entry]:
     return entries
 
 
+#: a policy's training env kwargs that are its training distribution and sensing, not its
+#: interface: a benchmark replaces them with its suite's
+TRAINING_KEYS = ("randomize", "randomization", "overrides", "terminate_on_failure", "episode_time",
+                 "samples_per_step", "sensor_noise", "obs_latency_steps", "sensor_delay", "events")
+
+
+def interface_kwargs(env_kwargs: dict) -> dict:
+    """A policy's env kwargs without :data:`TRAINING_KEYS`: what it acts through (its command,
+    control step...), kept when a benchmark runs it on its own suite."""
+    return {k: v for k, v in env_kwargs.items() if k not in TRAINING_KEYS}
+
+
 def episode_kwargs(entry: Entry, scenario: Scenario, phase: float) -> dict:
     """The env kwargs of one episode: the entry's (its command, control step...) without its
     training distribution and sensing, the scenario's scene values, power return and sensing
     (the latency as whole control steps of the entry's, rounded up: the newest measurement
     that has arrived)."""
-    kw = {k: v for k, v in entry.env_kwargs.items()
-          if k not in ("randomize", "randomization", "overrides", "terminate_on_failure",
-                       "episode_time", "samples_per_step", "sensor_noise", "obs_latency_steps",
-                       "sensor_delay")}
+    kw = interface_kwargs(entry.env_kwargs)
     kw.update(EVAL_KWARGS)
     kw.update(monitor_kwargs(kw))
     kw["overrides"] = {**(entry.env_kwargs.get("overrides") or {}), **scenario.scene_overrides(phase)}

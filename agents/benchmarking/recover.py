@@ -23,7 +23,7 @@ import time
 import numpy as np
 
 from ..control.controllers import controller_class, controller_env_kwargs, make_controller
-from ..control.seats import seat_of
+from ..control.seats import seat_for_kwargs, seat_of
 from .rollout import run_episodes
 from .score import write_json
 
@@ -85,15 +85,40 @@ def row_summary(records: list[dict], ref: list[dict], seed: int = 0) -> dict:
     return out
 
 
-def run_row(name: str, seeds, env_kwargs: dict) -> tuple[list[dict], float]:
-    """A designed law's events in its seat: (records, CPU seconds)."""
-    cls = controller_class(name)
-    if cls is None:
-        raise ValueError(f"{name!r} is not a designed law (a baseline controller name)")
-    kw = {**env_kwargs, **controller_env_kwargs(cls, ENV_ID)}
+def run_row(name: str, seeds, env_kwargs: dict, policy=None) -> tuple[list[dict], float]:
+    """A designed law's events in its seat, or with ``policy`` (a
+    :class:`~agents.learning.policies.LearnedPolicy`) that policy's, through its own interface
+    (:func:`~agents.benchmarking.benchmark.interface_kwargs`: command, control step) on the
+    suite's ``env_kwargs``: (records, CPU seconds)."""
+    if policy is not None:
+        from .benchmark import interface_kwargs
+        if policy.env_id != ENV_ID:
+            raise ValueError(f"--policy {name}: trained on {policy.env_id}, not {ENV_ID}")
+        kw, make_actor = {**interface_kwargs(policy.env_kwargs), **env_kwargs}, policy.bound
+    else:
+        cls = controller_class(name)
+        if cls is None:
+            raise ValueError(f"{name!r} is not a designed law (a baseline controller name) "
+                             f"nor a learned policy (a training run or model zip)")
+        kw = {**env_kwargs, **controller_env_kwargs(cls, ENV_ID)}
+        make_actor = lambda plant: make_controller(cls, plant)     # noqa: E731
     t0 = time.process_time()
-    eps = run_episodes(ENV_ID, lambda plant: make_controller(cls, plant), seeds, kw)
+    eps = run_episodes(ENV_ID, make_actor, seeds, kw)
     return [event_record(e) for e in eps], time.process_time() - t0
+
+
+def learned_rows(specs: list[str], names: list[str] | None = None) -> dict:
+    """The learned policies among ``specs`` (``--policy``: a training run, its ``best/`` or a
+    model zip; ``names``: ``--name``, one per such path) by display name; designed law names
+    are left out (they are rows of their own)."""
+    from ..learning.policies import shipped_names
+    from .benchmark import extras
+    paths = [s for s in specs if controller_class(s) is None]
+    shipped = [s for s in paths if s in shipped_names()]
+    if shipped:
+        raise ValueError(f"--policy {', '.join(shipped)}: no shipped policy runs {ENV_ID}")
+    learned, _ = extras(paths, ENV_ID, names)
+    return {p.name: p for p in learned}
 
 
 def calm_levitation(suite, seeds) -> list[bool]:
@@ -114,28 +139,32 @@ def add_calm(report: dict, suite) -> dict:
 
 def recover_benchmark(out, suite, quick: bool = False, policies: list[str] | None = None,
                       progress: bool = True, max_scenarios: int | None = None,
-                      validation: bool = False, **_ignored) -> dict:
+                      validation: bool = False, names: list[str] | None = None,
+                      **_ignored) -> dict:
     """``rotordrop benchmark --suite recover | recover-robust``: every designed law (or
-    ``policies``) in its seat on the suite's test events (``validation``: its validation
-    events), the report written to ``out/benchmark.json`` and ``out/leaderboard.md``."""
+    ``policies``: designed law names and learned policies, :func:`learned_rows`, named by
+    ``names``) in its seat on the suite's test events (``validation``: its validation events),
+    the report written to ``out/benchmark.json`` and ``out/leaderboard.md``."""
     from pathlib import Path
     n = suite.quick_size if quick else suite.size
     if max_scenarios is not None:
         n = min(n, max_scenarios)
     seeds = suite.validation_seeds() if validation else suite.test_seeds(n)
-    names = list(policies or DESIGNED)
-    if REFERENCE not in names:
-        names.insert(0, REFERENCE)
+    learned = learned_rows(list(policies or []), names)
+    rows_asked = [p for p in policies or DESIGNED if controller_class(p) is not None]
+    names = list(dict.fromkeys([REFERENCE, *rows_asked, *learned]))
     rows, cost = {}, {}
     for name in names:
-        rows[name], cost[name] = run_row(name, seeds, suite.env_kwargs)
+        rows[name], cost[name] = run_row(name, seeds, suite.env_kwargs, learned.get(name))
         if progress:
             print(f"{name}: {sum(r['recovered'] for r in rows[name])}/{len(seeds)} recovered "
                   f"({cost[name]:.1f} CPU s)", flush=True)
     board = []
     for name in names:
         s = row_summary(rows[name], rows[REFERENCE])
-        board.append({"controller": name, "seat": seat_of(controller_class(name)).name,
+        seat = (seat_for_kwargs(learned[name].env_kwargs) if name in learned
+                else seat_of(controller_class(name)))
+        board.append({"controller": name, "seat": seat.name, "learned": name in learned,
                       "cpu_s": cost[name], **s})
     board.sort(key=lambda r: (-r["recovered"]["value"], r["peak_contact_force_N"]["mean"]))
     report = add_calm({"env_id": ENV_ID, "suite": suite.name,

@@ -163,3 +163,35 @@ def test_results_store_a_recovery_leaderboard_and_generate_its_block(tmp_path):
     assert results.recover_standing(report) in text and recover_markdown(report) in text
     ref = next(r for r in report["board"] if r["controller"] == "inner-loop")
     assert f"recovers {100 * ref['recovered']['value']:.1f} ± " in text
+
+
+def test_a_learned_row_runs_through_its_interface_and_a_zero_residual_is_the_pid(tmp_path):
+    """`--policy RUN` rows: a fresh residual policy on inner-loop with its action mean zeroed
+    (zero_start) is the built-in PID, so on the same events it has the PID's outcomes exactly;
+    its training distribution (randomize, episode_time) gives way to the suite's."""
+    import gymnasium as gym
+    from stable_baselines3 import PPO
+
+    from agents.learning.exploration import zero_action_mean
+    from agents.sb3_policy import export_self_contained
+    env = gym.make(ENV_ID, command="supervisor")
+    model = PPO("MlpPolicy", env, seed=0, device="cpu", n_steps=64, batch_size=64)
+    zero_action_mean(model.policy)
+    path = export_self_contained(model, None, tmp_path / "zero.zip", env_id=ENV_ID,
+                                 env_kwargs={"command": "supervisor", "randomize": True,
+                                             "episode_time": 0.5},
+                                 residual="inner-loop", residual_scale=1.0)
+    suite = RecoverSuite("tiny", "two events", seed=60_000, size=2, quick_size=2,
+                         validation_seed=61_000, validation_size=2, env_id=ENV_ID,
+                         env_kwargs={"episode_time": 0.06})
+    report = recover_benchmark(tmp_path / "run", suite, policies=[str(path)],
+                               names=["zero-residual"], progress=False)
+    rows = report["events"]
+    assert list(rows) == ["inner-loop", "zero-residual"]
+    assert rows["zero-residual"] == rows["inner-loop"]
+    assert rows["inner-loop"][0]["peak_contact_force_N"] > 0       # the event makes contact
+    mine = next(r for r in report["board"] if r["controller"] == "zero-residual")
+    assert mine["learned"] and mine["seat"] == "supervisor"
+    assert mine["vs_reference"]["recovered"]["delta"] == 0.0
+    with pytest.raises(ValueError, match="ppo-damping"):
+        recover_benchmark(tmp_path / "bad", suite, policies=["ppo-damping"], progress=False)
