@@ -22,6 +22,8 @@ import time
 
 import numpy as np
 
+from physics.runs.study.ensemble import wilson
+
 from ..control.controllers import controller_class, controller_env_kwargs, make_controller
 from ..control.seats import seat_for_kwargs, seat_of
 from .rollout import run_episodes
@@ -54,10 +56,7 @@ def event_record(ep) -> dict:
 def rate(x: np.ndarray) -> dict:
     """A proportion with its binomial SE and Wilson 95 % interval."""
     n, p = len(x), float(np.mean(x)) if len(x) else math.nan
-    z = 1.96
-    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
-    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
-    return {"value": p, "se": math.sqrt(p * (1 - p) / n), "wilson95": [centre - half, centre + half]}
+    return {"value": p, "se": math.sqrt(p * (1 - p) / n), "wilson95": wilson(int(np.sum(x)), n)}
 
 
 def paired_bootstrap(a: np.ndarray, b: np.ndarray, rng: np.random.Generator) -> dict:

@@ -52,7 +52,7 @@ from generated_block import publish  # noqa: E402
 from physics import compute_metrics, load_scene, simulate  # noqa: E402
 from physics.campbell import SPRINGS_ONLY, first_bending, flexible_whirl  # noqa: E402
 from physics.metrics import valid_or_before, whirled  # noqa: E402
-from physics.runs.study.ensemble import perturbations  # noqa: E402
+from physics.runs.study.ensemble import perturbations, wilson  # noqa: E402
 
 PRESET = "machine-flexible"
 #: the study keeps the static correction modes (the most accurate basis, docs/accuracy.md)
@@ -124,18 +124,6 @@ def decision(d: dict) -> bool | None:
     if d["backward_whirl"]:
         return True
     return False if d["left_validity_at_s"] is None else None
-
-
-Z95 = 1.959964                                  # two-sided 95 % normal quantile
-
-
-def wilson(k: int, n: int) -> list[float]:
-    """Wilson's 95 % score interval of a binomial fraction k / n (Wilson 1927): unlike p +- SE it
-    stays in [0, 1] and is not empty at k = 0 or k = n (3 / n wide there, the 'rule of three')."""
-    p, z2 = k / n, Z95 * Z95
-    mid = (p + z2 / (2 * n)) / (1 + z2 / n)
-    half = Z95 * np.sqrt(p * (1 - p) / n + z2 / (4 * n * n)) / (1 + z2 / n)
-    return [float(max(mid - half, 0.0)), float(min(mid + half, 1.0))]     # a list, as in JSON
 
 
 def whirl_fraction(drops: list[dict]) -> list[dict]:

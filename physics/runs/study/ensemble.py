@@ -134,3 +134,16 @@ def probability_curve(values: Sequence[float], whirls: Sequence[bool]) -> list[d
         groups.setdefault(round(float(v), 6), []).append(bool(w))
     return [dict(value=v, probability=sum(ws) / len(ws), runs=len(ws), whirls=sum(ws))
             for v, ws in sorted(groups.items())]
+
+
+Z95 = 1.959964                                  # two-sided 95 % normal quantile
+
+
+def wilson(k: int, n: int) -> list[float]:
+    """Wilson's 95 % score interval of a binomial fraction k / n (Wilson 1927): unlike p +- SE it
+    stays in [0, 1] and is not empty at k = 0 or k = n (3 / n wide there, the 'rule of three').
+    The studies' whirl fractions and the Recover benchmark's rates use it."""
+    p, z2 = k / n, Z95 * Z95
+    mid = (p + z2 / (2 * n)) / (1 + z2 / n)
+    half = Z95 * math.sqrt(p * (1 - p) / n + z2 / (4 * n * n)) / (1 + z2 / n)
+    return [float(max(mid - half, 0.0)), float(min(mid + half, 1.0))]     # a list, as in JSON
