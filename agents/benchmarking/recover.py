@@ -27,7 +27,7 @@ from physics.runs.study.ensemble import wilson
 from ..control.controllers import controller_class, controller_env_kwargs, make_controller
 from ..control.seats import seat_for_kwargs, seat_of
 from .rollout import run_episodes
-from .score import write_json
+from .score import BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, write_json
 
 ENV_ID = "RotorDrop-Recover-v1"
 #: the reference row: the built-in PID, left alone
@@ -35,7 +35,6 @@ REFERENCE = "inner-loop"
 #: the designed rows, each run in its seat
 DESIGNED = ("inner-loop", "sync-phase-search", "sync-motion-comp", "pid-relevitate",
             "sync-current-search", "whirl-brake")
-BOOTSTRAP = 1000
 
 
 def event_record(ep) -> dict:
@@ -62,13 +61,13 @@ def rate(x: np.ndarray) -> dict:
 def paired_bootstrap(a: np.ndarray, b: np.ndarray, rng: np.random.Generator) -> dict:
     """mean(a − b) over paired events with its bootstrap SE and 95 % percentile interval."""
     d = np.asarray(a, float) - np.asarray(b, float)
-    idx = rng.integers(0, len(d), size=(BOOTSTRAP, len(d)))
+    idx = rng.integers(0, len(d), size=(BOOTSTRAP_RESAMPLES, len(d)))
     boot = d[idx].mean(axis=1)
     return {"delta": float(d.mean()), "se": float(boot.std(ddof=1)),
             "ci95": [float(np.percentile(boot, 2.5)), float(np.percentile(boot, 97.5))]}
 
 
-def row_summary(records: list[dict], ref: list[dict], seed: int = 0) -> dict:
+def row_summary(records: list[dict], ref: list[dict], seed: int = BOOTSTRAP_SEED) -> dict:
     """A row's figures against the reference row's ``ref`` (the same events, in order)."""
     rng = np.random.default_rng(seed)
     col = lambda rs, key: np.array([float(r[key]) for r in rs])     # noqa: E731
