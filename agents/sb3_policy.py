@@ -257,7 +257,7 @@ def export_self_contained(model, vecnormalize, out_path: str | Path, *, env_id: 
     :class:`~agents.control.residual.ResidualAction` wrapper, if any). ``frame_stack``: the number of
     observations the network sees at once (the run's ``frame_stack``). The model passed in is
     left as it was."""
-    from .control.controllers import BASELINES
+    from .control.controllers import BASELINES, baseline_name
     from .control.residual import RESIDUAL_SCALE, residual_of
     cls = _exported_class(model.policy)
     if env_id is None:
@@ -268,15 +268,15 @@ def export_self_contained(model, vecnormalize, out_path: str | Path, *, env_id: 
         spec = venv.get_attr("spec", [0])[0]
         env_id, env_kwargs = spec.id, dict(spec.kwargs)
         residual, residual_scale = residual_of(venv)
-    if residual is not None and residual not in BASELINES:
-        raise ValueError(f"residual = {residual!r} is not a baseline ({', '.join(BASELINES)})")
+    if residual is not None:
+        baseline_name(residual)                 # ValueError naming the baselines
     norm = None
     if vecnormalize is not None and vecnormalize.norm_obs:
         norm = {"epsilon": float(vecnormalize.epsilon), "clip_obs": float(vecnormalize.clip_obs)}
     meta = dict(env_id=env_id, env_kwargs=copy.deepcopy(dict(env_kwargs or {})), normalize=norm,
                 residual=residual,
                 residual_scale=float(RESIDUAL_SCALE if residual_scale is None else residual_scale),
-                memoryless=bool(residual is None or BASELINES[residual].memoryless),
+                memoryless=bool(residual is None or BASELINES[baseline_name(residual)].memoryless),
                 frame_stack=int(frame_stack))
     policy, kwargs = _rebuilt(model, cls, meta)
     if norm is not None:

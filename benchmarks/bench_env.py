@@ -4,6 +4,7 @@ in the controller seat (``--control-dt``) as ratios to Gymnasium's ``Pendulum-v1
     python benchmarks/bench_env.py [--repeats 3] [--episodes 2] [--n-envs 16] [--json out.json]
                                    [--set KEY=VALUE ...]
     python benchmarks/bench_env.py --control-dt 2e-4 --control-dt 1e-4 [--repeats 15]
+                                   [--compare-set solver.rtol=1e-4 ...]
                                    [--json docs/data/bench-env-seat.json]
 
 With ``--control-dt`` (one or more control steps [s]) it measures only the controller seat
@@ -241,13 +242,15 @@ SEAT_ENV = "RotorDrop-Full-v1"
 PENDULUM = "Pendulum-v1"
 
 
-def seat_kwargs(control_dt: float) -> dict:
+def seat_kwargs(control_dt: float, overrides: dict | None = None) -> dict:
     """The env kwargs of a controller-seat row at ``control_dt``: raw currents, the robust
-    suite's sensor noise and the middle of its sensor delay range, no transport latency."""
+    suite's sensor noise and the middle of its sensor delay range, no transport latency;
+    ``overrides``: scene keys (``--set``, e.g. a looser ``solver.rtol``)."""
     from agents.benchmarking.robust import SENSOR_DELAY_S, SENSOR_NOISE
     from agents.control.seats import CONTROLLER
-    return dict(CONTROLLER.env_kwargs(control_dt), command="continuous", sensor_noise=SENSOR_NOISE,
-                sensor_delay=0.5 * (SENSOR_DELAY_S[0] + SENSOR_DELAY_S[1]))
+    kw = dict(CONTROLLER.env_kwargs(control_dt), command="continuous", sensor_noise=SENSOR_NOISE,
+              sensor_delay=0.5 * (SENSOR_DELAY_S[0] + SENSOR_DELAY_S[1]))
+    return dict(kw, overrides=dict(overrides)) if overrides else kw
 
 
 def stepping_rate(env, steps: int, seed: int = 0):
@@ -285,11 +288,11 @@ def vector_rate(env_id: str, kwargs: dict, n_envs: int, steps: int, seed: int = 
     return run
 
 
-def seat_cases(control_dt: float, n_envs: int, steps: int) -> dict:
+def seat_cases(control_dt: float, n_envs: int, steps: int, overrides: dict | None = None) -> dict:
     """The timed runs of the controller seat at ``control_dt`` (each returns steps/s), warmed
     up: Pendulum-v1, the single env (``gym.make``, unwrapped), the SB3 batch and the vector env
-    (``n_envs``, one thread)."""
-    kw = seat_kwargs(control_dt)
+    (``n_envs``, one thread); ``overrides``: scene keys."""
+    kw = seat_kwargs(control_dt, overrides)
     batch_steps = max(1, steps // n_envs)
     cases = {PENDULUM: stepping_rate(gym.make(PENDULUM), 4 * steps),
              "single (gym.make)": stepping_rate(gym.make(SEAT_ENV, **kw), steps),
@@ -301,11 +304,13 @@ def seat_cases(control_dt: float, n_envs: int, steps: int) -> dict:
     return cases
 
 
-def seat_speed(control_dt: float, repeats: int, n_envs: int, steps: int) -> dict:
+def seat_speed(control_dt: float, repeats: int, n_envs: int, steps: int,
+               overrides: dict | None = None) -> dict:
     """The controller seat's rates at ``control_dt`` and their ratios to Pendulum-v1's, each
-    the median over ``repeats`` rounds that time every case once (module doc)."""
-    kw = seat_kwargs(control_dt)
-    cases = seat_cases(control_dt, n_envs, steps)
+    the median over ``repeats`` rounds that time every case once (module doc); ``overrides``:
+    scene keys for every case."""
+    kw = seat_kwargs(control_dt, overrides)
+    cases = seat_cases(control_dt, n_envs, steps, overrides)
     rounds = [{name: run() for name, run in cases.items()} for _ in range(repeats)]
     out = {"control_dt_s": control_dt, "env_id": SEAT_ENV, "env_kwargs": kw, "repeats": repeats,
            "rates": {}, "ratio_to_pendulum": {}}
@@ -344,13 +349,19 @@ def _rhs_share(res: dict) -> float:
     return i["rhs"] * i["rhs_ns"] * 1e-3 / res["per-step us"]["physics"]
 
 
+def _seat_label(r: dict) -> str:
+    """A seat run's control step, and its scene overrides if any (``--set``)."""
+    extra = r["env_kwargs"].get("overrides") or {}
+    return f"{1e3 * r['control_dt_s']:g} ms" + "".join(f", `{k}={v}`" for k, v in extra.items())
+
+
 def seat_table(res: dict) -> str:
     """The markdown table of a ``--control-dt`` run's JSON (docs/environments.md pastes it
     between its markers; ``--render JSON`` prints it)."""
     rows = ["| control step | case | env steps/s | × Pendulum-v1 (median of per-round ratios) |",
             "|---|---|---|---|"]
     for r in res["seat"]:
-        dt = f"{1e3 * r['control_dt_s']:g} ms"
+        dt = _seat_label(r)
         for name, rate in r["rates"].items():
             ratio = r["ratio_to_pendulum"].get(name)
             rows.append(f"| {dt} | {name} | {rate:,.0f} | "
@@ -362,7 +373,7 @@ def seat_table(res: dict) -> str:
              "|---|---|---|---|---|---|---|---|---|---|"]
     for r in res["seat"]:
         c = r["per-step us"]
-        rows.append(f"| {1e3 * r['control_dt_s']:g} ms | {c['physics']:.1f} µs | "
+        rows.append(f"| {_seat_label(r)} | {c['physics']:.1f} µs | "
                     f"{c['kernel'] - c['physics']:.1f} µs | {c['unwrapped'] - c['kernel']:.1f} µs | "
                     f"{c['wrapped'] - c['unwrapped']:.1f} µs | {c['wrapped']:.1f} µs | "
                     f"{100 * c['physics'] / c['wrapped']:.0f} % | "
@@ -373,7 +384,7 @@ def seat_table(res: dict) -> str:
                     f"{1e6 / c['physics'] / r['rates'][PENDULUM]:.2f} |")
     kw = res["seat"][0]["env_kwargs"]
     rows += ["", f"{res['seat'][0]['env_id']}, "
-             + ", ".join(f"`{k}={v!r}`" for k, v in kw.items() if k != "control_dt")
+             + ", ".join(f"`{k}={v!r}`" for k, v in kw.items() if k not in ("control_dt", "overrides"))
              + f"; {res['steps']} env steps per case and round, {res['seat'][0]['repeats']} "
              f"rounds, N = {res['n_envs']}, {res['clock']} clock."]
     return "\n".join(rows) + "\n"
@@ -405,6 +416,10 @@ def main(argv=None) -> int:
     p.add_argument("--control-dt", type=float, action="append", default=[], metavar="SECONDS",
                    help="measure the controller seat at this control step (repeatable) against "
                         "Pendulum-v1 instead of the 1 ms figures")
+    p.add_argument("--compare-set", action="append", default=[], metavar="KEY=VALUE",
+                   help="with --control-dt: one more controller-seat run at the first control "
+                        "step with this scene override (repeatable), e.g. solver.rtol=1e-4: "
+                        "what a looser tolerance buys")
     p.add_argument("--steps", type=int, default=3000,
                    help="env steps per controller-seat run (per case and round)")
     p.add_argument("--render", default=None, metavar="JSON",
@@ -416,15 +431,19 @@ def main(argv=None) -> int:
         return 0
     global CLOCK
     CLOCK = time.process_time if args.clock == "cpu" else time.perf_counter
+    overrides = dict(parse_assignment(a) for a in args.overrides)
     if args.control_dt:
         res = {"clock": args.clock, "n_envs": args.n_envs, "steps": args.steps,
-               "seat": [seat_speed(dt, args.repeats, args.n_envs, args.steps)
-                        for dt in args.control_dt]}
+               "seat": [seat_speed(dt, args.repeats, args.n_envs, args.steps, overrides)
+                        for dt in args.control_dt]
+               + [seat_speed(args.control_dt[0], args.repeats, args.n_envs, args.steps,
+                             dict(overrides, **dict([parse_assignment(a)])))
+                  for a in args.compare_set]}
         for r in res["seat"]:
             _print_seat(r)
         _write(args.json, res)
         return 0
-    kwargs = {"overrides": dict(parse_assignment(a) for a in args.overrides)} if args.overrides else {}
+    kwargs = {"overrides": overrides} if overrides else {}
     R, E = args.repeats, args.episodes
     res: dict = {"scene": "paper", "overrides": kwargs.get("overrides", {}), "clock": args.clock,
                  "control_dt_s": 1e-3, "numba_threads": numba.config.NUMBA_NUM_THREADS}

@@ -303,6 +303,15 @@ def acting(I, U):
 
 
 @njit_inline
+def reads_sensor(I, U):
+    """The AMBs' law reads the sensed displacement (and so the held sensor noise) now: the
+    linear law or the actuator's PID while powered; not direct coil currents, not unpowered."""
+    amb = I[F_AMB]
+    return U[U_AMB_POWER] > 0.0 and (
+        amb == AMB_LINEAR or (amb == AMB_ACTUATOR and U[U_AMB_DIRECT] <= 0.0))
+
+
+@njit_inline
 def force(t, y, P, I, U, dy, aux, load):
     """The AMBs' forces at their stations into the load, their power as external work, and the
     actuator's PID, filter and coil rates (spec §5)."""

@@ -10,6 +10,7 @@ import math
 import numpy as np
 
 from ._jit import njit, njit_borrow
+from .amb import reads_sensor
 from .layout import Slots
 from .model import A_FR, A_LOAD, A_QMAX, F_SENSOR, N_AUX, N_AUX_PLANE, P_SENS_RATE, P_SENS_SIGMA, rhs
 from .sensor import hold_noise, samples_inside
@@ -195,13 +196,22 @@ def integrate_sensed(y, t0, t1, P, I, U, Z, rtol, atol, h, h_max, h_min, fixed, 
     (physics/sensor.py): split at the n sample instants inside (t0, t1), the held sample
     U_SENS_NOISE set to sensor.noise x ``Z[i]`` (standard normals, the AMB axes' order) from the
     i-th of them on. Without noise it is one call of :func:`integrate_segment_into` (nothing split,
-    ``Z`` unread); like it, it allocates nothing (``aux``: the diagnostics scratch). Returns
-    what that returns (the counts summed over the pieces)."""
+    ``Z`` unread); so it is when nothing inside the model reads the noise during the step (the
+    AMBs driven by direct coil currents or unpowered: :func:`physics.amb.reads_sensor`), the
+    last sample of the step then held at its end for what reads it there (the observations).
+    Like :func:`integrate_segment_into`, it allocates nothing (``aux``: the diagnostics
+    scratch). Returns what that returns (the counts summed over the pieces)."""
     if not I[F_SENSOR] or P[P_SENS_SIGMA] == 0.0:
         return integrate_segment_into(y, t0, t1, P, I, U, rtol, atol, h, h_max, h_min, fixed,
                                       max_steps, t_out, Y_out, out_pos, work, aux)
     rate = P[P_SENS_RATE]
     k0, n = samples_inside(t0, t1, rate)
+    if not reads_sensor(I, U):
+        res = integrate_segment_into(y, t0, t1, P, I, U, rtol, atol, h, h_max, h_min, fixed,
+                                     max_steps, t_out, Y_out, out_pos, work, aux)
+        if n > 0 and res[0] == OK:
+            hold_noise(Z[n - 1], P, U)
+        return res
     t = t0
     h_next = h
     n_rhs = n_steps = n_rej = 0

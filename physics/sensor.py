@@ -26,7 +26,8 @@ frame and the environments' observations see of the displacement d of one AMB ax
   next (zero-order hold), whatever the step of the one who reads it: the built-in PID, the
   supervisor's orbit frame and the observations all see the sample current at their time. The
   held sample is the U entries ``U_SENS_NOISE``; a control step that spans sample instants is
-  integrated in pieces split there (:func:`physics.integrate.integrate_sensed`), the entries
+  integrated in pieces split there when the AMBs' law reads them (:func:`physics.integrate.integrate_sensed`;
+  driven by direct coil currents nothing inside the model does, and the step is one piece), the entries
   set between pieces from standard normals the environments draw from their ``np_random``
   (:func:`samples_inside` says how many), so the kernel stays deterministic given its inputs.
 

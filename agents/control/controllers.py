@@ -39,6 +39,7 @@ the power returns.
 """
 from __future__ import annotations
 
+import math
 from contextlib import contextmanager
 
 import numpy as np
@@ -760,16 +761,16 @@ def controller_class(spec: str) -> type[Controller] | None:
     return load_controller(spec) if is_controller_spec(spec) else None
 
 
-def make_controller(cls: type[Controller], plant: Plant) -> Controller:
-    """``cls(plant)`` after checking that the environment has the channels it needs; an error
-    in the constructor (say an argument without default) is a :class:`ControllerError`."""
+def make_controller(cls: type[Controller], plant: Plant, **gains) -> Controller:
+    """``cls(plant, **gains)`` after checking that the environment has the channels it needs; an
+    error in the constructor (say an argument without default) is a :class:`ControllerError`."""
     if not cls.supports(plant):
         where = "" if cls.env_ids is None else f" in {', '.join(cls.env_ids)}"
         raise ValueError(f"controller {cls.name!r} needs action channels {cls.needs}{where}, "
                          f"which {plant.env_id} does not have (it has "
                          f"{', '.join(plant.channels)})")
-    with blame(cls, f"{cls.__name__}(plant)"):
-        return cls(plant)
+    with blame(cls, f"{cls.__name__}(plant{', **gains' if gains else ''})"):
+        return cls(plant, **gains)
 
 
 def check_controller(actor, plant: Plant, obs: np.ndarray) -> None:
@@ -791,7 +792,32 @@ def check_controller(actor, plant: Plant, obs: np.ndarray) -> None:
                                   f"{np.shape(action)} for {plant.env_id}, expected {want}")
 
 
-def make_baseline(name: str, plant: Plant) -> Controller:
+def baseline_name(spec) -> str:
+    """The law of a baseline ``spec``: a baseline's name, or ``{"law": name, "gains": {...}}``
+    (that law with those constants, e.g. the ones tuned on a suite: what a residual policy
+    corrects when it names them). ValueError naming the allowed forms otherwise."""
+    if isinstance(spec, dict):
+        if set(spec) != {"law", "gains"} or not isinstance(spec["gains"], dict):
+            raise ValueError(f"a baseline with constants is {{'law': NAME, 'gains': {{...}}}}, "
+                             f"got {spec!r}")
+        name = spec["law"]
+    else:
+        name = spec
     if name not in BASELINES:
-        raise KeyError(f"unknown baseline controller {name!r}; known: {', '.join(BASELINES)}")
-    return make_controller(BASELINES[name], plant)
+        raise ValueError(f"unknown baseline controller {name!r}; known: {', '.join(BASELINES)}")
+    return name
+
+
+def make_baseline(spec, plant: Plant) -> Controller:
+    """The baseline ``spec`` (:func:`baseline_name`) on ``plant``: a name with its class
+    constants, or a law with the given ones (each named by the class and finite)."""
+    cls = BASELINES[baseline_name(spec)]
+    if not isinstance(spec, dict):
+        return make_controller(cls, plant)
+    known = getattr(cls, "GAINS", {})
+    for k, v in spec["gains"].items():
+        if k not in known:
+            raise ValueError(f"{cls.name} has no constant {k!r}; its constants: {', '.join(known)}")
+        if not isinstance(v, (int, float)) or isinstance(v, bool) or not math.isfinite(v):
+            raise ValueError(f"{cls.name} constant {k} must be a finite number, got {v!r}")
+    return make_controller(cls, plant, **spec["gains"])

@@ -30,7 +30,7 @@ class ResidualAction(VecEnvWrapper):
     2019). Box action spaces only. Works on the batched VecEnv and on SB3's DummyVecEnv (rl-zoo3's
     default) or SubprocVecEnv of ``gym.make`` environments."""
 
-    def __init__(self, venv, base: str, scale: float = RESIDUAL_SCALE):
+    def __init__(self, venv, base: str | dict, scale: float = RESIDUAL_SCALE):
         from .controllers import make_baseline
         from .plant import Plant
         super().__init__(venv)

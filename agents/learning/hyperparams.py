@@ -23,7 +23,10 @@ arguments a block may hold:
 ``reward``         ``env`` (the environment's reward, default) or ``kpi`` (the KPI-aligned
                    reward of :mod:`agents.learning.reward`), with optional ``reward_kwargs``
 ``residual``       a baseline controller name: the agent's action corrects that controller's
-                   (:mod:`agents.control.residual`; the saved policy applies it too)
+                   (:mod:`agents.control.residual`; the saved policy applies it too); or
+                   ``{law: NAME, tuned_on: SUITE}``: that law with the constants tuned on the
+                   suite's validation drops (``rotordrop research tune-designed``), written
+                   into the run as ``{law: NAME, gains: {...}}`` (also accepted as such)
 ``residual_scale`` the residual's authority: env action = clip(base + scale * a, -1, 1)
                    (default 2: the agent can override the baseline anywhere)
 ``validation``     ``true``: keep as ``best/`` the model with the highest benchmark score on the
@@ -119,6 +122,30 @@ FRACTIONS = ("gamma", "gae_lambda", "tau")
 #: SB3 arguments that take a tuple, which YAML writes as a list (``train_freq: [1, episode]``)
 TUPLES = ("train_freq",)
 
+
+def residual_spec(value):
+    """The ``residual`` key checked: a baseline's name, or ``{law, gains}`` with the gains given
+    or read from a suite's tuned record (``{law, tuned_on}``); ConfigError otherwise."""
+    from ..control.controllers import BASELINES, baseline_name
+    if isinstance(value, dict) and set(value) == {"law", "tuned_on"}:
+        from ..benchmarking.suites import SUITES
+        from ..benchmarking.tuned import load_records
+        try:
+            suite = SUITES.get(value["tuned_on"], "tune")
+        except ValueError as exc:
+            raise ConfigError(f"residual.tuned_on: {exc}") from exc
+        rec = load_records(suite).get(value["law"])
+        if rec is None:
+            raise ConfigError(f"residual: no tuned record of {value['law']!r} on the "
+                              f"{suite.name} suite (rotordrop research tune-designed)")
+        value = {"law": value["law"], "gains": dict(rec["gains"])}
+    try:
+        baseline_name(value)
+    except ValueError as exc:
+        raise ConfigError(f"residual must be a baseline controller ({', '.join(BASELINES)}) or "
+                          f"{{law: NAME, tuned_on: SUITE}} or {{law: NAME, gains: {{...}}}}: "
+                          f"{exc}") from exc
+    return value
 
 def _yaml():
     try:
@@ -449,10 +476,7 @@ def split(hp: dict) -> tuple[dict, dict]:
     if meta["reward"] not in REWARDS:
         raise ConfigError(f"reward must be one of {', '.join(REWARDS)}, got {meta['reward']!r}")
     if meta.get("residual") is not None:
-        from ..control.controllers import BASELINES
-        if meta["residual"] not in BASELINES:
-            raise ConfigError(f"residual must be a baseline controller ({', '.join(BASELINES)}), "
-                              f"got {meta['residual']!r}")
+        meta["residual"] = residual_spec(meta["residual"])
     if meta.get("residual") is not None:
         from ..control.residual import RESIDUAL_SCALE
         meta.setdefault("residual_scale", RESIDUAL_SCALE)

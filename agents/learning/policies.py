@@ -56,7 +56,7 @@ class LearnedPolicy:
     model: object
     vecnormalize: object | None
     meta: dict = field(default_factory=dict)
-    residual: str | None = None          # baseline whose action the policy corrects
+    residual: str | dict | None = None   # baseline (a name, or {law, gains}) the policy corrects
     residual_scale: float = RESIDUAL_SCALE
     base: object | None = None
     source: str | None = None            # the path it was loaded from

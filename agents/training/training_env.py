@@ -8,7 +8,7 @@ from __future__ import annotations
 
 def make_vec_env(env_id: str, n_envs: int, seed: int, env_kwargs: dict, monitor_file=None,
                  reward: str = "env", reward_kwargs: dict | None = None,
-                 residual: str | None = None, residual_scale: float | None = None):
+                 residual: str | dict | None = None, residual_scale: float | None = None):
     """The batched SB3 VecEnv of ``rotordrop_env`` with episode statistics (``VecMonitor``);
     ``reward="kpi"`` makes the environments' reward the KPI-aligned one (env kwarg
     ``reward="kpi"``, :mod:`rotordrop_env.reward`), ``residual`` makes the agent's action a

@@ -23,7 +23,7 @@ EVAL_FREQ = 25_000
 
 
 def validation_score(validator, model, algo: str, env_id: str, env_kwargs: dict, vecnormalize,
-                     residual: str | None = None, residual_scale: float | None = None,
+                     residual: str | dict | None = None, residual_scale: float | None = None,
                      frame_stack: int | None = None) -> float:
     """The benchmark score of ``model`` (with its ``vecnormalize``, ``residual`` and
     ``frame_stack``; None: read from the model's training env) on the validation suite of

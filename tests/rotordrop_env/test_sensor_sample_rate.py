@@ -72,6 +72,39 @@ def test_a_1ms_step_integrates_in_pieces_at_the_10khz_sample_instants(t0, distin
     assert not np.array_equal(y, held)
 
 
+@pytest.mark.parametrize("power", [0.0, 1.0])
+def test_direct_currents_read_no_noise_so_the_step_is_not_split(power):
+    """Coil currents set directly (the controller seat; powered or not): nothing inside the
+    model reads the sensed displacement, so a 1 ms step at f_s = 10 kHz is one piece, its state
+    independent of the noise samples bit for bit, and the step's last sample is held at its end
+    (what the observations read there). The split is a cost only the PID's reading justifies."""
+    from physics.model import U_AMB_DIRECT, U_AMB_POWER, U_ICMD
+    m = build_model(load_scene("paper", {"effects.amb": "actuator", "sensor.noise": SIGMA,
+                                         "sensor.delay": 1e-4}))
+    t0, dt, rate = 1.23e-3, 1e-3, 1e4
+    n = samples_inside(t0, t0 + dt, rate)[1]
+    y0, U0 = levitated_state(m), m.controls(True)
+    U0[U_AMB_POWER], U0[U_AMB_DIRECT] = power, 1.0
+    U0[U_ICMD:U_ICMD + 4] = [0.2, 1.1, -0.3, 0.9]
+    sv = m.scene.solver
+    atol, work = np.full(m.n_state, 1e-9), np.empty((9, m.n_state))
+    no_t, no_Y = np.empty(0), np.empty((0, m.n_state))
+    ends = []
+    for seed in (1, 2):
+        Z = np.random.default_rng(seed).standard_normal((n, 4))
+        y, U = y0.copy(), U0.copy()
+        res = integrate_sensed(y, t0, t0 + dt, m.P, m.I, U, Z, sv.rtol, atol, 1e-5, sv.max_step,
+                               sv.min_step, False, 10**6, no_t, no_Y, 0, work, np.empty(N_AUX))
+        assert res[0] == 0
+        assert np.array_equal(U[U_SENS_NOISE:U_SENS_NOISE + 4], SIGMA * Z[-1])
+        ends.append(y)
+    assert np.array_equal(ends[0], ends[1])
+    whole = y0.copy()
+    integrate_segment(whole, t0, t0 + dt, m.P, m.I, U0.copy(), sv.rtol, atol, 1e-5, sv.max_step,
+                      sv.min_step, False, 10**6, no_t, no_Y, 0, work)
+    assert np.array_equal(ends[0], whole)
+
+
 def noise_run(control_dt, rate, steps, seed=3, **kw):
     """(step start and end times, the held noise after each step [m], the rows of Z each step
     drew) of a re-levitation episode with noise sampled at ``rate``."""

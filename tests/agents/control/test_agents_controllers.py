@@ -51,7 +51,7 @@ def test_controllers_obey_the_action_space(env_id, kw):
 
 def test_unknown_baseline_is_named():
     env = make_env("RotorDrop-Damping-v1", **SHORT)
-    with pytest.raises(KeyError, match="max-damping"):
+    with pytest.raises(ValueError, match="max-damping"):
         make_baseline("maximum", Plant.from_env(env))
 
 

@@ -163,3 +163,47 @@ def test_export_reads_env_and_residual_from_the_models_training_env(tmp_path):
     assert (inside["env_id"], inside["residual"], inside["residual_scale"]) == \
         ("RotorDrop-Relevitate-v1", "whirl-brake", 0.5)
     assert inside["env_kwargs"] == kw and inside["normalize"]["clip_obs"] == 10.0
+
+
+def test_a_residual_on_tuned_constants_carries_them_and_acts_as_that_law(tmp_path):
+    """``residual: {law: whirl-brake, tuned_on: robust}`` is written into the run as the law with
+    the robust suite's tuned constants; the exported policy corrects that law (not the class
+    gains) under plain SB3 and the project loader alike."""
+    from agents.benchmarking.suites import SUITES
+    from agents.benchmarking.tuned import load_records
+    from agents.learning.hyperparams import residual_spec
+    from agents.learning.policies import LearnedPolicy
+    spec = residual_spec({"law": "whirl-brake", "tuned_on": "robust"})
+    gains = load_records(SUITES.get("robust", "tune"))["whirl-brake"]["gains"]
+    assert spec == {"law": "whirl-brake", "gains": gains}
+    model, vn, env_id, env_kwargs = _trained_run(tmp_path, "ppo")
+    out = export_self_contained(model, vn, tmp_path / "tuned.zip", env_id=env_id,
+                                env_kwargs=env_kwargs, residual=spec, residual_scale=0.5)
+    env = gym.make(env_id, **env_kwargs)
+    plant = Plant.from_env(env)
+    tuned, plain_law = make_baseline(spec, plant), make_baseline("whirl-brake", plant)
+    obs = _episode_obs(env, algo_class("ppo").load(out, device="cpu"), seeds=(3,), steps=20)
+    net, _ = model.predict(vn.normalize_obs(obs), deterministic=True)
+    expected = residual_action(tuned, obs, net, 0.5)
+    assert tuned.g == {**plain_law.g, **gains} and tuned.g != plain_law.g
+    assert np.array_equal(algo_class("ppo").load(out, device="cpu").predict(obs, deterministic=True)[0],
+                          expected)
+    pol = LearnedPolicy.load(str(out)).bound(plant)
+    assert pol.residual == spec and pol.base.g == tuned.g
+    assert np.array_equal(pol.predict(obs)[0], expected)
+
+
+@pytest.mark.parametrize("value, match", [
+    ({"law": "whirl-brake", "tuned_on": "nowhere"}, "tuned_on"),
+    ({"law": "max-damping", "tuned_on": "robust"}, "no tuned record of 'max-damping'"),
+    ({"law": "whirl-brake", "gains": {"kq": 1.0}}, "no constant 'kq'"),
+    ({"law": "whirl-brake", "gains": {"kp": float("nan")}}, "finite"),
+    ({"law": "whirl-brake"}, "law: NAME"),
+    ("no-such-law", "unknown baseline controller"),
+])
+def test_bad_residual_specs_are_clear_config_errors(value, match):
+    from agents.learning.config_checks import ConfigError
+    from agents.learning.hyperparams import residual_spec
+    env = gym.make("RotorDrop-Full-v1", command="continuous", episode_time=0.01)
+    with pytest.raises((ConfigError, ValueError), match=match):
+        make_baseline(residual_spec(value), Plant.from_env(env))
