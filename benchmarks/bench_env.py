@@ -4,7 +4,7 @@ in the controller seat (``--control-dt``) as ratios to Gymnasium's ``Pendulum-v1
     python benchmarks/bench_env.py [--repeats 3] [--episodes 2] [--n-envs 16] [--json out.json]
                                    [--set KEY=VALUE ...]
     python benchmarks/bench_env.py --control-dt 2e-4 --control-dt 1e-4 [--repeats 15]
-                                   [--compare-set solver.rtol=1e-4 ...]
+                                   [--compare-set solver.rtol=1e-4 ...] [--law whirl-brake]
                                    [--json docs/data/bench-env-seat.json]
 
 With ``--control-dt`` (one or more control steps [s]) it measures only the controller seat
@@ -88,7 +88,7 @@ def single_env_rate(env_id: str, kwargs: dict, episodes: int, unwrapped: bool, s
 
 
 def cost_split(env_id: str, kwargs: dict, episodes: int, seed: int = 0,
-               stats: dict | None = None):
+               stats: dict | None = None, acts: list | None = None):
     """Per-step microseconds of physics, kernel, unwrapped step and wrapped step of ``env_id``
     on one trajectory (the passive env without action; others with seeded uniform random
     actions, the same in every part). The physics replays the controls ``U`` each step of the
@@ -100,8 +100,9 @@ def cost_split(env_id: str, kwargs: dict, episodes: int, seed: int = 0,
     space = env.action_space
     space.seed(seed)
     passive = env_id == "RotorDrop-Passive-v1"
-    acts = [np.zeros(space.shape, dtype=space.dtype) if passive else space.sample()
-            for _ in range(4096)]
+    if acts is None:
+        acts = [np.zeros(space.shape, dtype=space.dtype) if passive else space.sample()
+                for _ in range(4096)]
 
     def per_step(fn):
         def run():
@@ -253,16 +254,21 @@ def seat_kwargs(control_dt: float, overrides: dict | None = None) -> dict:
     return dict(kw, overrides=dict(overrides)) if overrides else kw
 
 
-def stepping_rate(env, steps: int, seed: int = 0):
+def stepping_rate(env, steps: int, seed: int = 0, acts: list | None = None):
     """Steps per second of a single env (``gym.make``'d or unwrapped) over ``steps`` steps with
-    seeded random actions, reset as episodes end."""
+    seeded random actions, reset as episodes end; or replaying ``acts`` (:func:`law_actions`:
+    what a designed law sent on these very episodes, from a reset with ``seed``)."""
     space = env.action_space
     space.seed(seed)
-    acts = [space.sample() for _ in range(1024)]
+    replay = acts is not None
+    acts = acts if replay else [space.sample() for _ in range(1024)]
     env.reset(seed=seed)
 
     def run():
-        env.reset()
+        if replay:                                      # the recorded episodes again
+            env.reset(seed=seed)
+        else:
+            env.reset()
         t0 = CLOCK()
         for k in range(steps):
             _, _, te, tr, _ = env.step(acts[k % len(acts)])
@@ -270,6 +276,27 @@ def stepping_rate(env, steps: int, seed: int = 0):
                 env.reset()
         return steps / (CLOCK() - t0)
     return run
+
+
+def law_actions(env_id: str, kwargs: dict, law: str, steps: int, seed: int = 0) -> list:
+    """The actions designed law ``law`` sends over ``steps`` steps of ``env_id`` from a reset
+    with ``seed``, reset as episodes end: replayed open loop, they drive the same episodes
+    again (the environment is deterministic given its seed and actions) without the law's
+    own cost in the timing."""
+    from agents.control.controllers import make_baseline
+    from agents.control.plant import Plant
+    env = gym.make(env_id, **kwargs)
+    ctrl = make_baseline(law, Plant.from_env(env))
+    obs, _ = env.reset(seed=seed)
+    start, acts = True, []
+    for _ in range(steps):
+        a, _ = ctrl.predict(obs, episode_start=np.array([start]))
+        acts.append(np.asarray(a, dtype=env.action_space.dtype))
+        obs, _, te, tr, _ = env.step(acts[-1])
+        start = bool(te or tr)
+        if start:
+            obs, _ = env.reset()
+    return acts
 
 
 def vector_rate(env_id: str, kwargs: dict, n_envs: int, steps: int, seed: int = 0):
@@ -288,45 +315,51 @@ def vector_rate(env_id: str, kwargs: dict, n_envs: int, steps: int, seed: int = 
     return run
 
 
-def seat_cases(control_dt: float, n_envs: int, steps: int, overrides: dict | None = None) -> dict:
+def seat_cases(control_dt: float, n_envs: int, steps: int, overrides: dict | None = None,
+               acts: list | None = None) -> dict:
     """The timed runs of the controller seat at ``control_dt`` (each returns steps/s), warmed
     up: Pendulum-v1, the single env (``gym.make``, unwrapped), the SB3 batch and the vector env
-    (``n_envs``, one thread); ``overrides``: scene keys."""
+    (``n_envs``, one thread); ``overrides``: scene keys. With ``acts`` (a law's, replayed:
+    :func:`law_actions`) the single env only."""
     kw = seat_kwargs(control_dt, overrides)
     batch_steps = max(1, steps // n_envs)
     cases = {PENDULUM: stepping_rate(gym.make(PENDULUM), 4 * steps),
-             "single (gym.make)": stepping_rate(gym.make(SEAT_ENV, **kw), steps),
-             "single (unwrapped)": stepping_rate(gym.make(SEAT_ENV, **kw).unwrapped, steps),
-             f"SB3 batch N={n_envs}, per core": batched_rate(SEAT_ENV, kw, n_envs, batch_steps, 1),
-             f"vector env N={n_envs}, per core": vector_rate(SEAT_ENV, kw, n_envs, batch_steps)}
+             "single (gym.make)": stepping_rate(gym.make(SEAT_ENV, **kw), steps, acts=acts),
+             "single (unwrapped)": stepping_rate(gym.make(SEAT_ENV, **kw).unwrapped, steps,
+                                                 acts=acts)}
+    if acts is None:
+        cases[f"SB3 batch N={n_envs}, per core"] = batched_rate(SEAT_ENV, kw, n_envs, batch_steps, 1)
+        cases[f"vector env N={n_envs}, per core"] = vector_rate(SEAT_ENV, kw, n_envs, batch_steps)
     for run in cases.values():                          # warm-up (JIT, scenario caches)
         run()
     return cases
 
 
 def seat_speed(control_dt: float, repeats: int, n_envs: int, steps: int,
-               overrides: dict | None = None) -> dict:
+               overrides: dict | None = None, law: str | None = None) -> dict:
     """The controller seat's rates at ``control_dt`` and their ratios to Pendulum-v1's, each
     the median over ``repeats`` rounds that time every case once (module doc); ``overrides``:
-    scene keys for every case."""
+    scene keys for every case; ``law``: the single env driven by that designed law's actions
+    (recorded, replayed) instead of random ones."""
     kw = seat_kwargs(control_dt, overrides)
-    cases = seat_cases(control_dt, n_envs, steps, overrides)
+    acts = law_actions(SEAT_ENV, kw, law, steps) if law else None
+    cases = seat_cases(control_dt, n_envs, steps, overrides, acts)
     rounds = [{name: run() for name, run in cases.items()} for _ in range(repeats)]
     out = {"control_dt_s": control_dt, "env_id": SEAT_ENV, "env_kwargs": kw, "repeats": repeats,
-           "rates": {}, "ratio_to_pendulum": {}}
+           "actions": law or "random", "rates": {}, "ratio_to_pendulum": {}}
     for name in cases:
         out["rates"][name] = statistics.median(r[name] for r in rounds)
         if name != PENDULUM:
             out["ratio_to_pendulum"][name] = statistics.median(r[name] / r[PENDULUM] for r in rounds)
     stats: dict = {}
     out["per-step us"] = {k: _median(fn, repeats)
-                          for k, fn in cost_split(SEAT_ENV, kw, 1, stats=stats).items()}
+                          for k, fn in cost_split(SEAT_ENV, kw, 1, stats=stats, acts=acts).items()}
     out["integrator per step"] = stats
     return out
 
 
 def _print_seat(res: dict) -> None:
-    print(f"controller seat, {res['env_id']} {res['env_kwargs']}, random actions, resets as "
+    print(f"controller seat, {res['env_id']} {res['env_kwargs']}, {res.get('actions', 'random')} actions, resets as "
           f"episodes end (median of {res['repeats']} rounds):")
     for name, rate in res["rates"].items():
         ratio = res["ratio_to_pendulum"].get(name)
@@ -352,7 +385,9 @@ def _rhs_share(res: dict) -> float:
 def _seat_label(r: dict) -> str:
     """A seat run's control step, and its scene overrides if any (``--set``)."""
     extra = r["env_kwargs"].get("overrides") or {}
-    return f"{1e3 * r['control_dt_s']:g} ms" + "".join(f", `{k}={v}`" for k, v in extra.items())
+    law = r.get("actions", "random")
+    return (f"{1e3 * r['control_dt_s']:g} ms" + "".join(f", `{k}={v}`" for k, v in extra.items())
+            + ("" if law == "random" else f", `{law}`'s actions"))
 
 
 def seat_table(res: dict) -> str:
@@ -420,6 +455,10 @@ def main(argv=None) -> int:
                    help="with --control-dt: one more controller-seat run at the first control "
                         "step with this scene override (repeatable), e.g. solver.rtol=1e-4: "
                         "what a looser tolerance buys")
+    p.add_argument("--law", action="append", default=[], metavar="NAME",
+                   help="with --control-dt: one more run at the first control step whose single "
+                        "env replays the actions this designed law sent on the same episodes "
+                        "(repeatable), e.g. whirl-brake: what a learner near the law steps")
     p.add_argument("--steps", type=int, default=3000,
                    help="env steps per controller-seat run (per case and round)")
     p.add_argument("--render", default=None, metavar="JSON",
@@ -438,7 +477,9 @@ def main(argv=None) -> int:
                         for dt in args.control_dt]
                + [seat_speed(args.control_dt[0], args.repeats, args.n_envs, args.steps,
                              dict(overrides, **dict([parse_assignment(a)])))
-                  for a in args.compare_set]}
+                  for a in args.compare_set]
+               + [seat_speed(args.control_dt[0], args.repeats, args.n_envs, args.steps,
+                             overrides, law) for law in args.law]}
         for r in res["seat"]:
             _print_seat(r)
         _write(args.json, res)
