@@ -818,7 +818,9 @@ def standing(report: dict, task: str) -> str:
 #: docs/tasks.md's learning tables: key -> a `rotordrop benchmark --suite robust --only ...`
 #: report of learned seed groups beside their reference (``rotordrop results --learning KEY=FILE``)
 LEARNING = {"controller-seat-residual": "learning-controller-seat-residual.json",
-            "controller-seat-scratch": "learning-controller-seat-scratch.json"}
+            "controller-seat-scratch": "learning-controller-seat-scratch.json",
+            "supervisor-seat-residual": "learning-supervisor-seat-residual.json",
+            "supervisor-seat-scratch": "learning-supervisor-seat-scratch.json"}
 
 
 def store_learning(paths: list[str], dest: Path, prefix: str | None = None) -> Path:
