@@ -83,16 +83,22 @@ def row_summary(records: list[dict], ref: list[dict], seed: int = BOOTSTRAP_SEED
     return out
 
 
+def learned_kwargs(policy_kwargs: dict, suite_kwargs: dict) -> dict:
+    """The env kwargs a learned policy trained with ``policy_kwargs`` runs a suite's events
+    with: its own interface (:func:`~agents.benchmarking.benchmark.interface_kwargs`: command,
+    control step), the suite's ``suite_kwargs`` for the rest (machine, events, sensing)."""
+    from .benchmark import interface_kwargs
+    return {**interface_kwargs(policy_kwargs), **suite_kwargs}
+
+
 def run_row(name: str, seeds, env_kwargs: dict, policy=None) -> tuple[list[dict], float]:
     """A designed law's events in its seat, or with ``policy`` (a
     :class:`~agents.learning.policies.LearnedPolicy`) that policy's, through its own interface
-    (:func:`~agents.benchmarking.benchmark.interface_kwargs`: command, control step) on the
-    suite's ``env_kwargs``: (records, CPU seconds)."""
+    (:func:`learned_kwargs`) on the suite's ``env_kwargs``: (records, CPU seconds)."""
     if policy is not None:
-        from .benchmark import interface_kwargs
         if policy.env_id != ENV_ID:
             raise ValueError(f"--policy {name}: trained on {policy.env_id}, not {ENV_ID}")
-        kw, make_actor = {**interface_kwargs(policy.env_kwargs), **env_kwargs}, policy.bound
+        kw, make_actor = learned_kwargs(policy.env_kwargs, env_kwargs), policy.bound
     else:
         cls = controller_class(name)
         if cls is None:
@@ -103,6 +109,42 @@ def run_row(name: str, seeds, env_kwargs: dict, policy=None) -> tuple[list[dict]
     t0 = time.process_time()
     eps = run_episodes(ENV_ID, make_actor, seeds, kw)
     return [event_record(e) for e in eps], time.process_time() - t0
+
+
+#: model selection: how many of a suite's validation events score a model by default
+VALIDATION_EVENTS = 30
+#: the tie-break's force scale [N]: a mean peak contact force F costs F / (F + this) < 1 point
+TIE_FORCE_N = 1e4
+
+
+def selection_score(records: list[dict]) -> float:
+    """A model's validation score on its events: the recovered percentage, ties broken by the
+    mean peak contact force F (lower is better): 100 · recovered − F / (F + 10 kN). The
+    tie-break is under 1 point and one event is at least 1 point for up to 100 events, so it
+    never outranks a recovery."""
+    force = float(np.mean([r["peak_contact_force_N"] for r in records]))
+    return 100.0 * float(np.mean([r["recovered"] for r in records])) - force / (force + TIE_FORCE_N)
+
+
+class RecoverValidator:
+    """Model selection on the Recover task (the training validation callback,
+    :func:`agents.benchmarking.robust.validator_for`): a model's :func:`selection_score` on the
+    first ``events`` validation events of ``suite`` (its seeds apart from the test events),
+    the model run through its own interface on the suite's env kwargs (:func:`learned_kwargs`),
+    as the benchmark will run it. ``score`` returns (score, event records)."""
+
+    def __init__(self, suite, events: int = VALIDATION_EVENTS):
+        n = suite.validation_size
+        if isinstance(events, bool) or int(events) != events or not 1 <= events <= min(n, 100):
+            raise ValueError(f"validation_events = {events!r} must be an integer in "
+                             f"[1, {min(n, 100)}] (the {suite.name} suite's validation events)")
+        self.suite, self.seeds = suite, suite.validation_seeds()[:int(events)]
+
+    def score(self, make_actor, env_kwargs: dict) -> tuple[float, list[dict]]:
+        eps = run_episodes(ENV_ID, make_actor, self.seeds,
+                           learned_kwargs(env_kwargs, self.suite.env_kwargs))
+        records = [event_record(e) for e in eps]
+        return selection_score(records), records
 
 
 def learned_rows(specs: list[str], names: list[str] | None = None) -> dict:

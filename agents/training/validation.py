@@ -2,14 +2,20 @@
 
 :func:`validation_score` is the benchmark score (:class:`agents.benchmarking.benchmark.Validator`: frictions
 and unbalance phases the benchmark does not use) of a model being trained, run as the saved
-policy will run: its observation normalisation and, for a residual policy, its baseline.
+policy will run: its observation normalisation and, for a residual policy, its baseline. On the
+Recover task it is the recovery score on the recover suite's validation events
+(:class:`agents.benchmarking.recover.RecoverValidator`: recovered %, ties broken by the mean
+peak contact force; ``events`` of them).
 
 :class:`ValidationCallback` runs it as an SB3 callback, the one class for both: rl-zoo3 builds it
 from a config's ``callback:`` entry (``agents.training.validation.ValidationCallback``; in
 ``rotordrop train`` that entry means ``validation: true``) and scores every ``eval_freq``
-environment steps; ``rotordrop train`` scores after each of its KPI evaluations. It logs
-``eval/validation_score`` and, with a ``save_path``, keeps the best-scoring model there as a
-self-contained zip (:mod:`agents.sb3_policy`) that plain SB3 loads.
+environment steps; ``rotordrop train`` scores after each of its KPI evaluations. Both also
+score the initial policy as training starts (a fresh run), so a model that training made
+worse is never kept over it. It logs ``eval/validation_score`` and, with a ``save_path``,
+keeps the best-scoring model there as a self-contained zip (:mod:`agents.sb3_policy`) that
+plain SB3 loads, with ``validation.json``: every score (steps, score, and on the Recover task
+the events recovered) and the best.
 """
 from __future__ import annotations
 
@@ -24,17 +30,16 @@ EVAL_FREQ = 25_000
 
 def validation_score(validator, model, algo: str, env_id: str, env_kwargs: dict, vecnormalize,
                      residual: str | None = None, residual_scale: float | None = None,
-                     frame_stack: int | None = None) -> float:
+                     frame_stack: int | None = None) -> tuple[float, list[dict]]:
     """The benchmark score of ``model`` (with its ``vecnormalize``, ``residual`` and
     ``frame_stack``; None: read from the model's training env) on the validation suite of
-    ``validator``."""
+    ``validator``, and its rows (per validation drop or event)."""
     from ..learning.policies import LearnedPolicy
     pol = LearnedPolicy("candidate", algo, env_id, env_kwargs, model, vecnormalize,
                         frame_stack=frame_stack)
     if residual is not None:
         pol.residual, pol.residual_scale = residual, residual_scale
-    score, _ = validator.score(pol.bound, env_kwargs)
-    return score
+    return validator.score(pol.bound, env_kwargs)
 
 
 class ValidationCallback(BaseCallback):
@@ -50,19 +55,22 @@ class ValidationCallback(BaseCallback):
     written into that evaluation's learning-curve entry; ``policy`` (``env_id``, ``algo``,
     ``env_kwargs``, ``residual``, ``residual_scale``, ``frame_stack``) says what the run trains,
     ``best`` is a continued run's best score so far and ``save(model, path)`` saves the best model
-    (default: :func:`agents.sb3_policy.export_self_contained`).
+    (default: :func:`agents.sb3_policy.export_self_contained`). ``events``: on the Recover task,
+    how many of the recover suite's validation events score a model (default
+    :data:`agents.benchmarking.recover.VALIDATION_EVENTS`; a ValueError on other tasks).
     """
 
     def __init__(self, eval_freq: int = EVAL_FREQ, save_path: str | None = None, verbose: int = 1,
                  *, evaluations=None, policy: dict | None = None, best: float = -np.inf,
-                 save=None):
+                 save=None, events: int | None = None):
         super().__init__(verbose)
         if int(eval_freq) != eval_freq or eval_freq < 1:
             raise ValueError(f"ValidationCallback: eval_freq = {eval_freq!r} must be an integer >= 1")
         self.eval_freq = int(eval_freq)
         self.save_path = None if save_path is None else Path(save_path)
         self.evaluations, self.policy, self.save = evaluations, policy, save
-        self.best = best
+        self.best, self.events = best, events
+        self.history: list[dict] = []
         self.last = 0
         self.seen = 0 if evaluations is None else len(evaluations.kpi_history)
         self.validator = None
@@ -76,9 +84,17 @@ class ValidationCallback(BaseCallback):
             spec = self.training_env.get_attr("spec", [0])[0]
             self.env_id, self.env_kwargs = spec.id, dict(spec.kwargs)
             self.algo = type(self.model).__name__.lower()
-        self.validator = validator_for(self.env_id, self.env_kwargs)
+        self.validator = validator_for(self.env_id, self.env_kwargs, self.events)
         if self.save_path is not None:
             self.save_path.mkdir(parents=True, exist_ok=True)
+            kept = self.save_path / "validation.json"
+            if self.model.num_timesteps > 0 and kept.is_file():     # a continued run's scores
+                import json
+                self.history = json.loads(kept.read_text()).get("history", [])
+
+    def _on_training_start(self) -> None:
+        if self.model.num_timesteps == 0:           # a fresh run: the initial policy is a candidate
+            self.validate()
 
     def _on_step(self) -> bool:
         if self.evaluations is not None:
@@ -104,9 +120,13 @@ class ValidationCallback(BaseCallback):
             from ..control.residual import residual_of
             residual, scale = residual_of(self.training_env)
             frame_stack = None
-        score = validation_score(self.validator, self.model, self.algo, self.env_id,
-                                 self.env_kwargs, vn, residual, scale, frame_stack)
+        score, rows = validation_score(self.validator, self.model, self.algo, self.env_id,
+                                       self.env_kwargs, vn, residual, scale, frame_stack)
         self.logger.record("eval/validation_score", score)
+        entry = {"timesteps": int(self.num_timesteps), "score": float(score)}
+        if rows and "recovered" in rows[0]:          # Recover events
+            entry.update(recovered=int(sum(r["recovered"] for r in rows)), events=len(rows))
+        self.history.append(entry)
         if self.verbose:
             print(f"validation score {score:.2f} at {self.num_timesteps} steps (best {max(score, self.best):.2f})")
         if score > self.best:
@@ -120,4 +140,8 @@ class ValidationCallback(BaseCallback):
                     export_self_contained(self.model, vn, path, env_id=self.env_id,
                                           env_kwargs=self.env_kwargs, residual=residual,
                                           residual_scale=scale)
+        if self.save_path is not None:
+            from ..benchmarking.score import write_json
+            write_json(self.save_path / "validation.json",
+                       {"env_id": self.env_id, "best": self.best, "history": self.history})
         return score

@@ -314,7 +314,10 @@ def test_validation_keeps_the_best_model_by_validation_score(tmp_path):
     base, _ = v.score(WhirlBrake, {"command": "continuous"})
     assert max(scores) == pytest.approx(base, abs=1.0)       # a 1 % residual barely moves it
     kept, _ = v.score(pol.bound, {"command": "continuous"})
-    assert kept == max(scores)                                # best/ is the best-scoring model
+    history = json.loads((res.out / "best" / "validation.json").read_text())["history"]
+    assert history[0]["timesteps"] == 0                      # the initial policy is a candidate
+    assert [h["score"] for h in history[1:]] == scores
+    assert kept == max(h["score"] for h in history)           # best/ is the best-scoring model
     with pytest.raises(ConfigError, match="residual_scale"):
         split({"residual_scale": 3.0})
 
