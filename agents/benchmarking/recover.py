@@ -91,16 +91,17 @@ def learned_kwargs(policy_kwargs: dict, suite_kwargs: dict) -> dict:
     return {**interface_kwargs(policy_kwargs), **suite_kwargs}
 
 
-def run_row(name: str, seeds, env_kwargs: dict, policy=None) -> tuple[list[dict], float]:
-    """A designed law's events in its seat, or with ``policy`` (a
-    :class:`~agents.learning.policies.LearnedPolicy`) that policy's, through its own interface
-    (:func:`learned_kwargs`) on the suite's ``env_kwargs``: (records, CPU seconds)."""
+def run_row(name: str, seeds, env_kwargs: dict, policy=None, law=None) -> tuple[list[dict], float]:
+    """A designed law's events in its seat (``law``: that controller class, else the baseline
+    called ``name``), or with ``policy`` (a :class:`~agents.learning.policies.LearnedPolicy`)
+    that policy's, through its own interface (:func:`learned_kwargs`) on the suite's
+    ``env_kwargs``: (records, CPU seconds)."""
     if policy is not None:
         if policy.env_id != ENV_ID:
             raise ValueError(f"--policy {name}: trained on {policy.env_id}, not {ENV_ID}")
         kw, make_actor = learned_kwargs(policy.env_kwargs, env_kwargs), policy.bound
     else:
-        cls = controller_class(name)
+        cls = law or controller_class(name)
         if cls is None:
             raise ValueError(f"{name!r} is not a designed law (a baseline controller name) "
                              f"nor a learned policy (a training run or model zip)")
