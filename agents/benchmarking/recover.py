@@ -162,6 +162,35 @@ def learned_rows(specs: list[str], names: list[str] | None = None) -> dict:
     return {p.name: p for p in learned}
 
 
+def seed_groups(rows: dict, learned: list[str]) -> dict:
+    """The learned rows named ``GROUP-sSEED`` (two seeds or more of a group) as seed groups:
+    each seed's recovered rate, their mean ± std (ddof 1) and mean − std, and the seed-mean's
+    per-event recovery against the reference and against the best designed row of ``rows``
+    (paired bootstrap over events). ``rows``: each row's event records, the same events."""
+    import re
+    groups: dict[str, list[str]] = {}
+    for name in learned:
+        m = re.fullmatch(r"(.+)-s(\d+)", name)
+        if m:
+            groups.setdefault(m.group(1), []).append(name)
+    designed = [n for n in rows if n not in learned]
+    recovered = {n: np.array([float(r["recovered"]) for r in rows[n]]) for n in rows}
+    best = max(designed, key=lambda n: recovered[n].mean())
+    out = {}
+    for group, names in groups.items():
+        if len(names) < 2:
+            continue
+        rates = np.array([recovered[n].mean() for n in names])
+        mean = np.mean([recovered[n] for n in names], axis=0)
+        out[group] = {"rows": names, "rates": rates.tolist(), "mean": float(rates.mean()),
+                      "std": float(rates.std(ddof=1)),
+                      "mean_minus_std": float(rates.mean() - rates.std(ddof=1)),
+                      "vs": {n: paired_bootstrap(mean, recovered[n],
+                                                 np.random.default_rng(BOOTSTRAP_SEED))
+                             for n in dict.fromkeys([REFERENCE, best])}}
+    return out
+
+
 def calm_levitation(suite, seeds) -> list[bool]:
     """Per event of ``seeds``: whether the reference (the built-in PID) holds the event's
     machine contact-free for the task's hold at the end of an episode *without* the event (its
@@ -211,6 +240,7 @@ def recover_benchmark(out, suite, quick: bool = False, policies: list[str] | Non
     report = add_calm({"env_id": ENV_ID, "suite": suite.name,
                        "seeds": [seeds.start, seeds.stop - 1], "env_kwargs": suite.env_kwargs,
                        "reference": REFERENCE, "board": board, "events": rows,
+                       "groups": seed_groups(rows, list(learned)),
                        "cpu_s_total": sum(cost.values())}, suite)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -242,4 +272,25 @@ def recover_markdown(report: dict) -> str:
             f"{r['peak_contact_force_N']['mean'] / 1e3:.2f} | "
             f"{df['delta'] / 1e3:+.2f} ± {df['se'] / 1e3:.2f} | "
             f"{r['whirl_revolutions']['mean']:.2f} | {r['friction_energy_J']['mean']:.2f} |")
+    if report.get("groups"):
+        lines += ["", groups_markdown(report["groups"])]
+    return "\n".join(lines)
+
+
+def groups_markdown(groups: dict) -> str:
+    """The seed groups' table (:func:`seed_groups`): recovered % per seed, mean ± std, mean −
+    std, and the seed-mean's difference against each compared row (points ± paired SE [95 %])."""
+    against = list(dict.fromkeys(n for g in groups.values() for n in g["vs"]))
+    lines = ["| learned group | seeds: recovered % | mean ± std | mean − std | "
+             + " | ".join(f"seed-mean Δ vs `{n}` ± SE [95 %]" for n in against) + " |",
+             "|---|---|---:|---:|" + "---:|" * len(against)]
+    for name, g in groups.items():
+        cells = []
+        for n in against:
+            d = g["vs"].get(n)
+            cells.append("—" if d is None else f"{100 * d['delta']:+.1f} ± {100 * d['se']:.1f} "
+                         f"[{100 * d['ci95'][0]:+.1f}, {100 * d['ci95'][1]:+.1f}]")
+        lines.append(f"| `{name}` | {', '.join(f'{100 * r:.1f}' for r in g['rates'])} | "
+                     f"{100 * g['mean']:.1f} ± {100 * g['std']:.1f} | {100 * g['mean_minus_std']:.1f} | "
+                     + " | ".join(cells) + " |")
     return "\n".join(lines)
