@@ -141,11 +141,28 @@ class RecoverValidator:
                              f"[1, {min(n, 100)}] (the {suite.name} suite's validation events)")
         self.suite, self.seeds = suite, suite.validation_seeds()[:int(events)]
 
+    @property
+    def episodes(self) -> int:
+        """Validation episodes per score."""
+        return len(self.seeds)
+
     def score(self, make_actor, env_kwargs: dict) -> tuple[float, list[dict]]:
         eps = run_episodes(ENV_ID, make_actor, self.seeds,
                            learned_kwargs(env_kwargs, self.suite.env_kwargs))
         records = [event_record(e) for e in eps]
         return selection_score(records), records
+
+
+def tuned_law(suite, name: str):
+    """Designed row ``name`` as it runs on ``suite``: the law with the constants tuned on the
+    suite's validation events (``rotordrop research tune-designed --suite SUITE``,
+    :func:`agents.benchmarking.tuned.tuned_gains`) where a record has them, else None (the
+    law's own constants)."""
+    from ..control.controllers import with_constants
+    from .tuned import tuned_gains
+    cls = controller_class(name)
+    gains = tuned_gains(suite, name, ENV_ID) if cls is not None else None
+    return with_constants(cls, gains) if gains else None
 
 
 def learned_rows(specs: list[str], names: list[str] | None = None) -> dict:
@@ -213,7 +230,8 @@ def recover_benchmark(out, suite, quick: bool = False, policies: list[str] | Non
                       **_ignored) -> dict:
     """``rotordrop benchmark --suite recover | recover-robust``: every designed law (or
     ``policies``: designed law names and learned policies, :func:`learned_rows`, named by
-    ``names``) in its seat on the suite's test events (``validation``: its validation events),
+    ``names``) in its seat, with its constants tuned on the suite's validation events where
+    they were (:func:`tuned_law`), on the suite's test events (``validation``: its validation events),
     the report written to ``out/benchmark.json`` and ``out/leaderboard.md``."""
     from pathlib import Path
     n = suite.quick_size if quick else suite.size
@@ -223,9 +241,10 @@ def recover_benchmark(out, suite, quick: bool = False, policies: list[str] | Non
     learned = learned_rows(list(policies or []), names)
     rows_asked = [p for p in policies or DESIGNED if controller_class(p) is not None]
     names = list(dict.fromkeys([REFERENCE, *rows_asked, *learned]))
-    rows, cost = {}, {}
+    rows, cost, laws = {}, {}, {n: tuned_law(suite, n) for n in names if n not in learned}
     for name in names:
-        rows[name], cost[name] = run_row(name, seeds, suite.env_kwargs, learned.get(name))
+        rows[name], cost[name] = run_row(name, seeds, suite.env_kwargs, learned.get(name),
+                                         laws.get(name))
         if progress:
             print(f"{name}: {sum(r['recovered'] for r in rows[name])}/{len(seeds)} recovered "
                   f"({cost[name]:.1f} CPU s)", flush=True)
@@ -234,7 +253,9 @@ def recover_benchmark(out, suite, quick: bool = False, policies: list[str] | Non
         s = row_summary(rows[name], rows[REFERENCE])
         seat = (seat_for_kwargs(learned[name].env_kwargs) if name in learned
                 else seat_of(controller_class(name)))
+        law = laws.get(name)
         board.append({"controller": name, "seat": seat.name, "learned": name in learned,
+                      "tuned_constants": None if law is None else law.GAINS,
                       "cpu_s": cost[name], **s})
     board.sort(key=lambda r: (-r["recovered"]["value"], r["peak_contact_force_N"]["mean"]))
     report = add_calm({"env_id": ENV_ID, "suite": suite.name,

@@ -538,6 +538,14 @@ def law_constants(law, gains: dict) -> dict:
     return {**law.GAINS, **gains}
 
 
+def with_constants(law: type, constants: dict, name: str | None = None) -> type:
+    """``law`` as a controller class whose class constants ``GAINS`` are updated by
+    ``constants`` (checked: :func:`law_constants`), named ``name`` (default the law's): a
+    designed law with tuned or searched constants, run wherever a controller class runs."""
+    gains = law_constants(law, constants) if constants else dict(getattr(law, "GAINS", {}))
+    return type(law.__name__, (law,), {"GAINS": gains, "name": name or law.name})
+
+
 #: the tasks the recovery laws are designed for (their contact watch assumes the AMBs on)
 RECOVERY_TASKS = ("RotorDrop-Recover-v1",)
 #: the synchronous laws' watch and search constants (revolutions, fractions of the clearance).

@@ -49,7 +49,9 @@ def register(subparsers) -> None:
                                              "validation drops, in its seat, and store the "
                                              "constants with what they were tuned under")
     q.add_argument("--suite", default="robust", help="the suite whose validation drops tune "
-                                                     "(default robust)")
+                                                     "(default robust; recover or "
+                                                     "recover-robust: the recovery laws on its "
+                                                     "validation events)")
     q.add_argument("--law", action="append", default=None,
                    help=f"a designed law to tune (repeatable; default all: {', '.join(DESIGNED)})")
     q.add_argument("--episodes", type=at_least(LEARNED_SELECTION_EPISODES),

@@ -49,7 +49,8 @@ from ..benchmarking.recover import (ENV_ID, REFERENCE, TIE_FORCE_N, calm_levitat
                                     paired_bootstrap, rate, run_row)
 from ..benchmarking.score import BOOTSTRAP_SEED, write_json
 from ..control.controllers import (SEARCH, InnerLoop, PidRelevitate, SyncCurrentSearch,
-                                   SyncMotionCompensation, SyncPhaseSearch, supervisor_action)
+                                   SyncMotionCompensation, SyncPhaseSearch, supervisor_action,
+                                   with_constants)
 from ..control.seats import seat_of
 
 SEAT_NAMES = ("supervisor", "controller")
@@ -97,8 +98,7 @@ class Plan:
 
     def controller(self) -> type:
         """The law as a controller class whose class constants are this plan's."""
-        gains = {**getattr(self.law, "GAINS", {}), **self.constants}
-        return type(self.law.__name__, (self.law,), {"GAINS": gains, "name": self.name})
+        return with_constants(self.law, self.constants, self.name)
 
 
 def _f(v: float) -> str:
