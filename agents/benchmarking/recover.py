@@ -315,3 +315,19 @@ def groups_markdown(groups: dict) -> str:
                      f"{100 * g['mean']:.1f} ± {100 * g['std']:.1f} | {100 * g['mean_minus_std']:.1f} | "
                      + " | ".join(cells) + " |")
     return "\n".join(lines)
+
+
+def main(argv=None) -> int:
+    """``python -m agents.benchmarking.recover BENCHMARK.json``: print a recovery report's
+    leaderboard (and its seed groups' table)."""
+    import argparse
+    import json
+    from pathlib import Path
+    ap = argparse.ArgumentParser(description="print the tables of a recovery benchmark report")
+    ap.add_argument("report", help="a rotordrop benchmark --suite recover benchmark.json")
+    print(recover_markdown(json.loads(Path(ap.parse_args(argv).report).read_text())))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -145,3 +145,52 @@ class ValidationCallback(BaseCallback):
             write_json(self.save_path / "validation.json",
                        {"env_id": self.env_id, "best": self.best, "history": self.history})
         return score
+
+
+def selection_rows(runs) -> list[dict]:
+    """Per training run directory of ``runs`` (``rotordrop train --out``, with ``validation:
+    true``): its steps, wall time, whether the time limit stopped it, and from
+    ``best/validation.json`` the initial, kept (best) and final validation scores, the step of the
+    kept one and, on the Recover task, the events each recovered."""
+    import json
+    out = []
+    for run in map(Path, runs):
+        rec = json.loads((run / "training.json").read_text())
+        hist = json.loads((run / "best" / "validation.json").read_text())["history"]
+        best = max(hist, key=lambda h: h["score"])      # the first of equals: the one kept
+        row = {"run": run.name, "steps": rec["timesteps"], "wall_s": round(rec["wall_time_s"], 1),
+               "stopped_by_time_limit": bool(rec.get("stopped_by_time_limit")),
+               "checks": len(hist), "kept_step": best["timesteps"]}
+        for key, h in (("initial", hist[0]), ("kept", best), ("final", hist[-1])):
+            row[f"{key}_score"] = round(h["score"], 2)
+            if "recovered" in h:
+                row[f"{key}_recovered"] = f"{h['recovered']}/{h['events']}"
+        out.append(row)
+    return out
+
+
+def main(argv=None) -> int:
+    """``python -m agents.training.validation RUN... [--csv FILE]``: the model selection of
+    each run (:func:`selection_rows`) as a markdown table (and a CSV)."""
+    import argparse
+    import csv
+    ap = argparse.ArgumentParser(description="what model selection kept in each training run")
+    ap.add_argument("runs", nargs="+", help="rotordrop train output directories")
+    ap.add_argument("--csv", default=None, help="also write the rows to this CSV file")
+    a = ap.parse_args(argv)
+    rows = selection_rows(a.runs)
+    keys = list(dict.fromkeys(k for r in rows for k in r))
+    print("| " + " | ".join(k.replace("_", " ") for k in keys) + " |")
+    print("|---|" + "---:|" * (len(keys) - 1))
+    for r in rows:
+        print("| " + " | ".join(str(r.get(k, "—")) for k in keys) + " |")
+    if a.csv:
+        with open(a.csv, "w", newline="") as fh:
+            w = csv.DictWriter(fh, keys)
+            w.writeheader()
+            w.writerows(rows)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

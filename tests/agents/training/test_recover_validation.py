@@ -92,3 +92,7 @@ def test_a_recover_run_keeps_its_best_model_from_step_zero_on_recover_events(tmp
     assert pid[0]["peak_contact_force_N"] > 0                     # the events make contact
     assert first["score"] == pytest.approx(selection_score(pid))
     assert first["recovered"] == sum(r["recovered"] for r in pid)
+    from agents.training.validation import selection_rows
+    row, = selection_rows([res.out])
+    assert row["initial_recovered"] == f"{first['recovered']}/2" and row["checks"] == len(kept["history"])
+    assert row["kept_score"] == pytest.approx(kept["best"], abs=0.01) and row["steps"] == res.timesteps
