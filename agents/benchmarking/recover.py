@@ -317,16 +317,23 @@ def groups_markdown(groups: dict) -> str:
     return "\n".join(lines)
 
 
-def main(argv=None) -> int:
-    """``python -m agents.benchmarking.recover BENCHMARK.json``: print a recovery report's
-    leaderboard (and its seed groups' table)."""
+
+def print_table(render, argv, what: str) -> int:
+    """Print ``render(report)`` of the JSON report named on the command line ``argv``
+    (``what`` it is, for the help)."""
     import argparse
     import json
     from pathlib import Path
-    ap = argparse.ArgumentParser(description="print the tables of a recovery benchmark report")
-    ap.add_argument("report", help="a rotordrop benchmark --suite recover benchmark.json")
-    print(recover_markdown(json.loads(Path(ap.parse_args(argv).report).read_text())))
+    ap = argparse.ArgumentParser(description=f"print the tables of {what}")
+    ap.add_argument("report", help=what)
+    print(render(json.loads(Path(ap.parse_args(argv).report).read_text())))
     return 0
+
+
+def main(argv=None) -> int:
+    """``python -m agents.benchmarking.recover BENCHMARK.json``: print a recovery report's
+    leaderboard (and its seed groups' table)."""
+    return print_table(recover_markdown, argv, "a recovery benchmark report (benchmark.json)")
 
 
 if __name__ == "__main__":

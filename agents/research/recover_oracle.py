@@ -304,14 +304,11 @@ def run(a) -> None:
     recover_oracle(a.out, a.suite, a.events, a.seat or ("supervisor",), not a.quiet)
 
 
+
 def main(argv=None) -> int:
     """``python -m agents.research.recover_oracle ORACLE.json``: print the report's table."""
-    import argparse
-    import json
-    ap = argparse.ArgumentParser(description="print the table of a recover-oracle report")
-    ap.add_argument("report", help="an oracle_recover.json")
-    print(table(json.loads(Path(ap.parse_args(argv).report).read_text())))
-    return 0
+    from ..benchmarking.recover import print_table
+    return print_table(table, argv, "a recover-oracle report (oracle_recover.json)")
 
 
 if __name__ == "__main__":
