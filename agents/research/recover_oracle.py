@@ -15,8 +15,9 @@ seat (each plan a designed law with stated constants, :class:`Plan`):
   at three gains x three leads; a PID gain command held from the detection
   (:class:`GainOnContact`); the search and the motion compensation with an eager watch;
 * controller seat (raw currents, 0.2 ms step): ``pid-relevitate``; ``sync-current-search`` at
-  three amplitudes; a synchronous current of one fixed phase at two amplitudes held from the
-  detection.
+  three amplitudes; a synchronous current of one fixed phase (eight phases x two amplitudes)
+  held from the detection; a release and re-levitation from the detection (the currents off
+  for 5, 20 or 50 ms, then ``pid-relevitate``'s ramped lift: :class:`ReleaseOnContact`).
 
 It is a search, not a bound: another law, a time-varying plan or a finer grid may recover
 more. The report gives the recovered fraction of the per-event best (per seat and over both),
@@ -48,7 +49,7 @@ from ..benchmarking.headroom import best_rows
 from ..benchmarking.recover import (ENV_ID, REFERENCE, TIE_FORCE_N, calm_levitation,
                                     paired_bootstrap, rate, run_row)
 from ..benchmarking.score import BOOTSTRAP_SEED, write_json
-from ..control.controllers import (SEARCH, InnerLoop, PidRelevitate, SyncCurrentSearch,
+from ..control.controllers import (SEARCH, InnerLoop, PidRelevitate, Searching, SyncCurrentSearch,
                                    SyncMotionCompensation, SyncPhaseSearch, supervisor_action,
                                    with_constants)
 from ..control.seats import seat_of
@@ -80,6 +81,40 @@ class GainOnContact(SyncPhaseSearch):
         out = super().commands(obs)
         active = self.search.active
         out["gain"] = np.where(active, self.g["scale"], out["gain"])
+        return out
+
+
+class ReleaseOnContact(Searching, PidRelevitate):
+    """A plan of the pool (controller seat): on persistent contact (the synchronous laws'
+    watch) the AMB currents are set to zero for ``off`` seconds (the rotor leaves the
+    contact-stiffened synchronous state and settles on its retainer bearing), then
+    ``pid-relevitate``'s own PID lifts it again from where it lies, on its ramp; the watch
+    restarts once the orbit has stayed free for ``release`` revolutions."""
+
+    name = "release-on-contact"
+    GAINS = dict(SEARCH, off=0.02, phases=(180.0,))
+
+    def __init__(self, plant, **gains):
+        super().__init__(plant)
+        self.start_search(plant, gains)
+        self.released = np.zeros(0)
+
+    def reset(self, n, which=None):
+        super().reset(n, which)
+        if which is None or len(self.released) != n:
+            self.released = np.full(n, np.nan)
+        else:
+            self.released[which] = np.nan
+
+    def commands(self, obs):
+        out = super().commands(obs)
+        active, _ = self.search.step(obs, self.t)
+        self.released[~active] = np.nan
+        start = active & np.isnan(self.released)
+        self.released[start] = self.t[start]
+        off = active & (self.t - self.released < self.g["off"])
+        self.on_t[off] = np.nan                 # the PID restarts, ramped, once the time is over
+        out["currents"] = np.where(off[:, None], 0.0, out["currents"])
         return out
 
 
@@ -138,6 +173,8 @@ def plan_pool(seats=SEAT_NAMES) -> list[Plan]:
         pool += [Plan(f"held current phase {_f(p)} A{_f(a)}", "current of a fixed phase from "
                       "detection", SyncCurrentSearch, {"amplitude": a, "phases": (p,)})
                  for p in PHASES for a in (0.6, 1.0)]
+        pool += [Plan(f"release {_f(1e3 * t)} ms", "release and re-levitation from detection",
+                      ReleaseOnContact, {"off": t}) for t in (0.005, 0.02, 0.05)]
     return pool
 
 

@@ -29,12 +29,13 @@ def test_the_pool_starts_with_the_pid_and_runs_each_plan_in_its_seat():
             ro.plan_pool(seats)
 
 
-def test_gain_on_contact_commands_its_gain_only_while_the_watch_holds_contact():
-    plant = plant_of(ENV_ID, command="supervisor", episode_time=0.3)
-    law = ro.Plan("g", "f", ro.GainOnContact, {"scale": -0.5}).controller()(plant)
-    gain = plant.action_names.index("gain")
+def _driver(law, plant):
+    """drive(r, seconds): step ``law`` on an orbit held at r x clearance on both planes at
+    10 000 rpm (continuing its episode); its last action."""
     obs = np.zeros((1, len(plant.obs_names)))
     obs[:, plant.index("rotor_speed")] = 10000 * np.pi / 30
+    if "amb_power" in plant.obs_names:
+        obs[:, plant.index("amb_power")] = 1.0
 
     def drive(r, seconds):
         for k in (1, 2):
@@ -43,6 +44,14 @@ def test_gain_on_contact_commands_its_gain_only_while_the_watch_holds_contact():
             obs[:, plant.index("time")] = law.t[0] if law.n else 0.0
             a, _ = law.predict(obs / plant.obs_scale, episode_start=np.array([law.n == 0]))
         return a[0]
+    return drive
+
+
+def test_gain_on_contact_commands_its_gain_only_while_the_watch_holds_contact():
+    plant = plant_of(ENV_ID, command="supervisor", episode_time=0.3)
+    law = ro.Plan("g", "f", ro.GainOnContact, {"scale": -0.5}).controller()(plant)
+    gain = plant.action_names.index("gain")
+    drive = _driver(law, plant)
     assert drive(0.3, 0.02)[gain] == 0.0                          # free: the PID's own gains
     assert drive(0.95, 0.08)[gain] == pytest.approx(-0.5)         # persistent contact: held
     np.testing.assert_allclose(drive(0.95, 0.01)[-4:], 0.0)       # amplitude 0: no offset
@@ -89,3 +98,20 @@ def test_a_tiny_oracle_run_writes_its_report(tmp_path, monkeypatch):
         ro.recover_oracle(tmp_path / "x", events=0, progress=False)
     with pytest.raises(ValueError, match="--suite"):
         ro.recover_oracle(tmp_path / "x", suite="robust", progress=False)
+
+
+def test_release_on_contact_switches_the_currents_off_then_lifts_again():
+    plant = plant_of(ENV_ID, command="continuous", control_dt=2e-4, episode_time=0.3)
+    plan = ro.Plan("r", "f", ro.ReleaseOnContact, {"off": 0.01})
+    assert plan.seat == "controller"
+    law = plan.controller()(plant)
+    drive = _driver(law, plant)
+    assert np.abs(drive(0.3, 0.01)).max() > 0                     # free: the own PID acts
+    rev = 60.0 / 10000
+    t_detect = -law.g["revolutions"] * np.log(1.0 - law.g["fraction"]) * rev
+    drive(0.95, t_detect + 2e-3)                                  # persistent contact: released
+    np.testing.assert_array_equal(drive(0.95, 4e-3), 0.0)
+    t_off = law.t[0]
+    after = drive(0.95, 0.01)                                     # off time over: lifting again
+    assert np.abs(after).max() > 0
+    assert t_off < law.on_t[0] < law.t[0]                         # its PID restarted, ramped
