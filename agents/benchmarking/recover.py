@@ -129,7 +129,7 @@ def selection_score(records: list[dict]) -> float:
 
 class RecoverValidator:
     """Model selection on the Recover task (the training validation callback,
-    :func:`agents.benchmarking.robust.validator_for`): a model's :func:`selection_score` on the
+    :func:`agents.training.validation.validator_for`): a model's :func:`selection_score` on the
     first ``events`` validation events of ``suite`` (its seeds apart from the test events),
     the model run through its own interface on the suite's env kwargs (:func:`learned_kwargs`),
     as the benchmark will run it. ``score`` returns (score, event records)."""

@@ -106,21 +106,9 @@ def distribution(suite, n: int) -> dict:
                 sensor_sample_rate_hz=SENSOR_SAMPLE_RATE, power_grid_s=suite.power_grid, scenario_seeds=[suite.seed, suite.seed + n - 1])
 
 
-def validator_for(env_id: str, env_kwargs: dict | None = None, events: int | None = None):
+def validator_for(env_id: str, env_kwargs: dict | None = None) -> Validator:
     """The validation suite of a training run: the robust one when its environments have
-    sensor noise or observation latency, else the nominal one. On the Recover task the recover
-    suites' validation events (:class:`agents.benchmarking.recover.RecoverValidator`, the
-    first ``events`` of them, default its ``VALIDATION_EVENTS``; ``recover-robust``'s for
-    imperfect sensing); ``events`` is a ValueError on another task."""
-    from . import recover
-    if env_id == recover.ENV_ID:
-        from .suites import SUITES
-        suite = SUITES.get("recover-robust" if is_robust(env_kwargs or {}) else "recover")
-        return recover.RecoverValidator(suite, recover.VALIDATION_EVENTS if events is None
-                                        else events)
-    if events is not None:
-        raise ValueError(f"validation_events = {events!r}: only {recover.ENV_ID} validates on "
-                         f"events; {env_id} validates on its validation drops (remove it)")
+    sensor noise or observation latency, else the nominal one."""
     if is_robust(env_kwargs or {}):
         return robust_validator(env_id)
     return Validator(env_id)

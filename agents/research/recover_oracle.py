@@ -327,9 +327,10 @@ def plot(record: dict, path: Path) -> Path:
     ax.invert_yaxis()
     ax.set_xlabel("events recovered [%] (Wilson 95 % interval)")
     s = record["settings"]
-    ax.set_title(f"Recover: plans that know the event ({s['suite']} test events "
+    ax.set_title(f"Recover: plans that know the event\n({s['suite']} test events "
                  f"{s['seeds'][0]}-{s['seeds'][1]}; a search, not a bound)", fontsize=10)
-    ax.legend(fontsize=8, loc="lower right")
+    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.4, -0.06 - 1.0 / len(rows)),
+              ncol=len(groups))
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)

@@ -28,6 +28,27 @@ from stable_baselines3.common.callbacks import BaseCallback
 EVAL_FREQ = 25_000
 
 
+def validator_for(env_id: str, env_kwargs: dict | None = None, events: int | None = None):
+    """The validation set of a training run on ``env_id`` with ``env_kwargs``: on the Recover
+    task the recover suite's validation events (:class:`agents.benchmarking.recover.RecoverValidator`,
+    the first ``events`` of them, default ``VALIDATION_EVENTS``; ``recover-robust``'s when the
+    run senses with noise or delay), else the drop validation suite
+    (:func:`agents.benchmarking.robust.validator_for`); ``events`` on another task is a
+    ValueError."""
+    from ..benchmarking import recover
+    from ..benchmarking.robust import is_robust
+    from ..benchmarking.robust import validator_for as drop_validator
+    if env_id == recover.ENV_ID:
+        from ..benchmarking.suites import SUITES
+        suite = SUITES.get("recover-robust" if is_robust(env_kwargs or {}) else "recover")
+        return recover.RecoverValidator(suite, recover.VALIDATION_EVENTS if events is None
+                                        else events)
+    if events is not None:
+        raise ValueError(f"validation_events = {events!r}: only {recover.ENV_ID} validates on "
+                         f"events; {env_id} validates on its validation drops (remove it)")
+    return drop_validator(env_id, env_kwargs)
+
+
 def validation_score(validator, model, algo: str, env_id: str, env_kwargs: dict, vecnormalize,
                      residual: str | None = None, residual_scale: float | None = None,
                      frame_stack: int | None = None) -> tuple[float, list[dict]]:
@@ -76,7 +97,6 @@ class ValidationCallback(BaseCallback):
         self.validator = None
 
     def _init_callback(self) -> None:
-        from ..benchmarking.robust import validator_for
         if self.policy is not None:
             self.env_id, self.env_kwargs = self.policy["env_id"], dict(self.policy["env_kwargs"])
             self.algo = self.policy["algo"]
@@ -169,15 +189,43 @@ def selection_rows(runs) -> list[dict]:
     return out
 
 
+def plot_selection(runs, path) -> Path:
+    """Each run's validation scores against its environment steps (``best/validation.json``),
+    the kept model marked: a PNG at ``path``."""
+    import json
+
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(8, 4))
+    for run in map(Path, runs):
+        hist = json.loads((run / "best" / "validation.json").read_text())["history"]
+        best = max(hist, key=lambda h: h["score"])
+        line, = ax.plot([h["timesteps"] for h in hist], [h["score"] for h in hist], "o-", ms=3,
+                        label=run.name)
+        ax.plot([best["timesteps"]], [best["score"]], "*", ms=12, color=line.get_color())
+    ax.set_xlabel("environment steps")
+    ax.set_ylabel("validation score (kept: star)")
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return Path(path)
+
+
 def main(argv=None) -> int:
-    """``python -m agents.training.validation RUN... [--csv FILE]``: the model selection of
-    each run (:func:`selection_rows`) as a markdown table (and a CSV)."""
+    """``python -m agents.training.validation RUN... [--csv FILE] [--png FILE]``: the model
+    selection of each run (:func:`selection_rows`) as a markdown table (and a CSV; the scores
+    against the steps as a PNG, :func:`plot_selection`)."""
     import argparse
     import csv
     ap = argparse.ArgumentParser(description="what model selection kept in each training run")
     ap.add_argument("runs", nargs="+", help="rotordrop train output directories")
     ap.add_argument("--csv", default=None, help="also write the rows to this CSV file")
+    ap.add_argument("--png", default=None, help="also plot the validation scores to this PNG")
     a = ap.parse_args(argv)
+    if a.png:
+        plot_selection(a.runs, a.png)
     rows = selection_rows(a.runs)
     keys = list(dict.fromkeys(k for r in rows for k in r))
     print("| " + " | ".join(k.replace("_", " ") for k in keys) + " |")

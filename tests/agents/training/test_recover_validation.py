@@ -7,7 +7,7 @@ import pytest
 
 from agents.benchmarking.recover import (ENV_ID, RecoverValidator, event_record, learned_kwargs,
                                          selection_score)
-from agents.benchmarking.robust import validator_for
+from agents.training.validation import validator_for
 from agents.benchmarking.suites import SUITES
 from agents.learning.hyperparams import ConfigError, split
 
@@ -96,3 +96,5 @@ def test_a_recover_run_keeps_its_best_model_from_step_zero_on_recover_events(tmp
     row, = selection_rows([res.out])
     assert row["initial_recovered"] == f"{first['recovered']}/2" and row["checks"] == len(kept["history"])
     assert row["kept_score"] == pytest.approx(kept["best"], abs=0.01) and row["steps"] == res.timesteps
+    from agents.training.validation import plot_selection
+    assert plot_selection([res.out], tmp_path / "sel.png").stat().st_size > 0
