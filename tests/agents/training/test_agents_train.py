@@ -62,7 +62,10 @@ def test_every_experiment_delta_passes_the_checks_rotordrop_train_makes(cfg):
     data = read_yaml(cfg)
     assert "base" in data and len(data) <= 13, "a delta names its base and only what differs"
     algo = cfg.stem.split("-")[0]
-    named = str(data["base"]).rpartition(":")[2]       # a base entry named after its env id
+    named, base = "", cfg
+    while base.is_file() and not named.startswith("RotorDrop-"):    # a delta of a delta: its base's
+        ref = str(read_yaml(base).get("base", ""))
+        named, base = ref.rpartition(":")[2], base.parent / ref   # a base entry named after its env id
     env_id = (named if named.startswith("RotorDrop-") else
               "RotorDrop-Relevitate-v1" if "currents" in cfg.stem else "RotorDrop-Full-v1")
     _check(algo, env_id, cfg)
