@@ -44,3 +44,19 @@ def run_env_checkers(make_env) -> None:
         warnings.simplefilter("ignore")
         gym_check_env(make_env())
         sb3_check_env(make_env())
+
+
+def check_tuned_records(suite, validation_seeds: list[int]) -> dict:
+    """Every designed law tuned on ``suite`` (agents/benchmarking/tuned): tuned under the
+    current environment and sensing, on ``validation_seeds`` (first, last), with at least a
+    learned configuration's selection budget, never worse than its start. Returns the records."""
+    from agents.benchmarking.tune_designed import laws_for, load_records, stale
+    records = load_records(suite)
+    assert set(records) <= set(laws_for(suite))
+    for name, rec in records.items():
+        assert stale(suite, name) == [], (name, stale(suite, name))
+        b = rec["budget"]
+        assert b["validation_episodes"] >= b["learned_selection_episodes"]
+        assert b["validation_seeds"] == validation_seeds
+        assert rec["validation_score"] >= rec["start_validation_score"] - 1e-9
+    return records

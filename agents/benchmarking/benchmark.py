@@ -491,6 +491,11 @@ class Validator:
         self.passive = suite_rows(Entry("passive", self.task, Passive, {}), self.scenarios,
                                   self.phases)
 
+    @property
+    def episodes(self) -> int:
+        """Validation episodes per score."""
+        return len(self.scenarios) * len(self.phases)
+
     def score(self, make_actor, env_kwargs: dict) -> tuple[float, list[dict]]:
         rows = suite_rows(Entry("candidate", self.task, make_actor, env_kwargs, strict=False),
                           self.scenarios, self.phases)

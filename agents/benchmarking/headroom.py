@@ -66,6 +66,12 @@ def drop_table(report: dict, task: str) -> tuple[list[str], dict, dict, np.ndarr
     return names, terms, p_cost, floor
 
 
+def best_rows(cost: np.ndarray) -> np.ndarray:
+    """Per drop (column of ``cost``, rows x drops), the index of the row with the lowest cost
+    (the first of equals): the "per-drop best row" of a pool."""
+    return np.argmin(np.asarray(cost), axis=0)
+
+
 def headroom(report: dict, task: str = "full", reference: str | None = None) -> dict:
     """The per-term points of the rows and the estimates of the module docstring."""
     names, terms, p_cost, floor = drop_table(report, task)
@@ -83,7 +89,7 @@ def headroom(report: dict, task: str = "full", reference: str | None = None) -> 
     for label, pool in (("per-drop best designed row", designed),
                         ("per-drop best row", names)):
         idx = [names.index(n) for n in pool]
-        best = np.argmin(cost[idx], axis=0)
+        best = best_rows(cost[idx])
         envelope[label] = stack[idx][best, :, np.arange(cost.shape[1])].T   # (terms, drops)
     termwise = stack.min(axis=0)
     t_r = TERMS.index("relevitation_time")

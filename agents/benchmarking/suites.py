@@ -159,6 +159,14 @@ class RecoverSuite(Suite):
     def validation(self) -> list:
         return list(self.validation_seeds())
 
+    def validator(self, env_id: str):
+        """All its validation events (:class:`agents.benchmarking.recover.RecoverValidator`)."""
+        from .recover import ENV_ID, RecoverValidator
+        if env_id != ENV_ID:
+            raise ValueError(f"the {self.name} suite's validation events are for {ENV_ID}, "
+                             f"not {env_id}")
+        return RecoverValidator(self, self.validation_size)
+
     def run(self, out, **options) -> dict:
         from .recover import recover_benchmark
         return recover_benchmark(out, suite=self, **options)
@@ -223,10 +231,12 @@ def _registry() -> SuiteRegistry:
         RecoverSuite("recover", "events of the Recover task on a machine with persistent "
                                 "contact (agents.benchmarking.recover)", seed=60_000, size=200,
                      quick_size=40, validation_seed=61_000, validation_size=60,
+                     purposes=("benchmark", "tune"),
                      env_id="RotorDrop-Recover-v1", env_kwargs=RECOVER_NOMINAL),
         RecoverSuite("recover-robust", "events of the Recover task on machines drawn around it, "
                                        "with sensor noise and delay",
                      seed=62_000, size=200, quick_size=40, validation_seed=63_000,
+                     purposes=("benchmark", "tune"),
                      validation_size=60, env_id="RotorDrop-Recover-v1", env_kwargs=RECOVER_ROBUST),
     ])
 

@@ -1,7 +1,9 @@
 """Designed rows tuned like learned ones: ``rotordrop research tune-designed --suite robust``.
 
 Every designed law with constants (:data:`DESIGNED`) is tuned on the suite's **validation**
-drops only (:meth:`agents.benchmarking.suites.Suite.validator`), in its seat
+drops only (:meth:`agents.benchmarking.suites.Suite.validator`; on a recover suite the
+recovery laws on its validation events, scored by the recovered percentage, ties broken by the
+mean peak contact force: :class:`agents.benchmarking.recover.RecoverValidator`), in its seat
 (:mod:`agents.control.seats`), under the current environment and sensing, by a cross-entropy
 search (:mod:`agents.benchmarking.search`) that maximises the validation score. The budget is
 stated in validation episodes and is at least what one learned configuration spends on its
@@ -37,18 +39,35 @@ LEARNED_SELECTION_EPISODES = (1_000_000 // 10_000) * 20
 @dataclass(frozen=True)
 class Designed:
     """A designed law with constants to tune: its baseline name, the constants' ranges (the
-    search box) and the search's population per generation."""
+    search box), the search's population per generation and whether it is a recovery law
+    (tuned on a recover suite's validation events, the others on a drop suite's drops)."""
     name: str
     ranges: dict[str, tuple[float, float]]
     population: int
+    recover: bool = False
 
 
+#: the synchronous recovery laws' watch and search constants (revolutions, fractions of the
+#: clearance): the box around agents.control.controllers.SEARCH
+WATCH_RANGES = {"r_contact": (0.5, 0.95), "revolutions": (2.0, 16.0), "fraction": (0.1, 0.9),
+                "release": (2.0, 12.0)}
 #: the designed laws with constants, in the order they are tuned
 DESIGNED: dict[str, Designed] = {d.name: d for d in (
     Designed("inner-loop-lift", {"gain": (0.0, 1.0), "offset_r": (-1.0, 0.0)}, 12),
     Designed("whirl-brake", {"kp": (0.0, 30.0), "kd": (0.0, 5.0), "kc": (-3.0, 3.0),
                              "kt": (-0.5, 0.5), "kr": (-1.0, 1.0), "ff": (0.0, 2.0)}, 20),
+    Designed("sync-phase-search", {"amplitude": (0.05, 1.0), "dwell": (1.0, 10.0),
+                                   **WATCH_RANGES}, 8, recover=True),
+    Designed("sync-motion-comp", {"gain": (0.0, 1.0), "lead": (-1.0, 1.0), **WATCH_RANGES}, 8,
+             recover=True),
 )}
+
+
+def laws_for(suite) -> list[str]:
+    """The designed laws tuned on ``suite``: the recovery laws on a recover suite, the others
+    on a drop suite."""
+    from .suites import RecoverSuite
+    return [n for n, d in DESIGNED.items() if d.recover == isinstance(suite, RecoverSuite)]
 
 
 #: recorded for the reader, not compared: a release that changes neither the plant nor the
@@ -72,13 +91,17 @@ def sensing_fingerprint(suite, cls, env_id: str, duration: float = 0.01) -> str:
     from ..control.controllers import controller_env_kwargs
     from ..control.plant import make_env
     from .benchmark import Entry, episode_kwargs, task_of
-    sc = suite.validation()[0]
-    entry = Entry(cls.name, task_of(env_id), None, controller_env_kwargs(cls, env_id))
-    kw = episode_kwargs(entry, sc, 0.0)
+    from .suites import RecoverSuite
+    if isinstance(suite, RecoverSuite):         # its first validation event
+        kw, seed = {**suite.env_kwargs, **controller_env_kwargs(cls, env_id)}, suite.validation_seed
+    else:
+        sc = suite.validation()[0]
+        entry = Entry(cls.name, task_of(env_id), None, controller_env_kwargs(cls, env_id))
+        kw, seed = episode_kwargs(entry, sc, 0.0), sc.seed
     env = make_env(env_id, **kw)
     steps = int(round(duration / kw.get("control_dt", 1e-3)))
     try:
-        obs, _ = env.reset(seed=sc.seed)
+        obs, _ = env.reset(seed=seed)
         rows = [obs]
         zero = np.zeros(env.action_space.shape, dtype=env.action_space.dtype) \
             if env.action_space.shape else 0
@@ -97,7 +120,8 @@ def environment_record(suite, cls, env_id: str) -> dict:
     from ..control.seats import seat_of
     return dict(env_id=env_id, package_version=package_version(), seat=seat_of(cls).name,
                 env_kwargs=controller_env_kwargs(cls, env_id),
-                sensing=suite.describe(suite, suite.size) if suite.describe else None,
+                sensing=(suite.describe(suite, suite.size) if getattr(suite, "describe", None)
+                         else getattr(suite, "env_kwargs", None)),
                 sensing_fingerprint=sensing_fingerprint(suite, cls, env_id))
 
 
@@ -123,24 +147,26 @@ def budget_plan(designed: Designed, episodes: int, drops: int) -> int:
 def tune_designed(suite, names: list[str] | None = None, episodes: int = LEARNED_SELECTION_EPISODES,
                   seed: int = 0, progress: bool = True, out: Path | None = None,
                   store: bool = True) -> dict:
-    """Tune every law of ``names`` (default :data:`DESIGNED`) on ``suite``'s validation drops
-    with at least ``episodes`` validation episodes each (module doc); store the records under
-    :data:`TUNED_DIR` (``store``) and return them with their costs."""
+    """Tune every law of ``names`` (default the suite's, :func:`laws_for`) on ``suite``'s
+    validation drops (a recover suite: its validation events) with at least ``episodes``
+    validation episodes each (module doc); store the records under :data:`TUNED_DIR`
+    (``store``) and return them with their costs."""
     from ..control.controllers import BASELINES, controller_env_kwargs
     from .benchmark import TASKS
     from .search import cross_entropy
     from .tune import GainObjective
     env_id = suite.env_id or TASKS["full"]
-    names = list(DESIGNED) if names is None else names
-    unknown = [n for n in names if n not in DESIGNED]
+    own = laws_for(suite)
+    names = own if names is None else names
+    unknown = [n for n in names if n not in own]
     if unknown:
-        raise ValueError(f"--law {unknown}: the designed laws with constants are "
-                         f"{', '.join(DESIGNED)}")
+        raise ValueError(f"--law {unknown}: the designed laws with constants tuned on the "
+                         f"{suite.name} suite are {', '.join(own)}")
     if episodes < LEARNED_SELECTION_EPISODES:
         raise ValueError(f"--episodes = {episodes} is below a learned configuration's model "
                          f"selection ({LEARNED_SELECTION_EPISODES} validation episodes)")
     validator = suite.validator(env_id)
-    drops = len(validator.scenarios) * len(validator.phases)
+    drops = validator.episodes
     records = load_records(suite)
     for name in names:
         d, cls = DESIGNED[name], BASELINES[name]

@@ -539,6 +539,14 @@ def law_constants(law, gains: dict) -> dict:
     return {**law.GAINS, **gains}
 
 
+def with_constants(law: type, constants: dict, name: str | None = None) -> type:
+    """``law`` as a controller class whose class constants ``GAINS`` are updated by
+    ``constants`` (checked: :func:`law_constants`), named ``name`` (default the law's): a
+    designed law with tuned or searched constants, run wherever a controller class runs."""
+    gains = law_constants(law, constants) if constants else dict(getattr(law, "GAINS", {}))
+    return type(law.__name__, (law,), {"GAINS": gains, "name": name or law.name})
+
+
 #: the tasks the recovery laws are designed for (their contact watch assumes the AMBs on)
 RECOVERY_TASKS = ("RotorDrop-Recover-v1",)
 #: the synchronous laws' watch and search constants (revolutions, fractions of the clearance).
@@ -761,16 +769,16 @@ def controller_class(spec: str) -> type[Controller] | None:
     return load_controller(spec) if is_controller_spec(spec) else None
 
 
-def make_controller(cls: type[Controller], plant: Plant, **gains) -> Controller:
-    """``cls(plant, **gains)`` after checking that the environment has the channels it needs; an
-    error in the constructor (say an argument without default) is a :class:`ControllerError`."""
+def make_controller(cls: type[Controller], plant: Plant) -> Controller:
+    """``cls(plant)`` after checking that the environment has the channels it needs; an error
+    in the constructor (say an argument without default) is a :class:`ControllerError`."""
     if not cls.supports(plant):
         where = "" if cls.env_ids is None else f" in {', '.join(cls.env_ids)}"
         raise ValueError(f"controller {cls.name!r} needs action channels {cls.needs}{where}, "
                          f"which {plant.env_id} does not have (it has "
                          f"{', '.join(plant.channels)})")
-    with blame(cls, f"{cls.__name__}(plant{', **gains' if gains else ''})"):
-        return cls(plant, **gains)
+    with blame(cls, f"{cls.__name__}(plant)"):
+        return cls(plant)
 
 
 def check_controller(actor, plant: Plant, obs: np.ndarray) -> None:
@@ -814,10 +822,11 @@ def make_baseline(spec, plant: Plant) -> Controller:
     cls = BASELINES[baseline_name(spec)]
     if not isinstance(spec, dict):
         return make_controller(cls, plant)
-    known = getattr(cls, "GAINS", {})
     for k, v in spec["gains"].items():
-        if k not in known:
-            raise ValueError(f"{cls.name} has no constant {k!r}; its constants: {', '.join(known)}")
         if not isinstance(v, (int, float)) or isinstance(v, bool) or not math.isfinite(v):
             raise ValueError(f"{cls.name} constant {k} must be a finite number, got {v!r}")
-    return make_controller(cls, plant, **spec["gains"])
+    try:
+        law = with_constants(cls, spec["gains"])
+    except (TypeError, AttributeError) as exc:          # unknown constants, or a law without
+        raise ValueError(f"{cls.name}: {exc}") from None
+    return make_controller(law, plant)

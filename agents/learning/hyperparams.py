@@ -32,6 +32,10 @@ arguments a block may hold:
 ``validation``     ``true``: keep as ``best/`` the model with the highest benchmark score on the
                    validation suite (:class:`agents.benchmarking.benchmark.Validator`: frictions and unbalance
                    phases the benchmark does not use) instead of the highest evaluation reward
+``validation_events`` with ``validation`` on ``RotorDrop-Recover-v1``: how many of the recover
+                   suite's validation events score a model (default 30 of its 60;
+                   :class:`agents.benchmarking.recover.RecoverValidator`: recovered %, ties
+                   broken by the mean peak contact force)
 ``action_log_std`` PPO: initial log std of named action entries, e.g. ``{gain: -1.0}``; the
                    others keep ``log_std_init`` (:mod:`agents.learning.exploration`)
 ``zero_start``     ``true``: the policy's action mean starts at exactly zero (its last layer
@@ -55,6 +59,7 @@ rl-zoo3 entry                                                          means
 ``vec_env_wrapper: [{agents.learning.reward.KpiReward: {weights...}}]``         ``reward: kpi``,
                                                                        ``reward_kwargs``
 ``callback: [agents.training.validation.ValidationCallback]``                   ``validation: true``
+``callback: [{agents.training.validation.ValidationCallback: {events: N}}]``      ``validation_events: N``
 ``callback: [{agents.learning.exploration.ActionSpread: {log_std: {...}}}]``    ``action_log_std: {...}``
 =====================================================================  ===========================
 
@@ -93,7 +98,7 @@ CONTRIB_ALGOS = tuple(a for a, (module, _) in ALGO_CLASSES.items() if module == 
 META_KEYS = ("n_timesteps", "n_envs", "policy", "policy_kwargs", "normalize", "env_kwargs",
              "eval_freq", "n_eval_episodes", "checkpoint_freq", "noise_type", "noise_std",
              "reward", "reward_kwargs", "residual", "residual_scale", "validation",
-             "action_log_std", "frame_stack", "zero_start")
+             "validation_events", "action_log_std", "frame_stack", "zero_start")
 REWARDS = ("env", "kpi")
 #: evaluation and checkpoint intervals [environment steps] and evaluation episodes of a run
 #: when neither the command line nor the config sets them (rl-zoo3's eval_freq too)
@@ -104,7 +109,7 @@ KPI_WRAPPER = "agents.learning.reward.KpiReward"
 VALIDATION_CALLBACK = "agents.training.validation.ValidationCallback"
 SPREAD_CALLBACK = "agents.learning.exploration.ActionSpread"
 #: project keys that rl-zoo3's ``callback:`` entries set
-CALLBACK_KEYS = ("validation", "action_log_std")
+CALLBACK_KEYS = ("validation", "validation_events", "action_log_std")
 WRAPPER_KEYS = ("residual", "residual_scale", "reward", "reward_kwargs")
 #: rl-zoo3 keys rotordrop train cannot honour (the batched VecEnv steps unwrapped envs)
 ZOO_ONLY = {"env_wrapper": "gym wrappers around each environment",
@@ -365,12 +370,14 @@ def project_keys(block: dict) -> dict:
             raise ConfigError(f"callback {name}: rotordrop train knows {VALIDATION_CALLBACK} "
                               f"(validation: true) and {SPREAD_CALLBACK} (action_log_std); other "
                               "callbacks run under python -m rl_zoo3.train")
-        check_keys(name, kwargs, ("eval_freq", "save_path", "verbose"))
+        check_keys(name, kwargs, ("eval_freq", "save_path", "verbose", "events"))
         if kwargs.get("save_path") is not None:
             raise ConfigError(f"callback {name}: save_path is where rl-zoo3 keeps the best model; "
                               "rotordrop train keeps it in --out/best/: remove save_path (or pass "
                               "it with rl_zoo3.train's -params)")
         found["validation"] = True
+        if "events" in kwargs:
+            found["validation_events"] = kwargs["events"]
         if "eval_freq" in kwargs:
             found["eval_freq"] = kwargs["eval_freq"]
     for key, value in found.items():
@@ -490,6 +497,14 @@ def split(hp: dict) -> tuple[dict, dict]:
     for flag in ("validation", "zero_start"):
         if not isinstance(meta.setdefault(flag, False), bool):
             raise ConfigError(f"{flag} must be true or false, got {meta[flag]!r}")
+    if "validation_events" in meta:
+        n = meta["validation_events"]
+        if not meta["validation"]:
+            raise ConfigError(f"validation_events: {n!r} needs validation: true (it sets how "
+                              "many validation events score a model)")
+        if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= 60:
+            raise ConfigError(f"validation_events must be an integer in [1, 60] (of the recover "
+                              f"suite's 60 validation events), got {n!r}")
     if "action_log_std" in meta:
         from .exploration import check_action_log_std
         meta["action_log_std"] = check_action_log_std(meta["action_log_std"])

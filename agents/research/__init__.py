@@ -1,4 +1,4 @@
-"""``rotordrop research whirl-bound | tune-whirl-brake | tune-designed | seat-oracle``: research probes of the re-levitation
+"""``rotordrop research whirl-bound | tune-whirl-brake | tune-designed | seat-oracle | recover-oracle``: research probes of the re-levitation
 task (docs/agents.md), kept apart from the speed scripts in ``benchmarks/``.
 
 ``whirl-bound`` (:mod:`agents.research.whirl_bound`) searches the AMB current sequence with the
@@ -6,7 +6,9 @@ fewest backward-whirl revolutions in a known scenario, an empirical lower bound 
 control; ``tune-whirl-brake`` (:mod:`agents.research.tune_whirl_brake`) tunes the gains of the
 ``whirl-brake`` baseline on scenarios the benchmark does not use; ``seat-oracle``
 (:mod:`agents.research.seat_oracle`) scores each test drop by the best of a pool of
-``whirl-brake`` gain sets in the law's seat (a searched plan that knows the drop). Registration is light: the
+``whirl-brake`` gain sets in the law's seat (a searched plan that knows the drop);
+``recover-oracle`` (:mod:`agents.research.recover_oracle`) scores each Recover test event by the
+best of a pool of designed recovery plans in their seats. Registration is light: the
 environments are imported by the handlers.
 """
 from __future__ import annotations
@@ -47,7 +49,9 @@ def register(subparsers) -> None:
                                              "validation drops, in its seat, and store the "
                                              "constants with what they were tuned under")
     q.add_argument("--suite", default="robust", help="the suite whose validation drops tune "
-                                                     "(default robust)")
+                                                     "(default robust; recover or "
+                                                     "recover-robust: the recovery laws on its "
+                                                     "validation events)")
     q.add_argument("--law", action="append", default=None,
                    help=f"a designed law to tune (repeatable; default all: {', '.join(DESIGNED)})")
     q.add_argument("--episodes", type=at_least(LEARNED_SELECTION_EPISODES),
@@ -78,6 +82,19 @@ def register(subparsers) -> None:
     add_backend_args(q, resume=False)
     q.set_defaults(func=cmd_seat_oracle)
 
+    q = sub.add_parser("recover-oracle", help="per Recover test event, the best of a pool of "
+                                              "designed recovery plans in their seats: a "
+                                              "searched plan that knows the event, against the "
+                                              "PID (oracle_recover.json)")
+    q.add_argument("--suite", default="recover", help="recover or recover-robust (default recover)")
+    q.add_argument("--events", type=at_least(1), default=100,
+                   help="its first test events (default 100)")
+    q.add_argument("--seat", action="append", default=None, choices=("supervisor", "controller"),
+                   help="the seats whose plans run (repeatable; default supervisor)")
+    q.add_argument("--out", default="out/recover-oracle")
+    q.add_argument("--quiet", action="store_true", help="no progress bar")
+    q.set_defaults(func=cmd_recover_oracle)
+
     q = sub.add_parser("tune-whirl-brake", help="tune the whirl-brake baseline's gains by "
                                                 "cross-entropy search on a tuning set (tune.json)")
     q.add_argument("--env", default="RotorDrop-Relevitate-v1",
@@ -107,6 +124,11 @@ def cmd_whirl_bound(args) -> int:
 
 def cmd_seat_oracle(args) -> int:
     from .seat_oracle import run
+    return _usage_errors(run, args)
+
+
+def cmd_recover_oracle(args) -> int:
+    from .recover_oracle import run
     return _usage_errors(run, args)
 
 

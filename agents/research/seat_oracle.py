@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from ..benchmarking.benchmark import EPISODE_TIME, TASKS, Entry, controller_entry, entry_rows
-from ..benchmarking.headroom import drop_table, headroom, plot, table
+from ..benchmarking.headroom import best_rows, drop_table, headroom, plot, table
 from ..benchmarking.robust import scenario_record
 from ..benchmarking.score import DEFAULT_SCORE, write_json
 from ..benchmarking.suites import SUITES
@@ -106,7 +106,7 @@ def seat_oracle(out, suite: str = "robust", scenarios: int = 50, draws: int = 8,
     names, terms, _, _ = drop_table(report, "full")
     members = [n for n in names if n != "passive"]
     cost = np.array([terms[n].sum(axis=0) for n in members])
-    best = np.argmin(cost, axis=0)
+    best = best_rows(cost)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     record = dict(settings=dict(suite=chosen.name, scenarios=int(scenarios), draws=int(draws),

@@ -235,7 +235,7 @@ def _training_callbacks(env_id: str, algo: str, meta: dict, seed: int, out: Path
                       frame_stack=meta.get("frame_stack", 1))
         cbs.append(ValidationCallback(save_path=out / "best", verbose=0, evaluations=eval_cb,
                                       policy=policy, best=_best(curve, "validation_score"),
-                                      save=save))
+                                      save=save, events=meta.get("validation_events")))
     if meta.get("checkpoint_freq", 0):
         cbs.append(FinalCheckpoint(save_freq=max(meta["checkpoint_freq"] // n, 1),
                                    save_path=str(out / "checkpoints"), name_prefix="rl_model",

@@ -191,16 +191,11 @@ def test_shipped_tuned_records_match_the_current_environment_and_sensing():
     """A designed row's constants were tuned on validation under the environment and sensing
     it is scored under; a changed sensing model or plant (the fingerprint of a short validation
     drop), env id, seat or step makes this fail: re-run `rotordrop research tune-designed`."""
-    from agents.benchmarking.tune_designed import DESIGNED, load_records, stale
+    from agents.benchmarking.tune_designed import laws_for
+    from helpers import check_tuned_records
     suite = SUITES.get("robust", "tune")
-    records = load_records(suite)
-    assert set(records) == set(DESIGNED)
-    for name, rec in records.items():
-        assert stale(suite, name) == [], (name, stale(suite, name))
-        b = rec["budget"]
-        assert b["validation_episodes"] >= b["learned_selection_episodes"]
-        assert b["validation_seeds"] == [40_000, 40_019]
-        assert rec["validation_score"] >= rec["start_validation_score"] - 1e-9
+    records = check_tuned_records(suite, [40_000, 40_019])
+    assert set(records) == set(laws_for(suite))
     entries = {e.name: e for e in robust_entries(None, suite=suite)[0]}
     from agents.control.plant import plant_of
     plant = plant_of(FULL, **entries["whirl-brake"].env_kwargs)

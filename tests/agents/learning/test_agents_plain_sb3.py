@@ -196,7 +196,7 @@ def test_a_residual_on_tuned_constants_carries_them_and_acts_as_that_law(tmp_pat
 @pytest.mark.parametrize("value, match", [
     ({"law": "whirl-brake", "tuned_on": "nowhere"}, "tuned_on"),
     ({"law": "max-damping", "tuned_on": "robust"}, "no tuned record of 'max-damping'"),
-    ({"law": "whirl-brake", "gains": {"kq": 1.0}}, "no constant 'kq'"),
+    ({"law": "whirl-brake", "gains": {"kq": 1.0}}, "unknown whirl-brake constants"),
     ({"law": "whirl-brake", "gains": {"kp": float("nan")}}, "finite"),
     ({"law": "whirl-brake"}, "law: NAME"),
     ("no-such-law", "unknown baseline controller"),

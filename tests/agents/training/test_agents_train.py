@@ -62,7 +62,10 @@ def test_every_experiment_delta_passes_the_checks_rotordrop_train_makes(cfg):
     data = read_yaml(cfg)
     assert "base" in data and len(data) <= 13, "a delta names its base and only what differs"
     algo = cfg.stem.split("-")[0]
-    named = str(data["base"]).rpartition(":")[2]       # a base entry named after its env id
+    named, base = "", cfg
+    while base.is_file() and not named.startswith("RotorDrop-"):    # a delta of a delta: its base's
+        ref = str(read_yaml(base).get("base", ""))
+        named, base = ref.rpartition(":")[2], base.parent / ref   # a base entry named after its env id
     env_id = (named if named.startswith("RotorDrop-") else
               "RotorDrop-Relevitate-v1" if "currents" in cfg.stem else "RotorDrop-Full-v1")
     _check(algo, env_id, cfg)
@@ -314,7 +317,10 @@ def test_validation_keeps_the_best_model_by_validation_score(tmp_path):
     base, _ = v.score(WhirlBrake, {"command": "continuous"})
     assert max(scores) == pytest.approx(base, abs=1.0)       # a 1 % residual barely moves it
     kept, _ = v.score(pol.bound, {"command": "continuous"})
-    assert kept == max(scores)                                # best/ is the best-scoring model
+    history = json.loads((res.out / "best" / "validation.json").read_text())["history"]
+    assert history[0]["timesteps"] == 0                      # the initial policy is a candidate
+    assert [h["score"] for h in history[1:]] == scores
+    assert kept == max(h["score"] for h in history)           # best/ is the best-scoring model
     with pytest.raises(ConfigError, match="residual_scale"):
         split({"residual_scale": 3.0})
 
