@@ -28,3 +28,19 @@ def tuned_gains(suite, name: str, env_id: str) -> dict | None:
     if rec is None or rec["env_id"] != env_id:
         return None
     return dict(rec["gains"])
+
+
+def tuned_spec(law: str, suite_name: str) -> dict:
+    """``{law, gains}``: designed law ``law`` with the constants tuned on suite ``suite_name``'s
+    validation drops (what a config's ``residual: {law, tuned_on}`` stands for); ValueError
+    naming the suites with records, or the missing record."""
+    path = TUNED_DIR / f"{suite_name}.json"
+    if not path.exists():
+        have = ", ".join(sorted(p.stem for p in TUNED_DIR.glob("*.json")))
+        raise ValueError(f"tuned_on = {suite_name!r}: no tuned records for that suite (suites "
+                         f"with records: {have})")
+    rec = json.loads(path.read_text()).get(law)
+    if rec is None:
+        raise ValueError(f"no tuned record of {law!r} on the {suite_name} suite "
+                         "(rotordrop research tune-designed)")
+    return {"law": law, "gains": dict(rec["gains"])}

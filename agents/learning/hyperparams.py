@@ -129,21 +129,17 @@ TUPLES = ("train_freq",)
 
 
 def residual_spec(value):
-    """The ``residual`` key checked: a baseline's name, or ``{law, gains}`` with the gains given
-    or read from a suite's tuned record (``{law, tuned_on}``); ConfigError otherwise."""
+    """The ``residual`` key checked: a baseline's name, ``{law, gains}``, or ``{law, tuned_on}``
+    (a suite whose tuned record gives the gains: ``rotordrop train`` writes them in,
+    :func:`agents.training.train.resolve_config`); ConfigError otherwise."""
     from ..control.controllers import BASELINES, baseline_name
     if isinstance(value, dict) and set(value) == {"law", "tuned_on"}:
-        from ..benchmarking.suites import SUITES
-        from ..benchmarking.tuned import load_records
-        try:
-            suite = SUITES.get(value["tuned_on"], "tune")
-        except ValueError as exc:
-            raise ConfigError(f"residual.tuned_on: {exc}") from exc
-        rec = load_records(suite).get(value["law"])
-        if rec is None:
-            raise ConfigError(f"residual: no tuned record of {value['law']!r} on the "
-                              f"{suite.name} suite (rotordrop research tune-designed)")
-        value = {"law": value["law"], "gains": dict(rec["gains"])}
+        if not isinstance(value["tuned_on"], str):
+            raise ConfigError(f"residual.tuned_on must be a suite's name, got {value['tuned_on']!r}")
+        if value["law"] not in BASELINES:
+            raise ConfigError(f"residual.law must be a baseline controller ({', '.join(BASELINES)}), "
+                              f"got {value['law']!r}")
+        return value
     try:
         baseline_name(value)
     except ValueError as exc:
@@ -151,6 +147,7 @@ def residual_spec(value):
                           f"{{law: NAME, tuned_on: SUITE}} or {{law: NAME, gains: {{...}}}}: "
                           f"{exc}") from exc
     return value
+
 
 def _yaml():
     try:

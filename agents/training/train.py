@@ -106,8 +106,16 @@ def _steps_of(p: Path) -> int:
 def resolve_config(env_id: str, algo: str, config=None, timesteps=None, n_envs=None,
                    **run: int | None) -> dict:
     """The hyperparameters with the command line's overrides (``run``: ``eval_freq``,
-    ``n_eval_episodes``, ``checkpoint_freq``; None keeps the config's)."""
+    ``n_eval_episodes``, ``checkpoint_freq``; None keeps the config's), a residual's
+    ``{law, tuned_on}`` replaced by the tuned constants themselves (``{law, gains}``)."""
     hp = load_hyperparams(algo, env_id, config)
+    spec = hp.get("residual")
+    if isinstance(spec, dict) and set(spec) == {"law", "tuned_on"}:
+        from ..benchmarking.tuned import tuned_spec        # the run keeps the numbers
+        try:
+            hp["residual"] = tuned_spec(spec["law"], spec["tuned_on"])
+        except ValueError as exc:
+            raise ConfigError(f"residual: {exc}") from exc
     if timesteps is not None:
         hp["n_timesteps"] = int(timesteps)
     if n_envs is not None:

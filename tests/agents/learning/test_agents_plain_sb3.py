@@ -4,6 +4,7 @@ baseline) did; exported SAC / TD3 zips too; a residual on a baseline with per-ep
 refuses plain SB3 with an error that says how to load it."""
 import json
 import pickle
+from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
@@ -16,6 +17,8 @@ from agents.control.plant import Plant
 from agents.learning.policies import LearnedPolicy, export_policy, load_shipped, shipped_dir, shipped_names
 from agents.control.residual import residual_action
 from agents.sb3_policy import export_self_contained, is_self_contained
+
+ROOT = Path(__file__).resolve().parents[3]
 
 torch.set_num_threads(1)
 
@@ -171,9 +174,12 @@ def test_a_residual_on_tuned_constants_carries_them_and_acts_as_that_law(tmp_pat
     gains) under plain SB3 and the project loader alike."""
     from agents.benchmarking.suites import SUITES
     from agents.benchmarking.tuned import load_records
-    from agents.learning.hyperparams import residual_spec
+    from agents.learning.hyperparams import split
     from agents.learning.policies import LearnedPolicy
-    spec = residual_spec({"law": "whirl-brake", "tuned_on": "robust"})
+    from agents.training.train import resolve_config
+    hp = resolve_config("RotorDrop-Full-v1", "ppo",
+                        str(ROOT / "docs/experiments/configs/ppo-ctrl-tuned-residual.yaml"))
+    spec = split(hp)[0]["residual"]
     gains = load_records(SUITES.get("robust", "tune"))["whirl-brake"]["gains"]
     assert spec == {"law": "whirl-brake", "gains": gains}
     model, vn, env_id, env_kwargs = _trained_run(tmp_path, "ppo")
@@ -194,16 +200,23 @@ def test_a_residual_on_tuned_constants_carries_them_and_acts_as_that_law(tmp_pat
 
 
 @pytest.mark.parametrize("value, match", [
-    ({"law": "whirl-brake", "tuned_on": "nowhere"}, "tuned_on"),
+    ({"law": "whirl-brake", "tuned_on": "nowhere"}, "tuned_on = 'nowhere'"),
     ({"law": "max-damping", "tuned_on": "robust"}, "no tuned record of 'max-damping'"),
+    ({"law": "no-such-law", "tuned_on": "robust"}, "no tuned record of 'no-such-law'"),
     ({"law": "whirl-brake", "gains": {"kq": 1.0}}, "unknown whirl-brake constants"),
     ({"law": "whirl-brake", "gains": {"kp": float("nan")}}, "finite"),
     ({"law": "whirl-brake"}, "law: NAME"),
     ("no-such-law", "unknown baseline controller"),
 ])
-def test_bad_residual_specs_are_clear_config_errors(value, match):
+def test_bad_residual_specs_are_clear_config_errors(value, match, tmp_path):
+    """Through ``rotordrop train``'s config resolution (which writes tuned constants in) and the
+    baseline they make: one clear error naming what is wrong."""
     from agents.learning.config_checks import ConfigError
-    from agents.learning.hyperparams import residual_spec
+    from agents.learning.hyperparams import split
+    from agents.training.train import resolve_config
+    cfg = tmp_path / "c.yaml"
+    cfg.write_text("base: ppo.yaml\nresidual: " + json.dumps(value) + "\n")
     env = gym.make("RotorDrop-Full-v1", command="continuous", episode_time=0.01)
     with pytest.raises((ConfigError, ValueError), match=match):
-        make_baseline(residual_spec(value), Plant.from_env(env))
+        make_baseline(split(resolve_config("RotorDrop-Full-v1", "ppo", str(cfg)))[0]["residual"],
+                      Plant.from_env(env))
