@@ -16,7 +16,7 @@ import json
 import shlex
 from pathlib import Path
 
-from .accuracy import ERROR_KEYS, TOLERANCE, _passes, recommend
+from .accuracy import ERROR_KEYS, TOLERANCE, WINDOW_S, _passes, recommend
 
 ROOT = Path(__file__).resolve().parents[2]
 DATA = ROOT / "docs" / "data" / "accuracy"
@@ -129,6 +129,16 @@ def _drops(study: dict) -> str:
     return f"{whirl} of {n}" + (f" ({chaotic} chaotic)" if chaotic else "")
 
 
+def _worst(rows: list[dict], key: str) -> float:
+    return max(r["errors"][key]["max"] for r in rows)
+
+
+def _drops_agreeing(studies: list[dict], rows: list[dict]) -> str:
+    n = [len(s["drops"]) for s in studies]
+    agree = sum(round(r["whirl_agreement"] * k) for r, k in zip(rows, n))
+    return f"{agree} of {sum(n)}"
+
+
 def table(studies: list[dict]) -> str:
     """The summary, one row per stored study, and the commands that made them."""
     t = _tol
@@ -144,7 +154,16 @@ def table(studies: list[dict]) -> str:
                  f"{_series(s, 'peak_contact_force_rel')} | {_series(s, 'peak_bearing_load_rel')} | "
                  f"{_pct(d, 'max_ball_load_rel')} % | {_rhs(d['rhs_evaluations'])} "
                  f"({_rhs(last['rhs_evaluations'])}) |")
-    L += ["", "Made by:", ""]
+    d = [row_at(s, DEFAULT_RTOL) for s in studies]
+    miss = [s["label"] for s in studies if not meets_criterion(s, DEFAULT_RTOL)]
+    L += ["", f"At rtol **{t(DEFAULT_RTOL)}** the {100 * TOLERANCE:g} % criterion holds in "
+          f"{len(studies) - len(miss)} of {len(studies)} scenes"
+          + (f"; not in {', '.join(miss)}" if miss else "") + ". Over the first "
+          f"{WINDOW_S * 1e3:g} ms after first contact its orbit stays within "
+          f"{_worst(d, 'trajectory_um'):.2g} µm of the reference and its first contact within "
+          f"{_worst(d, 'first_contact_time_abs_us'):.2g} µs in every scene; its whirl decision "
+          f"agrees with the reference's in {_drops_agreeing(studies, d)} drops.",
+          "", "Made by:", ""]
     L += [f"- {s['label']}: `{s['command']}`" for s in studies]
     return "\n".join(L) + "\n"
 
