@@ -66,3 +66,21 @@ def test_every_stored_study_is_a_full_study_with_its_command():
             assert f"--set {k}={v}" in s["command"]
         for t in summary.RTOLS:
             summary.row_at(s, t)
+
+
+@pytest.mark.parametrize("study", STUDIES, ids=[s["command"] for s in STUDIES])
+def test_the_recorded_command_reruns_the_stored_scene(study):
+    """`rotordrop accuracy` parses each recorded command to the stored scene and overrides (so
+    re-running it reproduces the stored study; --jobs changes wall times only)."""
+    import argparse
+    import shlex
+
+    from physics.cli import overrides_from_args, register
+    parser = argparse.ArgumentParser()
+    register(parser.add_subparsers(dest="command"))
+    words = shlex.split(study["command"])
+    assert words[0] == "rotordrop"
+    args = parser.parse_args(words[1:])
+    assert args.command == "accuracy" and args.scene == study["scene"]
+    assert args.quick == study["quick"] and not args.modes_only
+    assert overrides_from_args(args) == study["overrides"]
