@@ -342,7 +342,6 @@ def run(a) -> None:
     recover_oracle(a.out, a.suite, a.events, a.seat or ("supervisor",), not a.quiet)
 
 
-
 def main(argv=None) -> int:
     """``python -m agents.research.recover_oracle ORACLE.json``: print the report's table."""
     from ..benchmarking.recover import print_table

@@ -167,6 +167,12 @@ class ValidationCallback(BaseCallback):
         return score
 
 
+def _history(run: Path) -> list[dict]:
+    """A run's validation scores as its callback kept them (``best/validation.json``)."""
+    import json
+    return json.loads((run / "best" / "validation.json").read_text())["history"]
+
+
 def selection_rows(runs) -> list[dict]:
     """Per training run directory of ``runs`` (``rotordrop train --out``, with ``validation:
     true``): its steps, wall time, whether the time limit stopped it, and from
@@ -176,7 +182,7 @@ def selection_rows(runs) -> list[dict]:
     out = []
     for run in map(Path, runs):
         rec = json.loads((run / "training.json").read_text())
-        hist = json.loads((run / "best" / "validation.json").read_text())["history"]
+        hist = _history(run)
         best = max(hist, key=lambda h: h["score"])      # the first of equals: the one kept
         row = {"run": run.name, "steps": rec["timesteps"], "wall_s": round(rec["wall_time_s"], 1),
                "stopped_by_time_limit": bool(rec.get("stopped_by_time_limit")),
@@ -192,14 +198,12 @@ def selection_rows(runs) -> list[dict]:
 def plot_selection(runs, path) -> Path:
     """Each run's validation scores against its environment steps (``best/validation.json``),
     the kept model marked: a PNG at ``path``."""
-    import json
-
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(8, 4))
     for run in map(Path, runs):
-        hist = json.loads((run / "best" / "validation.json").read_text())["history"]
+        hist = _history(run)
         best = max(hist, key=lambda h: h["score"])
         line, = ax.plot([h["timesteps"] for h in hist], [h["score"] for h in hist], "o-", ms=3,
                         label=run.name)
