@@ -111,6 +111,7 @@ class Batch:
         self.rendering = first.render_mode is not None
         self.latency = np.zeros(n, dtype=np.int64)        # each env's observation latency
         self.values = np.zeros((n, K.N_V))                # the info numbers (rotordrop_env.info)
+        self.step_infos = [env._step_info for env in envs]  # each row's info templates
         if n_threads is not None and not 1 <= int(n_threads) <= numba.config.NUMBA_NUM_THREADS:
             raise ValueError(f"n_threads = {n_threads!r} must be in [1, "
                              f"{numba.config.NUMBA_NUM_THREADS}] (numba's NUMBA_NUM_THREADS)")

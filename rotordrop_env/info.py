@@ -84,32 +84,43 @@ def _one(floats: list, tail: list, time, relevitate: bool) -> dict:
 
 
 class StepInfo:
-    """The ``info`` of one environment, made at every step: :func:`info_dict`'s, the bools and
-    the latency (which change a few times per episode at most) reused from the previous step
-    while their numbers are the same."""
+    """The ``info`` of one environment, made at every step: :func:`info_dict`'s, built on a
+    template holding the bools and the latency (which change a few times per episode at most),
+    made again only when their numbers change, and copied with the step's numbers."""
 
     def __init__(self, relevitate: bool):
         self.relevitate = relevitate
         self._key: tuple | None = None
-        self._tail: list = []
+        self._template: dict = {}
 
     def __call__(self, v: np.ndarray, latency: int) -> dict:
+        return self.made(list(v[:_NF]), v, latency)
+
+    def made(self, floats: list, v: np.ndarray, latency: int) -> dict:
+        """The info of the numbers ``v`` (``(N_V,)``) whose float entries are ``floats``
+        (fresh numpy scalars)."""
         key = (v[_NF:].tobytes(), latency)
         if key != self._key:
-            self._key, self._tail = key, _tail(v.tolist(), latency, self.relevitate)
-        return _one(list(v[:_NF]), self._tail, v[K.V_TIME], self.relevitate)
+            self._key = key
+            self._template = _one([None] * _NF, _tail(v.tolist(), latency, self.relevitate),
+                                  None, self.relevitate)
+        info = self._template.copy()             # keys in order, the bools and the latency
+        info.update(zip(FLOAT_KEYS, floats))
+        info["kpi_episode_time_s"] = v[K.V_TIME]
+        return info
 
 
-def row_infos(v: np.ndarray, latency: np.ndarray, relevitate: bool) -> list[dict]:
+def row_infos(v: np.ndarray, latency: np.ndarray, relevitate: bool,
+              step_infos: list[StepInfo] | None = None) -> list[dict]:
     """Each environment's info (numpy scalars, as a single environment's) from the numbers
-    ``v`` of N, ``(N, N_V)``: the SB3 VecEnv's list of infos (every numpy scalar made in one
-    pass per kind)."""
+    ``v`` of N, ``(N, N_V)``: the SB3 VecEnv's list of infos (the float scalars made in one
+    pass); ``step_infos``: each row's :class:`StepInfo` (the environments' own), else new ones."""
     floats = list(v[:, :_NF].ravel())
-    numbers = v.tolist()
     lat = np.asarray(latency, dtype=np.int64).tolist()
-    times = list(v[:, K.V_TIME])
-    return [_one(floats[e * _NF:(e + 1) * _NF], _tail(numbers[e], lat[e], relevitate), times[e],
-                 relevitate) for e in range(v.shape[0])]
+    if step_infos is None:
+        step_infos = [StepInfo(relevitate) for _ in range(v.shape[0])]
+    return [s.made(floats[e * _NF:(e + 1) * _NF], v[e], lat[e])
+            for e, s in enumerate(step_infos)]
 
 
 def kpi_keys(info: dict) -> dict:

@@ -35,10 +35,11 @@ from __future__ import annotations
 
 import math
 import numbers
+from functools import partial
 
 import numpy as np
 
-from physics.jit import njit
+from physics.jit import bound, njit
 from physics.sensor import on_sample, samples_inside
 
 from .kernels import SUP_MIN_RADIUS
@@ -100,7 +101,12 @@ class Sensing:
     """The noisy, delayed observation of one environment (module doc).
 
     ``obs_names``/``obs_scale``: the environment's layout (normalised obs x scale = SI);
-    ``clearance`` [m] for the orbit's dead zone."""
+    ``clearance`` [m] for the orbit's dead zone.
+
+    A step's standard normals are drawn in one call (:meth:`draw_step`, before the kernel
+    step): the samples strictly inside the step, then the measurement's after it (4 of a new
+    displacement sample at a sample instant, then 4 of the velocity estimates), the very
+    numbers, in the very order, of one draw per sample and one per measurement."""
 
     def __init__(self, noise: float, latency: tuple[int, int], obs_names, obs_scale,
                  clearance: float, noise_control: int, sample_rate: float = 1e4,
@@ -109,7 +115,9 @@ class Sensing:
         self.noise, self.latency = noise, latency
         self.rate, self.dt = sample_rate, control_dt
         self.z = np.zeros(4)                    # standard normals of the held noise sample
-        self.fresh = True                       # a sample instant at the coming measurement
+        #: measurements taken this episode, latency k, the first row of the coming
+        #: measurement's normals (draw_step's; -1: not drawn), a sample instant at it (1/0)
+        self.state = np.array([0, 0, -1, 1], dtype=np.int64)
         self.last_drawn = 0                     # samples inside the last step (draw_step)
         self.noise_control = noise_control      # first of the 4 noise controls in U
         self.active = noise > 0.0 or latency[1] > 0
@@ -129,49 +137,76 @@ class Sensing:
         self.buffer = np.zeros((latency[1] + 1, len(names)))
         self._cols = self.cols if noise > 0.0 else np.zeros(0, dtype=np.int64)   # for _sense
         self._sigma = self.sigma if noise > 0.0 else np.zeros(0)
-        self.k = 0
-        self.n = 0                      # measurements taken this episode
+        self._own = np.zeros((2, 4))            # the measurement's normals drawn by itself
+        self._Z, self._rows = None, {}          # draw_step's Z and its flat views by rows
+
+    def __getstate__(self) -> dict:
+        state = self.__dict__.copy()            # the views of Z are made again (copies break
+        state["_Z"], state["_rows"] = None, {}  # them)
+        return state
+
+    @property
+    def k(self) -> int:
+        """The episode's observation latency [control steps]."""
+        return int(self.state[1])
+
+    @property
+    def n(self) -> int:
+        """Measurements taken this episode."""
+        return int(self.state[0])
+
+    @property
+    def fresh(self) -> bool:
+        """A sensor sample instant falls on the coming measurement."""
+        return bool(self.state[3])
 
     @property
     def n_noise(self) -> int:
-        """The most sensor samples strictly inside one control step (rows of the kernel's
-        ``Z``); 0 without noise."""
-        return math.ceil(self.dt * self.rate) + 1 if self.noise > 0.0 else 0
+        """Rows of the kernel's ``Z``: the most sensor samples strictly inside one control step,
+        then the 2 rows of the measurement after it (:meth:`draw_step`); 0 without noise."""
+        return math.ceil(self.dt * self.rate) + 3 if self.noise > 0.0 else 0
 
     def reset(self, true_obs: np.ndarray, rng: np.random.Generator,
               U: np.ndarray | None = None) -> np.ndarray:
         """Start an episode: draw its latency k, take the first measurement (with a fresh
         noise sample: the sensor's sample current at the episode's start)."""
         lo, hi = self.latency
-        self.k = int(rng.integers(lo, hi + 1)) if hi > lo else lo
-        self.n = 0
-        self.fresh = True
+        self.state[:] = (0, int(rng.integers(lo, hi + 1)) if hi > lo else lo, -1, 1)
         return self.step(true_obs, rng, U)
 
     def draw_step(self, t0: float, Z: np.ndarray, rng: np.random.Generator) -> int:
         """Before a control step from ``t0``: the standard normals of the noise samples at the
-        sensor's sample instants strictly inside the step into ``Z`` (the kernel holds them in
-        turn, :func:`physics.integrate.integrate_sensed`); a sample at the step's end is drawn
-        by the measurement after it. Returns their number (0, nothing drawn, without noise)."""
+        sensor's sample instants strictly inside the step into ``Z``'s first rows (the kernel
+        holds them in turn, :func:`physics.integrate.integrate_sensed`), and in the rows after
+        them the normals of the measurement after the step (a sample at the step's end is its
+        new displacement sample), in one draw. Returns the number of samples inside (0,
+        nothing drawn, without noise)."""
         if self.noise == 0.0:
             return 0
-        t1 = t0 + self.dt                       # as the kernel computes it
-        _, n = samples_inside(t0, t1, self.rate)
+        if self.state[2] >= 0 and self.last_drawn > 0:     # a step that was not measured
+            self.z[:] = Z[self.last_drawn - 1]             # holds its last sample
+        n, fresh = step_samples(t0, t0 + self.dt, self.rate)   # t1 as the kernel computes it
+        rows = n + fresh + 1
+        if Z is not self._Z:
+            self._Z, self._rows = Z, {}
+        flat = self._rows.get(rows)
+        if flat is None:
+            flat = self._rows[rows] = _flat(Z[:rows])
+        rng.standard_normal(out=flat)
         self.last_drawn = n
-        if n > 0:
-            Z[:n] = rng.standard_normal((n, 4))
-            self.z = Z[n - 1].copy()
-        self.fresh = bool(on_sample(t1, self.rate))
+        self.state[2] = n
+        self.state[3] = fresh
         return n
 
-    def _draw(self, rng: np.random.Generator) -> np.ndarray:
-        """The measurement's standard normals: 4 of the displacement noise (a fresh sample at a
-        sample instant, else the held one), then 4 of the velocity estimates'."""
-        if self.fresh:
-            z = rng.standard_normal(len(self.cols))
-            self.z = z[:4].copy()
-            return z
-        return np.concatenate((self.z, rng.standard_normal(len(self.cols) - 4)))
+    def _normals(self, rng: np.random.Generator) -> np.ndarray:
+        """The rows holding the coming measurement's normals from row ``state[2]`` on: the
+        ``Z`` of :meth:`draw_step`, else its own rows, drawn now (row 0)."""
+        if self.state[2] >= 0:
+            return self._Z
+        self.state[2] = 0
+        if self.noise > 0.0:
+            rng.standard_normal(out=_flat(self._own[:1 + self.state[3]]))
+        return self._own
 
     def step(self, true_obs: np.ndarray, rng: np.random.Generator,
              U: np.ndarray | None = None) -> np.ndarray:
@@ -181,26 +216,59 @@ class Sensing:
         if U is not None and (self.noise == 0.0 or self.orbit is None):
             # one compiled call, the same numbers as step_python (the supervisor's orbit
             # entries take the Python path)
-            z = self._draw(rng) if self.noise > 0.0 else _NO_DRAW
             out = np.empty(true_obs.shape[0], dtype=np.float32)
-            _sense(true_obs, z, self._sigma, self._cols, U, self.noise_control, self.noise,
-                   self.buffer, self.n, self.k, self.time_col, out)
-            self.n += 1
+            _sense(true_obs, self._normals(rng), self.z, self._sigma, self._cols, U,
+                   self.noise_control, self.noise, self.buffer, self.state, self.time_col, out)
             return out
         return self.step_python(true_obs, rng, U)
+
+    def measurer(self, true_obs: np.ndarray, Z: np.ndarray, U: np.ndarray):
+        """:meth:`step` on an environment's arrays after each :meth:`draw_step` into ``Z`` (or
+        without noise), bound to them (:func:`physics.jit.bound`): a callable returning the
+        observation (given the environment's random generator); None with the supervisor's
+        orbit entries (they take :meth:`step`)."""
+        if self.noise > 0.0 and self.orbit is not None:
+            return None
+        out = np.empty(true_obs.shape[0], dtype=np.float32)
+        call = bound(_sense, true_obs, Z, self.z, self._sigma, self._cols, U, self.noise_control,
+                     self.noise, self.buffer, self.state, self.time_col, out)
+        return partial(self._measured, call, out, true_obs, U)
+
+    def _measured(self, call, out: np.ndarray, true_obs: np.ndarray, U: np.ndarray,
+                  rng: np.random.Generator) -> np.ndarray:
+        """The bound measurement ``call`` (:meth:`measurer`): a fresh copy of its observation
+        ``out``; :meth:`step` when no :meth:`draw_step` drew its normals."""
+        if self.noise > 0.0 and self.state[2] < 0:
+            return self.step(true_obs, rng, U)
+        call()
+        return out.copy()
 
     def step_python(self, true_obs: np.ndarray, rng: np.random.Generator,
                     U: np.ndarray | None = None) -> np.ndarray:
         """:meth:`step` in numpy (any settings; the reference of its compiled path)."""
         m = self._measure(true_obs, rng, U)
         L = len(self.buffer)
-        self.buffer[self.n % L] = m
-        if self.n == 0:
+        n = self.n
+        self.buffer[n % L] = m
+        if n == 0:
             self.buffer[:] = m
-        out = self.buffer[(self.n - min(self.k, self.n)) % L].astype(np.float32)
+        out = self.buffer[(n - min(self.k, n)) % L].astype(np.float32)
         out[self.time_col] = true_obs[self.time_col]
-        self.n += 1
+        self.state[0] += 1
+        self.state[2] = -1
         return out
+
+    def _draw(self, rng: np.random.Generator) -> np.ndarray:
+        """The measurement's standard normals: 4 of the displacement noise (a fresh sample at a
+        sample instant, else the one held: the last inside the step, if any), then 4 of the
+        velocity estimates'."""
+        rows, r = self._normals(rng), int(self.state[2])
+        if self.fresh:
+            self.z[:] = rows[r]
+            r += 1
+        elif r > 0:
+            self.z[:] = rows[r - 1]
+        return np.concatenate((self.z, rows[r]))
 
     def _measure(self, true_obs: np.ndarray, rng: np.random.Generator,
                  U: np.ndarray | None) -> np.ndarray:
@@ -228,30 +296,58 @@ class Sensing:
             m[self.orbit[2 + k]] = rate / self.scale[self.orbit[2 + k]]
 
 
-_NO_DRAW = np.zeros(0)
+def _flat(rows: np.ndarray) -> np.ndarray:
+    """``rows`` (contiguous) as one flat view (never a copy: the draws must land in them)."""
+    flat = rows.view()
+    flat.shape = (rows.size,)
+    return flat
 
 
 @njit
-def _sense(true_obs, z, sigma, cols, U, noise_control, noise, buffer, n, k, time_col, out):
+def step_samples(t0, t1, rate):
+    """(n, at_end) of a control step from ``t0`` to ``t1``: n sensor sample instants lie
+    strictly inside it (:func:`physics.sensor.samples_inside`), and whether one falls at its
+    end."""
+    return samples_inside(t0, t1, rate)[1], on_sample(t1, rate)
+
+
+@njit
+def _sense(true_obs, Z, held, sigma, cols, U, noise_control, noise, buffer, state, time_col, out):
     """:meth:`Sensing.step` without the supervisor's orbit entries, compiled: the measurement
     (``true_obs`` + ``sigma`` z at ``cols``; the noise ``noise`` z of the 4 displacements into
-    ``U``) into the latency ring ``buffer`` (all of it at the episode's first measurement, n =
-    0) and the float32 observation of k measurements ago (its ``time`` the present) into ``out``."""
+    ``U``) into the latency ring ``buffer`` (all of it at the episode's first measurement,
+    ``state[0]`` = 0) and the float32 observation of k = ``state[1]`` measurements ago (its
+    ``time`` the present) into ``out``. z: the 4 displacement normals ``held`` (at a sample
+    instant, ``state[3]``, the new ones of row r = ``state[2]`` of ``Z``; else the last sample
+    inside the step, row r - 1, if any), then the 4 velocity normals of the next row; ``held``
+    keeps the displacement's; ``state[0]`` += 1, ``state[2]`` = -1."""
     L = buffer.shape[0]
+    n = state[0]
+    k = state[1]
     row = n % L
     for i in range(true_obs.shape[0]):
         buffer[row, i] = true_obs[i]
-    for j in range(cols.shape[0]):
-        buffer[row, cols[j]] += sigma[j] * z[j]
     if cols.shape[0] > 0:
+        r = state[2]
+        if state[3]:
+            for j in range(4):
+                held[j] = Z[r, j]
+            r += 1
+        elif r > 0:
+            for j in range(4):
+                held[j] = Z[r - 1, j]
         for j in range(4):                  # x1, y1, x2, y2: the AMB axes' order
-            U[noise_control + j] = noise * z[j]
+            buffer[row, cols[j]] += sigma[j] * held[j]
+            buffer[row, cols[4 + j]] += sigma[4 + j] * Z[r, j]
+            U[noise_control + j] = noise * held[j]
     if n == 0:
-        for r in range(L):
-            if r != row:
+        for q in range(L):
+            if q != row:
                 for i in range(true_obs.shape[0]):
-                    buffer[r, i] = buffer[row, i]
+                    buffer[q, i] = buffer[row, i]
     src = (n - min(k, n)) % L
     for i in range(true_obs.shape[0]):
         out[i] = buffer[src, i]
     out[time_col] = true_obs[time_col]
+    state[0] = n + 1
+    state[2] = -1
