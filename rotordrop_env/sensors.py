@@ -42,7 +42,7 @@ import numpy as np
 from physics.jit import bound, njit
 from physics.sensor import on_sample, samples_inside
 
-from .kernels import SUP_MIN_RADIUS
+from .kernels import M_T, SUP_MIN_RADIUS
 from .layout import SUPERVISOR_OBS
 
 #: interval of the velocity estimate that the velocity noise stands for [s]
@@ -116,9 +116,9 @@ class Sensing:
         self.rate, self.dt = sample_rate, control_dt
         self.z = np.zeros(4)                    # standard normals of the held noise sample
         #: measurements taken this episode, latency k, the first row of the coming
-        #: measurement's normals (draw_step's; -1: not drawn), a sample instant at it (1/0)
-        self.state = np.array([0, 0, -1, 1], dtype=np.int64)
-        self.last_drawn = 0                     # samples inside the last step (draw_step)
+        #: measurement's normals (draw_step's; -1: not drawn), a sample instant at it (1/0),
+        #: samples inside the last step (draw_step)
+        self.state = np.array([0, 0, -1, 1, 0], dtype=np.int64)
         self.noise_control = noise_control      # first of the 4 noise controls in U
         self.active = noise > 0.0 or latency[1] > 0
         self.time_col = names.index("time")
@@ -161,6 +161,17 @@ class Sensing:
         return bool(self.state[3])
 
     @property
+    def last_drawn(self) -> int:
+        """Sensor samples strictly inside the last step (:meth:`draw_step`)."""
+        return int(self.state[4])
+
+    @property
+    def compiled(self) -> bool:
+        """Every measurement is the compiled one (the supervisor's orbit entries with noise
+        take the Python path)."""
+        return self.noise == 0.0 or self.orbit is None
+
+    @property
     def n_noise(self) -> int:
         """Rows of the kernel's ``Z``: the most sensor samples strictly inside one control step,
         then the 2 rows of the measurement after it (:meth:`draw_step`); 0 without noise."""
@@ -171,7 +182,7 @@ class Sensing:
         """Start an episode: draw its latency k, take the first measurement (with a fresh
         noise sample: the sensor's sample current at the episode's start)."""
         lo, hi = self.latency
-        self.state[:] = (0, int(rng.integers(lo, hi + 1)) if hi > lo else lo, -1, 1)
+        self.state[:] = (0, int(rng.integers(lo, hi + 1)) if hi > lo else lo, -1, 1, 0)
         return self.step(true_obs, rng, U)
 
     def draw_step(self, t0: float, Z: np.ndarray, rng: np.random.Generator) -> int:
@@ -183,20 +194,14 @@ class Sensing:
         nothing drawn, without noise)."""
         if self.noise == 0.0:
             return 0
-        if self.state[2] >= 0 and self.last_drawn > 0:     # a step that was not measured
-            self.z[:] = Z[self.last_drawn - 1]             # holds its last sample
-        n, fresh = step_samples(t0, t0 + self.dt, self.rate)   # t1 as the kernel computes it
-        rows = n + fresh + 1
+        rows = plan_step(t0, self.dt, self.rate, Z, self.z, self.state)
         if Z is not self._Z:
             self._Z, self._rows = Z, {}
         flat = self._rows.get(rows)
         if flat is None:
             flat = self._rows[rows] = _flat(Z[:rows])
         rng.standard_normal(out=flat)
-        self.last_drawn = n
-        self.state[2] = n
-        self.state[3] = fresh
-        return n
+        return self.last_drawn
 
     def _normals(self, rng: np.random.Generator) -> np.ndarray:
         """The rows holding the coming measurement's normals from row ``state[2]`` on: the
@@ -213,7 +218,7 @@ class Sensing:
         """Measure ``true_obs`` (normalised, as the kernel wrote it) and return the float32
         observation the agent sees now; the displacement noise sample goes to the controls ``U``
         (the physics' sensed displacement until the next measurement) when given."""
-        if U is not None and (self.noise == 0.0 or self.orbit is None):
+        if U is not None and self.compiled:
             # one compiled call, the same numbers as step_python (the supervisor's orbit
             # entries take the Python path)
             out = np.empty(true_obs.shape[0], dtype=np.float32)
@@ -227,7 +232,7 @@ class Sensing:
         without noise), bound to them (:func:`physics.jit.bound`): a callable returning the
         observation (given the environment's random generator); None with the supervisor's
         orbit entries (they take :meth:`step`)."""
-        if self.noise > 0.0 and self.orbit is not None:
+        if not self.compiled:
             return None
         out = np.empty(true_obs.shape[0], dtype=np.float32)
         call = bound(_sense, true_obs, Z, self.z, self._sigma, self._cols, U, self.noise_control,
@@ -304,11 +309,43 @@ def _flat(rows: np.ndarray) -> np.ndarray:
 
 
 @njit
-def step_samples(t0, t1, rate):
-    """(n, at_end) of a control step from ``t0`` to ``t1``: n sensor sample instants lie
-    strictly inside it (:func:`physics.sensor.samples_inside`), and whether one falls at its
-    end."""
-    return samples_inside(t0, t1, rate)[1], on_sample(t1, rate)
+def plan_step(t0, dt, rate, Z, held, state):
+    """The draws of a control step from ``t0`` (:meth:`Sensing.draw_step`): its n sensor sample
+    instants strictly inside (:func:`physics.sensor.samples_inside`; t1 = t0 + dt, as the
+    kernel computes it) and whether one falls at its end, recorded in ``state`` (the
+    measurement's first row n, at its end, n); a step whose draws were not measured first
+    leaves its last sample inside ``held``. Returns the rows of ``Z`` to draw: n, then the
+    measurement's 1 (velocity) or, at a sample instant, 2 (a new displacement sample first)."""
+    if state[2] >= 0 and state[4] > 0:
+        for j in range(4):
+            held[j] = Z[state[4] - 1, j]
+    t1 = t0 + dt
+    n = samples_inside(t0, t1, rate)[1]
+    at_end = 1 if on_sample(t1, rate) else 0
+    state[2] = n
+    state[3] = at_end
+    state[4] = n
+    return n + at_end + 1
+
+
+@njit
+def plan_rows(rows, M, dt, rate, Z, HELD, STATE, counts):
+    """:func:`plan_step` of the environments ``rows`` of a batch (``M``: their monitors, the
+    step's start ``M[e, M_T]``): ``counts[i]``, the rows of ``Z[rows[i]]`` to draw."""
+    for i in range(rows.shape[0]):
+        e = rows[i]
+        counts[i] = plan_step(M[e, M_T], dt, rate, Z[e], HELD[e], STATE[e])
+
+
+@njit
+def sense_rows(rows, OBS, Z, HELD, sigma, cols, U, noise_control, noise, BUFFER, STATE,
+               time_col, OUT):
+    """:func:`_sense` of the environments ``rows`` of a batch, their observations into
+    ``OUT``."""
+    for i in range(rows.shape[0]):
+        e = rows[i]
+        _sense(OBS[e], Z[e], HELD[e], sigma, cols, U[e], noise_control, noise, BUFFER[e],
+               STATE[e], time_col, OUT[e])
 
 
 @njit
@@ -351,3 +388,72 @@ def _sense(true_obs, Z, held, sigma, cols, U, noise_control, noise, buffer, stat
     out[time_col] = true_obs[time_col]
     state[0] = n + 1
     state[2] = -1
+
+
+class SensingRows:
+    """The sensing of a batch's environments (one id and settings, compiled measurements:
+    :attr:`Sensing.compiled`) on stacked arrays: each environment's :class:`Sensing` keeps views
+    of its rows (its own numbers: its reset, latency and measurement work on them as a single
+    environment's), and the batch plans and measures a step of every row in one compiled call
+    each (:func:`plan_rows`, :func:`sense_rows`), with the draws from each environment's own
+    generator between them: the numbers of each environment stepped alone."""
+
+    def __init__(self, sensings: list[Sensing], stack):
+        self.sensings = sensings
+        first = sensings[0]
+        self.noise = first.noise
+        self.z = np.stack([s.z for s in sensings])
+        self.state = np.stack([s.state for s in sensings])
+        self.buffer = np.stack([s.buffer for s in sensings])
+        self.rows = np.arange(len(sensings))
+        self.counts = np.zeros(len(sensings), dtype=np.int64)
+        self.out = np.zeros(stack.obs.shape, dtype=np.float32)
+        self.attach(stack)
+
+    def attach(self, stack) -> None:
+        """Give each environment's sensing the views of its rows, and take the batch's
+        ``stack`` (:class:`rotordrop_env.buffers.Buffers`): again after a copy."""
+        for e, s in enumerate(self.sensings):
+            s.z, s.state, s.buffer = self.z[e], self.state[e], self.buffer[e]
+        self.stack = stack
+        self._views: list[dict] = [{} for _ in self.sensings]     # flat views of Z's rows
+        self._plan = self._sense = None                           # bound at first use
+
+    def __getstate__(self) -> dict:
+        state = self.__dict__.copy()
+        state["_views"], state["_plan"], state["_sense"] = [], None, None
+        return state
+
+    def draw(self, rngs: list, rows: np.ndarray | None = None) -> None:
+        """Before a batch step: each environment's draws (:meth:`Sensing.draw_step`) from its
+        generator in ``rngs``, for all rows or the rows ``rows``."""
+        if self.noise == 0.0:
+            return
+        st, first = self.stack, self.sensings[0]
+        if rows is None:
+            if self._plan is None:
+                self._plan = bound(plan_rows, self.rows, st.M, first.dt, first.rate, st.Z, self.z,
+                                   self.state, self.counts)
+            self._plan()
+            rows = self.rows
+        else:
+            plan_rows(rows, st.M, first.dt, first.rate, st.Z, self.z, self.state, self.counts)
+        for e, count in zip(rows.tolist(), self.counts.tolist()):
+            flat = self._views[e].get(count)
+            if flat is None:
+                flat = self._views[e][count] = _flat(st.Z[e, :count])
+            rngs[e].standard_normal(out=flat)
+
+    def measure(self, rows: np.ndarray | None = None) -> np.ndarray:
+        """After a batch step: every row's measurement (or the rows ``rows``'), its float32
+        observation in the rows of :attr:`out` (overwritten by the next step)."""
+        st, first = self.stack, self.sensings[0]
+        args = (st.obs, st.Z, self.z, first._sigma, first._cols, st.U, first.noise_control,
+                first.noise, self.buffer, self.state, first.time_col, self.out)
+        if rows is not None:
+            sense_rows(rows, *args)
+        else:
+            if self._sense is None:
+                self._sense = bound(sense_rows, self.rows, *args)
+            self._sense()
+        return self.out

@@ -212,3 +212,36 @@ def test_a_copied_noisy_env_continues_as_the_original(copier):
         t = twin.step(a)
         assert np.array_equal(c[0], o[0]) and np.array_equal(o[0], t[0]) and c[1] == o[1] == t[1]
         assert list(c[4]) == list(o[4]) and all(c[4][k] == o[4][k] for k in o[4])
+
+
+def test_a_batch_senses_each_row_as_its_single_env_through_resets_and_a_copy():
+    """The batch draws and measures all rows at once (rotordrop_env.sensors.SensingRows): each
+    row is its single environment step for step (noise sampled inside 0.2 ms steps, latency,
+    NEXT_STEP autoresets, whose steps advance some rows only), and a deep copy made
+    mid-run continues as the original."""
+    from gymnasium.vector import AutoresetMode
+    kw = dict(command="continuous", control_dt=2e-4, episode_time=0.003, sensor_noise=2e-6,
+              sensor_delay=1e-4, obs_latency_steps=(0, 3), terminate_on_failure=False)
+    venv = gym.make_vec(FULL, num_envs=3, vectorization_mode="vector_entry_point", n_threads=1,
+                        autoreset_mode=AutoresetMode.NEXT_STEP, **kw)
+    singles = [gym.make(FULL, **kw) for _ in range(3)]
+    obs, _ = venv.reset(seed=7)
+    for i, env in enumerate(singles):
+        assert np.array_equal(obs[i], env.reset(seed=7 + i)[0])
+    acts = np.random.default_rng(3).uniform(-1, 1, (40, 3, 6)).astype(np.float32)
+    ended = np.zeros(3, dtype=bool)
+    for k, a in enumerate(acts):
+        if k == 12:
+            twin = copy.deepcopy(venv)
+        obs, rew, te, tr, _ = venv.step(a)
+        if k >= 12:
+            o2, r2, *_ = twin.step(a)
+            assert np.array_equal(obs, o2) and np.array_equal(rew, r2)
+        for i, env in enumerate(singles):
+            if ended[i]:
+                assert np.array_equal(obs[i], env.reset()[0]) and rew[i] == 0.0
+            else:
+                o, r, *_ = env.step(a[i])
+                assert np.array_equal(obs[i], o) and rew[i] == r
+        ended = te | tr
+    assert venv.unwrapped.batch.sensing is not None          # the stacked path was taken
