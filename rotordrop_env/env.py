@@ -234,7 +234,8 @@ class RotorDropEnv(SettingsGuard, EpisodeView, gym.Env):
         b = self._b
         self._calls = _Calls(bound(K.step_one, *self._args), bound(K.check_action, b.act, b.C),
                              bound(K.info_values, b.out, b.M, b.C, self._values),
-                             self._sensing.measurer(b.obs, b.Z, b.U))
+                             self._sensing.measurer(b.obs, b.Z, b.U),
+                             self._sensing.drawer(b.M, b.Z))
         return self._calls
 
     def __getstate__(self) -> dict:
@@ -314,11 +315,11 @@ class RotorDropEnv(SettingsGuard, EpisodeView, gym.Env):
             self._check_steppable()
         calls = self._calls or self._bind_calls()
         load_action(action, self._b.act, self.action_space, self.action_names)
-        if self._sensing.noise > 0.0:
-            err = calls.check()                 # a refused action draws no noise (as a batch)
+        if calls.draw is not None:              # the sensor noise (rotordrop_env.sensors)
+            err = calls.check()                 # a refused action draws none (as in a batch)
             if err:
                 self._action_error(err, action)
-            self.draw_noise()
+            calls.draw(self.np_random)
         calls.step()
         return self._finish(action)
 
@@ -326,7 +327,7 @@ class RotorDropEnv(SettingsGuard, EpisodeView, gym.Env):
         """Before a kernel step (its action checked): the sensor noise samples inside it and
         the measurement's after it (:meth:`rotordrop_env.sensors.Sensing.draw_step`)."""
         if self._sensing.noise > 0.0:
-            self._sensing.draw_step(self._b.M[K.M_T], self._b.Z, self.np_random)
+            (self._calls or self._bind_calls()).draw(self.np_random)
 
     def _check_open(self, what: str) -> None:
         if self._closed:
@@ -408,11 +409,13 @@ class RotorDropEnv(SettingsGuard, EpisodeView, gym.Env):
 
 class _Calls(NamedTuple):
     """The compiled calls of one environment's step on its arrays (:meth:`RotorDropEnv._bind_calls`):
-    the kernel step, the action check, the info numbers, the measurement (None: the Python one)."""
+    the kernel step, the action check, the info numbers, the measurement (None: the Python one)
+    and the noise draws before a step (None without noise)."""
     step: Callable[[], None]
     check: Callable[[], int]
     info: Callable[[], None]
     measure: Callable[[np.random.Generator], np.ndarray] | None
+    draw: Callable[[np.random.Generator], None] | None
 
 
 def start_episode(b: Buffers, fs, n_steps: int, dt: float, power_return: float | None,

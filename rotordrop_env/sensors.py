@@ -203,6 +203,30 @@ class Sensing:
         rng.standard_normal(out=flat)
         return self.last_drawn
 
+    def drawer(self, M: np.ndarray, Z: np.ndarray):
+        """:meth:`draw_step` on an environment's arrays (``M``: its monitor, the step's start
+        at ``M[M_T]``), its plan bound to them (:func:`physics.jit.bound`): a callable of the
+        environment's generator; None without noise."""
+        if self.noise == 0.0:
+            return None
+        counts = np.zeros(1, dtype=np.int64)
+        plan = bound(plan_rows, np.zeros(1, dtype=np.int64), M[None], self.dt, self.rate, Z[None],
+                     self.z[None], self.state[None], counts)
+        return partial(self._drawn, plan, counts, Z, {})
+
+    def _drawn(self, plan, counts: np.ndarray, Z: np.ndarray, views: dict,
+               rng: np.random.Generator) -> None:
+        """The bound :meth:`draw_step` (:meth:`drawer`): ``plan`` fills ``counts``, the rows of
+        ``Z`` to draw (their flat views kept in ``views``)."""
+        plan()
+        rows = counts.item()
+        flat = views.get(rows)
+        if flat is None:
+            flat = views[rows] = _flat(Z[:rows])
+        rng.standard_normal(out=flat)
+        if Z is not self._Z:                    # where the Python measurement reads them
+            self._Z, self._rows = Z, {}
+
     def _normals(self, rng: np.random.Generator) -> np.ndarray:
         """The rows holding the coming measurement's normals from row ``state[2]`` on: the
         ``Z`` of :meth:`draw_step`, else its own rows, drawn now (row 0)."""
