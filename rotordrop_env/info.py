@@ -94,33 +94,39 @@ class StepInfo:
         self._template: dict = {}
 
     def __call__(self, v: np.ndarray, latency: int) -> dict:
-        return self.made(list(v[:_NF]), v, latency)
+        return self.made(list(v[:_NF]), v[_NF:].tobytes(), latency, v[K.V_TIME])
 
-    def made(self, floats: list, v: np.ndarray, latency: int) -> dict:
-        """The info of the numbers ``v`` (``(N_V,)``) whose float entries are ``floats``
-        (fresh numpy scalars)."""
-        key = (v[_NF:].tobytes(), latency)
+    def made(self, floats: list, rest: bytes, latency: int, time) -> dict:
+        """The info of one environment's numbers (``(N_V,)``): its float entries ``floats``
+        (fresh numpy scalars), the bytes ``rest`` of the entries after them, its latency and
+        its time ``time`` (a numpy scalar of its own)."""
+        key = (rest, latency)
         if key != self._key:
             self._key = key
-            self._template = _one([None] * _NF, _tail(v.tolist(), latency, self.relevitate),
+            numbers = [0.0] * _NF + np.frombuffer(rest).tolist()
+            self._template = _one([None] * _NF, _tail(numbers, latency, self.relevitate),
                                   None, self.relevitate)
         info = self._template.copy()             # keys in order, the bools and the latency
         info.update(zip(FLOAT_KEYS, floats))
-        info["kpi_episode_time_s"] = v[K.V_TIME]
+        info["kpi_episode_time_s"] = time
         return info
 
 
 def row_infos(v: np.ndarray, latency: np.ndarray, relevitate: bool,
               step_infos: list[StepInfo] | None = None) -> list[dict]:
     """Each environment's info (numpy scalars, as a single environment's) from the numbers
-    ``v`` of N, ``(N, N_V)``: the SB3 VecEnv's list of infos (the float scalars made in one
+    ``v`` of N, ``(N, N_V)``: the SB3 VecEnv's list of infos (the numpy scalars made in one
     pass); ``step_infos``: each row's :class:`StepInfo` (the environments' own), else new ones."""
+    n = v.shape[0]
     floats = list(v[:, :_NF].ravel())
+    times = list(v[:, K.V_TIME])
+    rest = np.ascontiguousarray(v[:, _NF:]).tobytes()
+    size = len(rest) // n if n else 0
     lat = np.asarray(latency, dtype=np.int64).tolist()
     if step_infos is None:
-        step_infos = [StepInfo(relevitate) for _ in range(v.shape[0])]
-    return [s.made(floats[e * _NF:(e + 1) * _NF], v[e], lat[e])
-            for e, s in enumerate(step_infos)]
+        step_infos = [StepInfo(relevitate) for _ in range(n)]
+    return [s.made(floats[e * _NF:(e + 1) * _NF], rest[e * size:(e + 1) * size], lat[e],
+                   times[e]) for e, s in enumerate(step_infos)]
 
 
 def kpi_keys(info: dict) -> dict:
