@@ -103,5 +103,5 @@ def bound(kernel, *args):
             kernel.compile(types)                   # compiled, or loaded from the disk cache
             overload = kernel.overloads[types]
         return partial(overload.entry_point, *args)
-    except (AttributeError, KeyError, TypeError):
+    except Exception:                               # the dispatcher raises its own errors
         return partial(kernel, *args)
