@@ -10,14 +10,17 @@ in the controller seat (``--control-dt``) as ratios to Gymnasium's ``Pendulum-v1
 With ``--control-dt`` (one or more control steps [s]) it measures only the controller seat
 (:mod:`agents.control.seats`): ``RotorDrop-Full-v1`` with raw coil currents
 (``command="continuous"``) and dampers, the robust suite's sensor noise and the middle of its
-sensor delay range, random actions, resets as episodes end. Per step and repeat it times
-``Pendulum-v1`` (``gym.make``, random actions) and then the single env (``gym.make`` and
-``env.unwrapped``), the SB3 batch ``BatchedRotorDropVecEnv`` (one numba thread: per core) and
-the Gymnasium vector env (``gymnasium.make_vec``, one thread), and prints each rate's median
-and the median of its per-repeat ratios to Pendulum-v1's rate (the machine's speed cancels),
-then the cost split of a step and what the physics is made of (right-hand sides per step, the
-cost of one at the episode's states, their share of the physics alone). ``--render JSON`` prints the table of docs/environments.md
-from that JSON (:func:`seat_table`).
+sensor delay range, random actions (``--law NAME``: the actions that designed law sends on
+the same episodes, recorded and replayed: what a learner near it steps), resets as episodes
+end. Per step and repeat it times ``Pendulum-v1`` (``gym.make``, random actions) and then the
+single env (``gym.make`` and ``env.unwrapped``), the SB3 batch ``BatchedRotorDropVecEnv`` (one
+numba thread: per core) and the Gymnasium vector env (``gymnasium.make_vec``, one thread),
+each from a seeded reset (every round the same episodes; every environment of a batch steps as
+many steps as the single env), and prints each rate's median and the median of its per-repeat
+ratios to Pendulum-v1's rate (the machine's speed cancels), then the cost split of a step and
+what the physics is made of (right-hand sides per step, the cost of one at the episode's
+states, their share of the physics alone). ``--render JSON`` prints the table of
+docs/environments.md from that JSON (:func:`seat_table`).
 
 Paper scene, default environment settings (episode 0.3 s = 300 steps, 5 monitor samples per
 step), whole episodes including resets. Every figure is the median of ``--repeats`` runs after a
@@ -44,13 +47,14 @@ import argparse
 import json
 import statistics
 import time
+from typing import Callable, NamedTuple
 
 import gymnasium as gym
 import numba
 import numpy as np
 
 import rotordrop_env
-from physics._jit import njit
+from physics._jit import bound, njit
 from physics.scene import parse_assignment
 from physics.integrate import integrate_sensed
 from physics.model import U_SENS_NOISE, rhs
@@ -118,10 +122,12 @@ def cost_split(env_id: str, kwargs: dict, episodes: int, seed: int = 0,
             return total / steps * 1e6
         return run
 
+    step = bound(K.step_one, *u._args)     # as the environment calls it (no dispatch)
+
     def kernel_step(a):
         u._b.act[:] = a
         u.draw_noise()                      # the sensor noise samples inside the step
-        K.step_one(*u._args)
+        step()
         return bool(u._b.out[K.O_TERM] or u._b.out[K.O_TRUNC])
 
     def unwrapped_step(a):
@@ -254,82 +260,109 @@ def seat_kwargs(control_dt: float, overrides: dict | None = None) -> dict:
     return dict(kw, overrides=dict(overrides)) if overrides else kw
 
 
-def stepping_rate(env, steps: int, seed: int = 0, acts: list | None = None):
-    """Steps per second of a single env (``gym.make``'d or unwrapped) over ``steps`` steps with
-    seeded random actions, reset as episodes end; or replaying ``acts`` (:func:`law_actions`:
-    what a designed law sent on these very episodes, from a reset with ``seed``)."""
-    space = env.action_space
-    space.seed(seed)
-    replay = acts is not None
-    acts = acts if replay else [space.sample() for _ in range(1024)]
-    env.reset(seed=seed)
-
-    def run():
-        if replay:                                      # the recorded episodes again
-            env.reset(seed=seed)
-        else:
-            env.reset()
-        t0 = CLOCK()
-        for k in range(steps):
-            _, _, te, tr, _ = env.step(acts[k % len(acts)])
-            if te or tr:
-                env.reset()
-        return steps / (CLOCK() - t0)
-    return run
+class Face(NamedTuple):
+    """One way to step the seat's environment: what a designed law reads its plant from, the
+    environments per step, the shape of one step's action (a batch's: a row per environment),
+    a seeded reset (the same episodes every time; returns the observation) and one step
+    (returns the next observation and where episodes start: reset as they end)."""
+    env: object
+    n: int
+    shape: tuple
+    reset: Callable[[], np.ndarray]
+    step: Callable[[np.ndarray], tuple]
 
 
-def law_actions(env_id: str, kwargs: dict, law: str, steps: int, seed: int = 0) -> list:
-    """The actions designed law ``law`` sends over ``steps`` steps of ``env_id`` from a reset
-    with ``seed``, reset as episodes end: replayed open loop, they drive the same episodes
-    again (the environment is deterministic given its seed and actions) without the law's
-    own cost in the timing."""
+def single_face(env, seed: int = 0) -> Face:
+    """A single env, ``gym.make``'d or unwrapped (reset by the caller as episodes end)."""
+    def reset():
+        return env.reset(seed=seed)[0]
+
+    def step(a):
+        obs, _, te, tr, _ = env.step(a)
+        if te or tr:
+            obs = env.reset()[0]
+        return obs, te or tr
+    return Face(env, 1, env.action_space.shape, reset, step)
+
+
+def sb3_face(venv, seed: int = 0) -> Face:
+    """The SB3 batch (environment i seeded ``seed + i``; auto-reset)."""
+    def reset():
+        venv.seed(seed)
+        return venv.reset()
+
+    def step(a):
+        obs, _, dones, _ = venv.step(a)
+        return obs, dones
+    return Face(venv, venv.num_envs, (venv.num_envs,) + venv.action_space.shape, reset, step)
+
+
+def vector_face(venv, seed: int = 0) -> Face:
+    """The Gymnasium vector env (environment i seeded ``seed + i``; same-step autoreset)."""
+    def reset():
+        return venv.reset(seed=seed)[0]
+
+    def step(a):
+        obs, _, te, tr, _ = venv.step(a)
+        return obs, te | tr
+    return Face(venv, venv.num_envs, venv.action_space.shape, reset, step)
+
+
+def face_actions(face: Face, steps: int, law: str | None = None, seed: int = 0) -> list:
+    """``steps`` actions of ``face``: seeded uniform random ones, or the ones designed law
+    ``law`` sends on the face's episodes from its reset (closed loop, recorded: replayed open
+    loop they drive the same episodes again, the environment being deterministic given its
+    seed and actions, without the law's own cost in the timing)."""
+    if law is None:
+        rng = np.random.default_rng(seed)
+        return [rng.uniform(-1, 1, face.shape).astype(np.float32) for _ in range(steps)]
     from agents.control.controllers import make_baseline
     from agents.control.plant import Plant
-    env = gym.make(env_id, **kwargs)
-    ctrl = make_baseline(law, Plant.from_env(env))
-    obs, _ = env.reset(seed=seed)
-    start, acts = True, []
+    ctrl = make_baseline(law, Plant.from_env(face.env))
+    obs, start, acts = face.reset(), np.ones(face.n, dtype=bool), []
     for _ in range(steps):
-        a, _ = ctrl.predict(obs, episode_start=np.array([start]))
-        acts.append(np.asarray(a, dtype=env.action_space.dtype))
-        obs, _, te, tr, _ = env.step(acts[-1])
-        start = bool(te or tr)
-        if start:
-            obs, _ = env.reset()
+        a, _ = ctrl.predict(obs, episode_start=start)
+        acts.append(np.asarray(a, dtype=np.float32))
+        obs, start = face.step(acts[-1])
+        start = np.atleast_1d(start)
     return acts
 
 
-def vector_rate(env_id: str, kwargs: dict, n_envs: int, steps: int, seed: int = 0):
-    """Env steps per second of the Gymnasium vector env on one thread (same-step autoreset)."""
-    venv = gym.make_vec(env_id, num_envs=n_envs, vectorization_mode="vector_entry_point",
-                        n_threads=1, **kwargs)
-    venv.action_space.seed(seed)
-    acts = [venv.action_space.sample() for _ in range(64)]
-    venv.reset(seed=seed)
+def face_rate(face: Face, acts: list):
+    """Env steps per second of ``face`` over ``acts`` from its seeded reset (every run the
+    same episodes)."""
+    step = face.step
 
     def run():
+        face.reset()
         t0 = CLOCK()
-        for k in range(steps):
-            venv.step(acts[k % len(acts)])
-        return steps * n_envs / (CLOCK() - t0)
+        for a in acts:
+            step(a)
+        return len(acts) * face.n / (CLOCK() - t0)
     return run
 
 
 def seat_cases(control_dt: float, n_envs: int, steps: int, overrides: dict | None = None,
-               acts: list | None = None) -> dict:
+               law: str | None = None) -> dict:
     """The timed runs of the controller seat at ``control_dt`` (each returns steps/s), warmed
-    up: Pendulum-v1, the single env (``gym.make``, unwrapped), the SB3 batch and the vector env
-    (``n_envs``, one thread); ``overrides``: scene keys. With ``acts`` (a law's, replayed:
-    :func:`law_actions`) the single env only."""
+    up: Pendulum-v1 (4 x ``steps``), the single env (``gym.make``, unwrapped) over ``steps``
+    steps, the SB3 batch and the vector env (``n_envs``, one thread), each of whose
+    environments steps ``steps`` steps too (the same span of the same episodes as the single
+    env: environment 0 of a batch is the single env); ``overrides``: scene keys; ``law``: every
+    case but Pendulum-v1 driven by that designed law's actions (:func:`face_actions`), else
+    by random ones."""
     kw = seat_kwargs(control_dt, overrides)
-    batch_steps = max(1, steps // n_envs)
-    cases = {PENDULUM: stepping_rate(gym.make(PENDULUM), 4 * steps),
-             "single (gym.make)": stepping_rate(gym.make(SEAT_ENV, **kw), steps, acts=acts),
-             "single (unwrapped)": stepping_rate(gym.make(SEAT_ENV, **kw).unwrapped, steps,
-                                                 acts=acts)}
-    if acts is None:
-        cases[f"SB3 batch N={n_envs}, per core"] = batched_rate(SEAT_ENV, kw, n_envs, batch_steps, 1)
-        cases[f"vector env N={n_envs}, per core"] = vector_rate(SEAT_ENV, kw, n_envs, batch_steps)
+    faces = {"single (gym.make)": single_face(gym.make(SEAT_ENV, **kw)),
+             "single (unwrapped)": single_face(gym.make(SEAT_ENV, **kw).unwrapped),
+             f"SB3 batch N={n_envs}, per core": sb3_face(
+                 rotordrop_env.BatchedRotorDropVecEnv(SEAT_ENV, n_envs, n_threads=1, **kw)),
+             f"vector env N={n_envs}, per core": vector_face(
+                 gym.make_vec(SEAT_ENV, num_envs=n_envs, vectorization_mode="vector_entry_point",
+                              n_threads=1, **kw))}
+    pendulum = single_face(gym.make(PENDULUM))
+    cases = {PENDULUM: face_rate(pendulum, face_actions(pendulum, 4 * steps))}
+    for name, face in faces.items():
+        cases[name] = face_rate(face, face_actions(face, steps, law))
     for run in cases.values():                          # warm-up (JIT, scenario caches)
         run()
     return cases
@@ -339,11 +372,11 @@ def seat_speed(control_dt: float, repeats: int, n_envs: int, steps: int,
                overrides: dict | None = None, law: str | None = None) -> dict:
     """The controller seat's rates at ``control_dt`` and their ratios to Pendulum-v1's, each
     the median over ``repeats`` rounds that time every case once (module doc); ``overrides``:
-    scene keys for every case; ``law``: the single env driven by that designed law's actions
+    scene keys for every case; ``law``: every case driven by that designed law's actions
     (recorded, replayed) instead of random ones."""
     kw = seat_kwargs(control_dt, overrides)
-    acts = law_actions(SEAT_ENV, kw, law, steps) if law else None
-    cases = seat_cases(control_dt, n_envs, steps, overrides, acts)
+    acts = face_actions(single_face(gym.make(SEAT_ENV, **kw)), steps, law) if law else None
+    cases = seat_cases(control_dt, n_envs, steps, overrides, law)
     rounds = [{name: run() for name, run in cases.items()} for _ in range(repeats)]
     out = {"control_dt_s": control_dt, "env_id": SEAT_ENV, "env_kwargs": kw, "repeats": repeats,
            "actions": law or "random", "rates": {}, "ratio_to_pendulum": {}}
@@ -390,17 +423,33 @@ def _seat_label(r: dict) -> str:
             + ("" if law == "random" else f", `{law}`'s actions"))
 
 
+#: the controller seat's speed targets, × Pendulum-v1's steps/s: a single environment, and a
+#: batch per core (1.5 × the single environment's target)
+SINGLE_TARGET = 0.5
+BATCH_TARGET = 1.5 * SINGLE_TARGET
+
+
+def target_of(case: str) -> float | None:
+    """The speed target of a seat case (:data:`SINGLE_TARGET`, :data:`BATCH_TARGET`; None:
+    Pendulum-v1, the reference)."""
+    if case == PENDULUM:
+        return None
+    return SINGLE_TARGET if case.startswith("single") else BATCH_TARGET
+
+
 def seat_table(res: dict) -> str:
     """The markdown table of a ``--control-dt`` run's JSON (docs/environments.md pastes it
     between its markers; ``--render JSON`` prints it)."""
-    rows = ["| control step | case | env steps/s | × Pendulum-v1 (median of per-round ratios) |",
-            "|---|---|---|---|"]
+    rows = ["| control step | case | env steps/s | × Pendulum-v1 (median of per-round ratios) "
+            "| target |", "|---|---|---|---|---|"]
     for r in res["seat"]:
         dt = _seat_label(r)
         for name, rate in r["rates"].items():
-            ratio = r["ratio_to_pendulum"].get(name)
+            ratio, target = r["ratio_to_pendulum"].get(name), target_of(name)
+            verdict = "" if target is None else \
+                f"≥ {target:g}: {'met' if ratio >= target else 'not met'}"
             rows.append(f"| {dt} | {name} | {rate:,.0f} | "
-                        f"{'1 (reference)' if ratio is None else f'{ratio:.2f}'} |")
+                        f"{'1 (reference)' if ratio is None else f'{ratio:.2f}'} | {verdict} |")
     rows += ["", "| control step | physics | + monitors, reward, obs | + Python `step` | "
              "+ wrappers | `env.step` | physics share | integrator steps (rejected), "
              "right-hand sides | a right-hand side (share of the physics) | physics alone, × "
@@ -420,8 +469,9 @@ def seat_table(res: dict) -> str:
     kw = res["seat"][0]["env_kwargs"]
     rows += ["", f"{res['seat'][0]['env_id']}, "
              + ", ".join(f"`{k}={v!r}`" for k, v in kw.items() if k not in ("control_dt", "overrides"))
-             + f"; {res['steps']} env steps per case and round, {res['seat'][0]['repeats']} "
-             f"rounds, N = {res['n_envs']}, {res['clock']} clock."]
+             + f"; {res['steps']} steps of every environment per case and round (a batch's "
+             f"N = {res['n_envs']} each), {res['seat'][0]['repeats']} rounds, {res['clock']} "
+             "clock."]
     return "\n".join(rows) + "\n"
 
 
@@ -456,9 +506,10 @@ def main(argv=None) -> int:
                         "step with this scene override (repeatable), e.g. solver.rtol=1e-4: "
                         "what a looser tolerance buys")
     p.add_argument("--law", action="append", default=[], metavar="NAME",
-                   help="with --control-dt: one more run at the first control step whose single "
-                        "env replays the actions this designed law sent on the same episodes "
-                        "(repeatable), e.g. whirl-brake: what a learner near the law steps")
+                   help="with --control-dt: one more run at each control step whose cases "
+                        "(single, batch, vector) replay the actions this designed law sent on "
+                        "the same episodes (repeatable), e.g. whirl-brake: what a learner near "
+                        "the law steps")
     p.add_argument("--steps", type=int, default=3000,
                    help="env steps per controller-seat run (per case and round)")
     p.add_argument("--render", default=None, metavar="JSON",
@@ -478,8 +529,8 @@ def main(argv=None) -> int:
                + [seat_speed(args.control_dt[0], args.repeats, args.n_envs, args.steps,
                              dict(overrides, **dict([parse_assignment(a)])))
                   for a in args.compare_set]
-               + [seat_speed(args.control_dt[0], args.repeats, args.n_envs, args.steps,
-                             overrides, law) for law in args.law]}
+               + [seat_speed(dt, args.repeats, args.n_envs, args.steps, overrides, law)
+                  for law in args.law for dt in args.control_dt]}
         for r in res["seat"]:
             _print_seat(r)
         _write(args.json, res)

@@ -35,6 +35,7 @@ from . import kernels as K
 from .buffers import Buffers
 from .env import RotorDropEnv, real_action
 from .info import info_dict
+from .sensors import SensingRows
 
 
 ENVS_PER_THREAD = 4      # fewer environments per thread than this never pay the parallel launch
@@ -108,9 +109,15 @@ class Batch:
         self.reward = first.reward_function
         self.sensed = any(env._sensing.active for env in envs)
         self.noisy = any(env._sensing.noise > 0.0 for env in envs)
+        #: the sensing of all rows on stacked arrays (None: row by row, the Python measurement)
+        self.sensing = (SensingRows([env._sensing for env in envs], self.stack)
+                        if self.sensed and all(env._sensing.compiled for env in envs) else None)
+        for env in envs:
+            env._calls = None                   # bound again to the stacked sensing rows
         self.rendering = first.render_mode is not None
         self.latency = np.zeros(n, dtype=np.int64)        # each env's observation latency
         self.values = np.zeros((n, K.N_V))                # the info numbers (rotordrop_env.info)
+        self.step_infos = [env._step_info for env in envs]  # each row's info templates
         if n_threads is not None and not 1 <= int(n_threads) <= numba.config.NUMBA_NUM_THREADS:
             raise ValueError(f"n_threads = {n_threads!r} must be in [1, "
                              f"{numba.config.NUMBA_NUM_THREADS}] (numba's NUMBA_NUM_THREADS)")
@@ -158,8 +165,11 @@ class Batch:
         e, err = K.first_bad_action(act, stack.C)
         if e >= 0:                                # before any env advances; single env's message
             self.envs[e]._action_error(err, a[e])
-        if self.noisy:                            # the sensor samples inside the step
-            for e in range(self.num_envs) if active is None else np.flatnonzero(active):
+        idx = None if active is None else np.flatnonzero(active)
+        if self.noisy and self.sensing is not None:   # the step's noise draws (.sensors)
+            self.sensing.draw([env.np_random for env in self.envs], idx)
+        elif self.noisy:
+            for e in range(self.num_envs) if active is None else idx:
                 self.envs[e].draw_noise()
         if active is None:
             self._step_kernel()
@@ -171,11 +181,19 @@ class Batch:
         if failed.size:                           # the single env's clear IntegrationError
             e = failed[0]
             self.envs[e]._finish(a[e])
-        obs = stack.obs.astype(np.float32)
-        rows = range(self.num_envs) if active is None else np.flatnonzero(active)
-        if self.sensed:                           # noise / latency (rotordrop_env.sensors)
-            for e in rows:
-                obs[e] = self.envs[e].observed()
+        rows = range(self.num_envs) if active is None else idx
+        if self.sensing is not None:              # noise / latency (rotordrop_env.sensors)
+            sensed = self.sensing.measure(idx)
+            if active is None:
+                obs = sensed.copy()
+            else:
+                obs = stack.obs.astype(np.float32)
+                obs[idx] = sensed[idx]
+        else:
+            obs = stack.obs.astype(np.float32)
+            if self.sensed:
+                for e in rows:
+                    obs[e] = self.envs[e].observed()
         rewards = self.reward.step(out, stack.M, stack.C, self.relevitate)
         if active is not None:
             rewards[~active] = 0.0
@@ -217,6 +235,8 @@ class Batch:
         self.__dict__.update(state)
         for e, env in enumerate(self.envs):
             env._use(self.stack.row(e))
+        if self.sensing is not None:
+            self.sensing.attach(self.stack)
         self._args = self.stack.args()
 
     def close(self) -> None:

@@ -20,8 +20,9 @@ class Buffers:
     def __init__(self, n_state: int, n_obs: int, n_act: int, n_sub: int, packed: dict[str, int],
                  n_envs: int | None = None, n_noise: int = 0):
         """``packed``: lengths of the physics' packed arrays ``P``, ``I``, ``U``, ``aux``
-        (:attr:`physics.model.Model.sizes`); ``n_noise``: the most sensor noise samples inside
-        one control step (rows of ``Z``, :meth:`rotordrop_env.sensors.Sensing.draw_step`)."""
+        (:attr:`physics.model.Model.sizes`); ``n_noise``: the rows of ``Z``, the most sensor
+        noise samples inside one control step and the measurement's after it
+        (:attr:`rotordrop_env.sensors.Sensing.n_noise`)."""
         lead = () if n_envs is None else (n_envs,)
         shapes = dict(act=(n_act,), y=(n_state,), P=(packed["P"],), I=(packed["I"],),
                       U=(packed["U"],), Z=(n_noise, 4), atol=(n_state,), work=(9, n_state), t_sub=(n_sub,),

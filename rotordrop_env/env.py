@@ -13,12 +13,14 @@ the episode view (:mod:`.view`) and the step kernels (:mod:`.kernels`).
 from __future__ import annotations
 
 import math
+from typing import Callable, NamedTuple
 
 import gymnasium as gym
 import numpy as np
 
 from physics.amb import static_weight_share
 from physics.ball_bearing import max_contact_pressure
+from physics.jit import bound
 from physics.metrics import WHIRL_MIN_REVOLUTIONS, WHIRL_RADIUS_FRACTION
 from physics.scene import Scene, SceneError
 from physics.simulate import IntegrationError, explain_status
@@ -224,6 +226,22 @@ class RotorDropEnv(SettingsGuard, EpisodeView, gym.Env):
         """Step on these arrays as they are (a copied batch re-attaching its rows)."""
         self._b = buffers
         self._args = buffers.args()
+        self._calls = None                  # the compiled calls bound to them, at first use
+
+    def _bind_calls(self) -> "_Calls":
+        """The compiled calls of a step, bound to this environment's arrays
+        (:func:`physics.jit.bound`: no per-call dispatch; made again after a copy or a rebind)."""
+        b = self._b
+        self._calls = _Calls(bound(K.step_one, *self._args), bound(K.check_action, b.act, b.C),
+                             bound(K.info_values, b.out, b.M, b.C, self._values),
+                             self._sensing.measurer(b.obs, b.Z, b.U),
+                             self._sensing.drawer(b.M, b.Z))
+        return self._calls
+
+    def __getstate__(self) -> dict:
+        state = self.__dict__.copy()
+        state["_calls"] = None              # bound machine code does not pickle: bound again
+        return state
 
     def _configure_static(self, hold: float) -> None:
         """The kernel configuration fixed at construction: command modes, weights, monitors."""
@@ -295,15 +313,21 @@ class RotorDropEnv(SettingsGuard, EpisodeView, gym.Env):
     def step(self, action):
         if self._needs_reset or self._ended:
             self._check_steppable()
+        calls = self._calls or self._bind_calls()
         load_action(action, self._b.act, self.action_space, self.action_names)
-        self.draw_noise()
-        K.step_one(*self._args)
+        if calls.draw is not None:              # the sensor noise (rotordrop_env.sensors)
+            err = calls.check()                 # a refused action draws none (as in a batch)
+            if err:
+                self._action_error(err, action)
+            calls.draw(self.np_random)
+        calls.step()
         return self._finish(action)
 
     def draw_noise(self) -> None:
-        """Before a kernel step: the sensor noise samples inside it (:mod:`.sensors`)."""
+        """Before a kernel step (its action checked): the sensor noise samples inside it and
+        the measurement's after it (:meth:`rotordrop_env.sensors.Sensing.draw_step`)."""
         if self._sensing.noise > 0.0:
-            self._sensing.draw_step(self._b.M[K.M_T], self._b.Z, self.np_random)
+            (self._calls or self._bind_calls()).draw(self.np_random)
 
     def _check_open(self, what: str) -> None:
         if self._closed:
@@ -347,7 +371,10 @@ class RotorDropEnv(SettingsGuard, EpisodeView, gym.Env):
         once per step, it takes the measurement)."""
         if not self._sensing.active:
             return self._b.obs.astype(np.float32)
-        return self._sensing.step(self._b.obs, self.np_random, self._b.U)
+        measure = (self._calls or self._bind_calls()).measure
+        if measure is None:                     # the supervisor's orbit entries
+            return self._sensing.step(self._b.obs, self.np_random, self._b.U)
+        return measure(self.np_random)
 
     def _action_error(self, err: int, action) -> None:
         """Raise the ValueError of a refused action (``err``: the kernel's ERR_* code)."""
@@ -355,8 +382,7 @@ class RotorDropEnv(SettingsGuard, EpisodeView, gym.Env):
 
     def _info(self) -> dict:
         """The ``info`` of the reset or step just taken (:mod:`rotordrop_env.info`)."""
-        b = self._b
-        K.info_values(b.out, b.M, b.C, self._values)
+        (self._calls or self._bind_calls()).info()
         return self._step_info(self._values, self._sensing.k)
 
     def kpis(self) -> dict:
@@ -379,6 +405,17 @@ class RotorDropEnv(SettingsGuard, EpisodeView, gym.Env):
     def state(self) -> np.ndarray:
         """A copy of the physical state vector (names: ``env.unwrapped.model.names``)."""
         return self._b.y.copy()
+
+
+class _Calls(NamedTuple):
+    """The compiled calls of one environment's step on its arrays (:meth:`RotorDropEnv._bind_calls`):
+    the kernel step, the action check, the info numbers, the measurement (None: the Python one)
+    and the noise draws before a step (None without noise)."""
+    step: Callable[[], None]
+    check: Callable[[], int]
+    info: Callable[[], None]
+    measure: Callable[[np.random.Generator], np.ndarray] | None
+    draw: Callable[[np.random.Generator], None] | None
 
 
 def start_episode(b: Buffers, fs, n_steps: int, dt: float, power_return: float | None,

@@ -84,32 +84,49 @@ def _one(floats: list, tail: list, time, relevitate: bool) -> dict:
 
 
 class StepInfo:
-    """The ``info`` of one environment, made at every step: :func:`info_dict`'s, the bools and
-    the latency (which change a few times per episode at most) reused from the previous step
-    while their numbers are the same."""
+    """The ``info`` of one environment, made at every step: :func:`info_dict`'s, built on a
+    template holding the bools and the latency (which change a few times per episode at most),
+    made again only when their numbers change, and copied with the step's numbers."""
 
     def __init__(self, relevitate: bool):
         self.relevitate = relevitate
         self._key: tuple | None = None
-        self._tail: list = []
+        self._template: dict = {}
 
     def __call__(self, v: np.ndarray, latency: int) -> dict:
-        key = (v[_NF:].tobytes(), latency)
+        return self.made(list(v[:_NF]), v[_NF:].tobytes(), latency, v[K.V_TIME])
+
+    def made(self, floats: list, rest: bytes, latency: int, time) -> dict:
+        """The info of one environment's numbers (``(N_V,)``): its float entries ``floats``
+        (fresh numpy scalars), the bytes ``rest`` of the entries after them, its latency and
+        its time ``time`` (a numpy scalar of its own)."""
+        key = (rest, latency)
         if key != self._key:
-            self._key, self._tail = key, _tail(v.tolist(), latency, self.relevitate)
-        return _one(list(v[:_NF]), self._tail, v[K.V_TIME], self.relevitate)
+            self._key = key
+            numbers = [0.0] * _NF + np.frombuffer(rest).tolist()
+            self._template = _one([None] * _NF, _tail(numbers, latency, self.relevitate),
+                                  None, self.relevitate)
+        info = self._template.copy()             # keys in order, the bools and the latency
+        info.update(zip(FLOAT_KEYS, floats))
+        info["kpi_episode_time_s"] = time
+        return info
 
 
-def row_infos(v: np.ndarray, latency: np.ndarray, relevitate: bool) -> list[dict]:
+def row_infos(v: np.ndarray, latency: np.ndarray, relevitate: bool,
+              step_infos: list[StepInfo] | None = None) -> list[dict]:
     """Each environment's info (numpy scalars, as a single environment's) from the numbers
-    ``v`` of N, ``(N, N_V)``: the SB3 VecEnv's list of infos (every numpy scalar made in one
-    pass per kind)."""
+    ``v`` of N, ``(N, N_V)``: the SB3 VecEnv's list of infos (the numpy scalars made in one
+    pass); ``step_infos``: each row's :class:`StepInfo` (the environments' own), else new ones."""
+    n = v.shape[0]
     floats = list(v[:, :_NF].ravel())
-    numbers = v.tolist()
-    lat = np.asarray(latency, dtype=np.int64).tolist()
     times = list(v[:, K.V_TIME])
-    return [_one(floats[e * _NF:(e + 1) * _NF], _tail(numbers[e], lat[e], relevitate), times[e],
-                 relevitate) for e in range(v.shape[0])]
+    rest = np.ascontiguousarray(v[:, _NF:]).tobytes()
+    size = len(rest) // n if n else 0
+    lat = np.asarray(latency, dtype=np.int64).tolist()
+    if step_infos is None:
+        step_infos = [StepInfo(relevitate) for _ in range(n)]
+    return [s.made(floats[e * _NF:(e + 1) * _NF], rest[e * size:(e + 1) * size], lat[e],
+                   times[e]) for e, s in enumerate(step_infos)]
 
 
 def kpi_keys(info: dict) -> dict:

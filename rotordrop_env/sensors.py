@@ -35,13 +35,14 @@ from __future__ import annotations
 
 import math
 import numbers
+from functools import partial
 
 import numpy as np
 
-from physics.jit import njit
+from physics.jit import bound, njit
 from physics.sensor import on_sample, samples_inside
 
-from .kernels import SUP_MIN_RADIUS
+from .kernels import M_T, SUP_MIN_RADIUS
 from .layout import SUPERVISOR_OBS
 
 #: interval of the velocity estimate that the velocity noise stands for [s]
@@ -100,7 +101,12 @@ class Sensing:
     """The noisy, delayed observation of one environment (module doc).
 
     ``obs_names``/``obs_scale``: the environment's layout (normalised obs x scale = SI);
-    ``clearance`` [m] for the orbit's dead zone."""
+    ``clearance`` [m] for the orbit's dead zone.
+
+    A step's standard normals are drawn in one call (:meth:`draw_step`, before the kernel
+    step): the samples strictly inside the step, then the measurement's after it (4 of a new
+    displacement sample at a sample instant, then 4 of the velocity estimates), the very
+    numbers, in the very order, of one draw per sample and one per measurement."""
 
     def __init__(self, noise: float, latency: tuple[int, int], obs_names, obs_scale,
                  clearance: float, noise_control: int, sample_rate: float = 1e4,
@@ -109,8 +115,10 @@ class Sensing:
         self.noise, self.latency = noise, latency
         self.rate, self.dt = sample_rate, control_dt
         self.z = np.zeros(4)                    # standard normals of the held noise sample
-        self.fresh = True                       # a sample instant at the coming measurement
-        self.last_drawn = 0                     # samples inside the last step (draw_step)
+        #: measurements taken this episode, latency k, the first row of the coming
+        #: measurement's normals (draw_step's; -1: not drawn), a sample instant at it (1/0),
+        #: samples inside the last step (draw_step)
+        self.state = np.array([0, 0, -1, 1, 0], dtype=np.int64)
         self.noise_control = noise_control      # first of the 4 noise controls in U
         self.active = noise > 0.0 or latency[1] > 0
         self.time_col = names.index("time")
@@ -129,78 +137,167 @@ class Sensing:
         self.buffer = np.zeros((latency[1] + 1, len(names)))
         self._cols = self.cols if noise > 0.0 else np.zeros(0, dtype=np.int64)   # for _sense
         self._sigma = self.sigma if noise > 0.0 else np.zeros(0)
-        self.k = 0
-        self.n = 0                      # measurements taken this episode
+        self._own = np.zeros((2, 4))            # the measurement's normals drawn by itself
+        self._Z, self._rows = None, {}          # draw_step's Z and its flat views by rows
+
+    def __getstate__(self) -> dict:
+        state = self.__dict__.copy()            # the views of Z are made again (copies break
+        state["_Z"], state["_rows"] = None, {}  # them)
+        return state
+
+    @property
+    def k(self) -> int:
+        """The episode's observation latency [control steps]."""
+        return int(self.state[1])
+
+    @property
+    def n(self) -> int:
+        """Measurements taken this episode."""
+        return int(self.state[0])
+
+    @property
+    def fresh(self) -> bool:
+        """A sensor sample instant falls on the coming measurement."""
+        return bool(self.state[3])
+
+    @property
+    def last_drawn(self) -> int:
+        """Sensor samples strictly inside the last step (:meth:`draw_step`)."""
+        return int(self.state[4])
+
+    @property
+    def compiled(self) -> bool:
+        """Every measurement is the compiled one (the supervisor's orbit entries with noise
+        take the Python path)."""
+        return self.noise == 0.0 or self.orbit is None
 
     @property
     def n_noise(self) -> int:
-        """The most sensor samples strictly inside one control step (rows of the kernel's
-        ``Z``); 0 without noise."""
-        return math.ceil(self.dt * self.rate) + 1 if self.noise > 0.0 else 0
+        """Rows of the kernel's ``Z``: the most sensor samples strictly inside one control step,
+        then the 2 rows of the measurement after it (:meth:`draw_step`); 0 without noise."""
+        return math.ceil(self.dt * self.rate) + 3 if self.noise > 0.0 else 0
 
     def reset(self, true_obs: np.ndarray, rng: np.random.Generator,
               U: np.ndarray | None = None) -> np.ndarray:
         """Start an episode: draw its latency k, take the first measurement (with a fresh
         noise sample: the sensor's sample current at the episode's start)."""
         lo, hi = self.latency
-        self.k = int(rng.integers(lo, hi + 1)) if hi > lo else lo
-        self.n = 0
-        self.fresh = True
+        self.state[:] = (0, int(rng.integers(lo, hi + 1)) if hi > lo else lo, -1, 1, 0)
         return self.step(true_obs, rng, U)
 
     def draw_step(self, t0: float, Z: np.ndarray, rng: np.random.Generator) -> int:
         """Before a control step from ``t0``: the standard normals of the noise samples at the
-        sensor's sample instants strictly inside the step into ``Z`` (the kernel holds them in
-        turn, :func:`physics.integrate.integrate_sensed`); a sample at the step's end is drawn
-        by the measurement after it. Returns their number (0, nothing drawn, without noise)."""
+        sensor's sample instants strictly inside the step into ``Z``'s first rows (the kernel
+        holds them in turn, :func:`physics.integrate.integrate_sensed`), and in the rows after
+        them the normals of the measurement after the step (a sample at the step's end is its
+        new displacement sample), in one draw. Returns the number of samples inside (0,
+        nothing drawn, without noise)."""
         if self.noise == 0.0:
             return 0
-        t1 = t0 + self.dt                       # as the kernel computes it
-        _, n = samples_inside(t0, t1, self.rate)
-        self.last_drawn = n
-        if n > 0:
-            Z[:n] = rng.standard_normal((n, 4))
-            self.z = Z[n - 1].copy()
-        self.fresh = bool(on_sample(t1, self.rate))
-        return n
+        rows = plan_step(t0, self.dt, self.rate, Z, self.z, self.state)
+        if Z is not self._Z:
+            self._Z, self._rows = Z, {}
+        flat = self._rows.get(rows)
+        if flat is None:
+            flat = self._rows[rows] = _flat(Z[:rows])
+        rng.standard_normal(out=flat)
+        return self.last_drawn
 
-    def _draw(self, rng: np.random.Generator) -> np.ndarray:
-        """The measurement's standard normals: 4 of the displacement noise (a fresh sample at a
-        sample instant, else the held one), then 4 of the velocity estimates'."""
-        if self.fresh:
-            z = rng.standard_normal(len(self.cols))
-            self.z = z[:4].copy()
-            return z
-        return np.concatenate((self.z, rng.standard_normal(len(self.cols) - 4)))
+    def drawer(self, M: np.ndarray, Z: np.ndarray):
+        """:meth:`draw_step` on an environment's arrays (``M``: its monitor, the step's start
+        at ``M[M_T]``), its plan bound to them (:func:`physics.jit.bound`): a callable of the
+        environment's generator; None without noise."""
+        if self.noise == 0.0:
+            return None
+        counts = np.zeros(1, dtype=np.int64)
+        plan = bound(plan_rows, np.zeros(1, dtype=np.int64), M[None], self.dt, self.rate, Z[None],
+                     self.z[None], self.state[None], counts)
+        return partial(self._drawn, plan, counts, Z, {})
+
+    def _drawn(self, plan, counts: np.ndarray, Z: np.ndarray, views: dict,
+               rng: np.random.Generator) -> None:
+        """The bound :meth:`draw_step` (:meth:`drawer`): ``plan`` fills ``counts``, the rows of
+        ``Z`` to draw (their flat views kept in ``views``)."""
+        plan()
+        rows = counts.item()
+        flat = views.get(rows)
+        if flat is None:
+            flat = views[rows] = _flat(Z[:rows])
+        rng.standard_normal(out=flat)
+        if Z is not self._Z:                    # where the Python measurement reads them
+            self._Z, self._rows = Z, {}
+
+    def _normals(self, rng: np.random.Generator) -> np.ndarray:
+        """The rows holding the coming measurement's normals from row ``state[2]`` on: the
+        ``Z`` of :meth:`draw_step`, else its own rows, drawn now (row 0)."""
+        if self.state[2] >= 0:
+            return self._Z
+        self.state[2] = 0
+        if self.noise > 0.0:
+            rng.standard_normal(out=_flat(self._own[:1 + self.state[3]]))
+        return self._own
 
     def step(self, true_obs: np.ndarray, rng: np.random.Generator,
              U: np.ndarray | None = None) -> np.ndarray:
         """Measure ``true_obs`` (normalised, as the kernel wrote it) and return the float32
         observation the agent sees now; the displacement noise sample goes to the controls ``U``
         (the physics' sensed displacement until the next measurement) when given."""
-        if U is not None and (self.noise == 0.0 or self.orbit is None):
+        if U is not None and self.compiled:
             # one compiled call, the same numbers as step_python (the supervisor's orbit
             # entries take the Python path)
-            z = self._draw(rng) if self.noise > 0.0 else _NO_DRAW
             out = np.empty(true_obs.shape[0], dtype=np.float32)
-            _sense(true_obs, z, self._sigma, self._cols, U, self.noise_control, self.noise,
-                   self.buffer, self.n, self.k, self.time_col, out)
-            self.n += 1
+            _sense(true_obs, self._normals(rng), self.z, self._sigma, self._cols, U,
+                   self.noise_control, self.noise, self.buffer, self.state, self.time_col, out)
             return out
         return self.step_python(true_obs, rng, U)
+
+    def measurer(self, true_obs: np.ndarray, Z: np.ndarray, U: np.ndarray):
+        """:meth:`step` on an environment's arrays after each :meth:`draw_step` into ``Z`` (or
+        without noise), bound to them (:func:`physics.jit.bound`): a callable returning the
+        observation (given the environment's random generator); None with the supervisor's
+        orbit entries (they take :meth:`step`)."""
+        if not self.compiled:
+            return None
+        out = np.empty(true_obs.shape[0], dtype=np.float32)
+        call = bound(_sense, true_obs, Z, self.z, self._sigma, self._cols, U, self.noise_control,
+                     self.noise, self.buffer, self.state, self.time_col, out)
+        return partial(self._measured, call, out, true_obs, U)
+
+    def _measured(self, call, out: np.ndarray, true_obs: np.ndarray, U: np.ndarray,
+                  rng: np.random.Generator) -> np.ndarray:
+        """The bound measurement ``call`` (:meth:`measurer`): a fresh copy of its observation
+        ``out``; :meth:`step` when no :meth:`draw_step` drew its normals."""
+        if self.noise > 0.0 and self.state[2] < 0:
+            return self.step(true_obs, rng, U)
+        call()
+        return out.copy()
 
     def step_python(self, true_obs: np.ndarray, rng: np.random.Generator,
                     U: np.ndarray | None = None) -> np.ndarray:
         """:meth:`step` in numpy (any settings; the reference of its compiled path)."""
         m = self._measure(true_obs, rng, U)
         L = len(self.buffer)
-        self.buffer[self.n % L] = m
-        if self.n == 0:
+        n = self.n
+        self.buffer[n % L] = m
+        if n == 0:
             self.buffer[:] = m
-        out = self.buffer[(self.n - min(self.k, self.n)) % L].astype(np.float32)
+        out = self.buffer[(n - min(self.k, n)) % L].astype(np.float32)
         out[self.time_col] = true_obs[self.time_col]
-        self.n += 1
+        self.state[0] += 1
+        self.state[2] = -1
         return out
+
+    def _draw(self, rng: np.random.Generator) -> np.ndarray:
+        """The measurement's standard normals: 4 of the displacement noise (a fresh sample at a
+        sample instant, else the one held: the last inside the step, if any), then 4 of the
+        velocity estimates'."""
+        rows, r = self._normals(rng), int(self.state[2])
+        if self.fresh:
+            self.z[:] = rows[r]
+            r += 1
+        elif r > 0:
+            self.z[:] = rows[r - 1]
+        return np.concatenate((self.z, rows[r]))
 
     def _measure(self, true_obs: np.ndarray, rng: np.random.Generator,
                  U: np.ndarray | None) -> np.ndarray:
@@ -228,30 +325,159 @@ class Sensing:
             m[self.orbit[2 + k]] = rate / self.scale[self.orbit[2 + k]]
 
 
-_NO_DRAW = np.zeros(0)
+def _flat(rows: np.ndarray) -> np.ndarray:
+    """``rows`` (contiguous) as one flat view (never a copy: the draws must land in them)."""
+    flat = rows.view()
+    flat.shape = (rows.size,)
+    return flat
 
 
 @njit
-def _sense(true_obs, z, sigma, cols, U, noise_control, noise, buffer, n, k, time_col, out):
+def plan_step(t0, dt, rate, Z, held, state):
+    """The draws of a control step from ``t0`` (:meth:`Sensing.draw_step`): its n sensor sample
+    instants strictly inside (:func:`physics.sensor.samples_inside`; t1 = t0 + dt, as the
+    kernel computes it) and whether one falls at its end, recorded in ``state`` (the
+    measurement's first row n, at its end, n); a step whose draws were not measured first
+    leaves its last sample inside ``held``. Returns the rows of ``Z`` to draw: n, then the
+    measurement's 1 (velocity) or, at a sample instant, 2 (a new displacement sample first)."""
+    if state[2] >= 0 and state[4] > 0:
+        for j in range(4):
+            held[j] = Z[state[4] - 1, j]
+    t1 = t0 + dt
+    n = samples_inside(t0, t1, rate)[1]
+    at_end = 1 if on_sample(t1, rate) else 0
+    state[2] = n
+    state[3] = at_end
+    state[4] = n
+    return n + at_end + 1
+
+
+@njit
+def plan_rows(rows, M, dt, rate, Z, HELD, STATE, counts):
+    """:func:`plan_step` of the environments ``rows`` of a batch (``M``: their monitors, the
+    step's start ``M[e, M_T]``): ``counts[i]``, the rows of ``Z[rows[i]]`` to draw."""
+    for i in range(rows.shape[0]):
+        e = rows[i]
+        counts[i] = plan_step(M[e, M_T], dt, rate, Z[e], HELD[e], STATE[e])
+
+
+@njit
+def sense_rows(rows, OBS, Z, HELD, sigma, cols, U, noise_control, noise, BUFFER, STATE,
+               time_col, OUT):
+    """:func:`_sense` of the environments ``rows`` of a batch, their observations into
+    ``OUT``."""
+    for i in range(rows.shape[0]):
+        e = rows[i]
+        _sense(OBS[e], Z[e], HELD[e], sigma, cols, U[e], noise_control, noise, BUFFER[e],
+               STATE[e], time_col, OUT[e])
+
+
+@njit
+def _sense(true_obs, Z, held, sigma, cols, U, noise_control, noise, buffer, state, time_col, out):
     """:meth:`Sensing.step` without the supervisor's orbit entries, compiled: the measurement
     (``true_obs`` + ``sigma`` z at ``cols``; the noise ``noise`` z of the 4 displacements into
-    ``U``) into the latency ring ``buffer`` (all of it at the episode's first measurement, n =
-    0) and the float32 observation of k measurements ago (its ``time`` the present) into ``out``."""
+    ``U``) into the latency ring ``buffer`` (all of it at the episode's first measurement,
+    ``state[0]`` = 0) and the float32 observation of k = ``state[1]`` measurements ago (its
+    ``time`` the present) into ``out``. z: the 4 displacement normals ``held`` (at a sample
+    instant, ``state[3]``, the new ones of row r = ``state[2]`` of ``Z``; else the last sample
+    inside the step, row r - 1, if any), then the 4 velocity normals of the next row; ``held``
+    keeps the displacement's; ``state[0]`` += 1, ``state[2]`` = -1."""
     L = buffer.shape[0]
+    n = state[0]
+    k = state[1]
     row = n % L
     for i in range(true_obs.shape[0]):
         buffer[row, i] = true_obs[i]
-    for j in range(cols.shape[0]):
-        buffer[row, cols[j]] += sigma[j] * z[j]
     if cols.shape[0] > 0:
+        r = state[2]
+        if state[3]:
+            for j in range(4):
+                held[j] = Z[r, j]
+            r += 1
+        elif r > 0:
+            for j in range(4):
+                held[j] = Z[r - 1, j]
         for j in range(4):                  # x1, y1, x2, y2: the AMB axes' order
-            U[noise_control + j] = noise * z[j]
+            buffer[row, cols[j]] += sigma[j] * held[j]
+            buffer[row, cols[4 + j]] += sigma[4 + j] * Z[r, j]
+            U[noise_control + j] = noise * held[j]
     if n == 0:
-        for r in range(L):
-            if r != row:
+        for q in range(L):
+            if q != row:
                 for i in range(true_obs.shape[0]):
-                    buffer[r, i] = buffer[row, i]
+                    buffer[q, i] = buffer[row, i]
     src = (n - min(k, n)) % L
     for i in range(true_obs.shape[0]):
         out[i] = buffer[src, i]
     out[time_col] = true_obs[time_col]
+    state[0] = n + 1
+    state[2] = -1
+
+
+class SensingRows:
+    """The sensing of a batch's environments (one id and settings, compiled measurements:
+    :attr:`Sensing.compiled`) on stacked arrays: each environment's :class:`Sensing` keeps views
+    of its rows (its own numbers: its reset, latency and measurement work on them as a single
+    environment's), and the batch plans and measures a step of every row in one compiled call
+    each (:func:`plan_rows`, :func:`sense_rows`), with the draws from each environment's own
+    generator between them: the numbers of each environment stepped alone."""
+
+    def __init__(self, sensings: list[Sensing], stack):
+        self.sensings = sensings
+        first = sensings[0]
+        self.noise = first.noise
+        self.z = np.stack([s.z for s in sensings])
+        self.state = np.stack([s.state for s in sensings])
+        self.buffer = np.stack([s.buffer for s in sensings])
+        self.rows = np.arange(len(sensings))
+        self.counts = np.zeros(len(sensings), dtype=np.int64)
+        self.out = np.zeros(stack.obs.shape, dtype=np.float32)
+        self.attach(stack)
+
+    def attach(self, stack) -> None:
+        """Give each environment's sensing the views of its rows, and take the batch's
+        ``stack`` (:class:`rotordrop_env.buffers.Buffers`): again after a copy."""
+        for e, s in enumerate(self.sensings):
+            s.z, s.state, s.buffer = self.z[e], self.state[e], self.buffer[e]
+        self.stack = stack
+        self._views: list[dict] = [{} for _ in self.sensings]     # flat views of Z's rows
+        self._plan = self._sense = None                           # bound at first use
+
+    def __getstate__(self) -> dict:
+        state = self.__dict__.copy()
+        state["_views"], state["_plan"], state["_sense"] = [], None, None
+        return state
+
+    def draw(self, rngs: list, rows: np.ndarray | None = None) -> None:
+        """Before a batch step: each environment's draws (:meth:`Sensing.draw_step`) from its
+        generator in ``rngs``, for all rows or the rows ``rows``."""
+        if self.noise == 0.0:
+            return
+        st, first = self.stack, self.sensings[0]
+        if rows is None:
+            if self._plan is None:
+                self._plan = bound(plan_rows, self.rows, st.M, first.dt, first.rate, st.Z, self.z,
+                                   self.state, self.counts)
+            self._plan()
+            rows = self.rows
+        else:
+            plan_rows(rows, st.M, first.dt, first.rate, st.Z, self.z, self.state, self.counts)
+        for e, count in zip(rows.tolist(), self.counts.tolist()):
+            flat = self._views[e].get(count)
+            if flat is None:
+                flat = self._views[e][count] = _flat(st.Z[e, :count])
+            rngs[e].standard_normal(out=flat)
+
+    def measure(self, rows: np.ndarray | None = None) -> np.ndarray:
+        """After a batch step: every row's measurement (or the rows ``rows``'), its float32
+        observation in the rows of :attr:`out` (overwritten by the next step)."""
+        st, first = self.stack, self.sensings[0]
+        args = (st.obs, st.Z, self.z, first._sigma, first._cols, st.U, first.noise_control,
+                first.noise, self.buffer, self.state, first.time_col, self.out)
+        if rows is not None:
+            sense_rows(rows, *args)
+        else:
+            if self._sense is None:
+                self._sense = bound(sense_rows, self.rows, *args)
+            self._sense()
+        return self.out

@@ -108,7 +108,7 @@ class BatchedRotorDropVecEnv(VecEnv):
         batch = self.batch
         obs, rewards, terminated, truncated, _ = batch.step(self.actions, columns=False)
         dones = terminated | truncated
-        infos = row_infos(batch.values, batch.latency, batch.relevitate)
+        infos = row_infos(batch.values, batch.latency, batch.relevitate, batch.step_infos)
         for e in np.flatnonzero(dones):
             infos[e]["terminal_observation"] = obs[e].copy()
             infos[e]["TimeLimit.truncated"] = bool(truncated[e] and not terminated[e])

@@ -34,3 +34,22 @@ def test_decorating_leaves_numba_global_cache_setting_alone():
 
     assert twice(2) == 4 and config.CACHE_DIR == previous
     assert twice._cache._cache_path.startswith(_jit.CACHE_DIR)
+
+
+def test_a_bound_kernel_runs_its_own_machine_code_with_the_dispatchers_numbers():
+    """physics.jit.bound calls the overload compiled for exactly its arguments' types (its
+    entry point, not the dispatcher) and gives the dispatcher's numbers; something that is not
+    a numba dispatcher is called as it is."""
+    import numpy as np
+    from physics.jit import bound
+    from rotordrop_env import kernels as K
+    rng = np.random.default_rng(3)
+    out, M, C = rng.normal(size=K.N_O), rng.normal(size=K.N_M), rng.normal(size=K.N_C)
+    by_dispatch, by_bound = np.zeros(K.N_V), np.zeros(K.N_V)
+    K.info_values(out, M, C, by_dispatch)
+    call = bound(K.info_values, out, M, C, by_bound)
+    assert call.func is not K.info_values and call.args == (out, M, C, by_bound)
+    call()
+    assert np.array_equal(by_bound, by_dispatch)
+    plain = bound(np.add, 1.0, 2.0)
+    assert plain.func is np.add and plain() == 3.0

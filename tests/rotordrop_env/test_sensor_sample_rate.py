@@ -198,3 +198,64 @@ def test_the_scene_key_has_its_range():
     assert env.unwrapped.sensor_sample_rate == 5e3
     with pytest.raises(AttributeError, match="sensor_sample_rate is fixed"):
         env.unwrapped.sensor_sample_rate = 2e4
+
+
+@pytest.mark.parametrize("control_dt, rate", [(2e-4, 1e4), (2.5e-4, 1e4), (2.5e-4, 3e3),
+                                              (1e-4, 1e4)])
+def test_a_step_draws_its_normals_in_one_call_as_one_per_sample_and_measurement(control_dt, rate):
+    """The step's standard normals, drawn in one call before the kernel step, are the numbers a
+    draw per sample instant strictly inside the step (4 each: the held samples the physics
+    reads) and then one for the measurement after it (8 when an instant falls at its end: a
+    new displacement sample and the velocity estimates; else the 4 velocity ones) would give:
+    the environment's generator is left exactly where those draws leave it."""
+    env = gym.make("RotorDrop-Full-v1", command="continuous", control_dt=control_dt,
+                   episode_time=60 * control_dt, sensor_noise=SIGMA, sensor_sample_rate=rate,
+                   terminate_on_failure=False)
+    u = env.unwrapped
+    env.reset(seed=4)
+    env.action_space.seed(4)
+    ref = np.random.Generator(np.random.PCG64())
+    ref.bit_generator.state = u.np_random.bit_generator.state
+    counts = set()
+    for _ in range(60):
+        t0 = u._b.M[K.M_T]
+        env.step(env.action_space.sample())
+        t1 = t0 + control_dt
+        n = len(instants_inside(t0, t1, rate))
+        at_end = abs(t1 * rate - round(t1 * rate)) < 1e-6
+        inside = ref.standard_normal((n, 4))
+        measured = ref.standard_normal(8 if at_end else 4)
+        assert np.array_equal(u._b.Z[:n], inside)
+        assert np.array_equal(u._b.Z[n:n + 1 + at_end].ravel(), measured)
+        counts.add((n, at_end))
+    assert ref.random() == u.np_random.random()
+    per_step = control_dt * rate
+    if abs(per_step - round(per_step)) > 1e-6:         # steps of different draws were met
+        assert len(counts) > 1
+
+
+def test_a_refused_action_draws_no_noise_as_in_a_batch():
+    """A refused action (a ValueError, nothing advanced) draws nothing from the environment's
+    generator: the episode goes on as if it had never been sent, and the batch, which checks
+    all actions before any environment draws, agrees step for step."""
+    from rotordrop_env import BatchedRotorDropVecEnv
+    kw = dict(command="continuous", control_dt=2e-4, episode_time=0.004, sensor_noise=SIGMA,
+              obs_latency_steps=(0, 2))
+    one = gym.make("RotorDrop-Full-v1", **kw)
+    clean = gym.make("RotorDrop-Full-v1", **kw)
+    batch = BatchedRotorDropVecEnv("RotorDrop-Full-v1", 1, seed=9, n_threads=1, **kw)
+    one.reset(seed=9), clean.reset(seed=9), batch.reset()
+    acts = np.random.default_rng(1).uniform(-1, 1, (12, 6)).astype(np.float32)
+    for k, a in enumerate(acts):
+        if k % 4 == 1:
+            bad = a.copy()
+            bad[3] = np.nan
+            with pytest.raises(ValueError, match="non-finite action"):
+                one.step(bad)
+            with pytest.raises(ValueError, match="non-finite action"):
+                batch.step(bad[None])
+        o1, r1, *_ = one.step(a)
+        o2, r2, *_ = clean.step(a)
+        o3, r3, *_ = batch.step(a[None])
+        assert np.array_equal(o1, o2) and r1 == r2
+        assert np.array_equal(o1, o3[0]) and np.float32(r1) == r3[0]
