@@ -258,17 +258,25 @@ def test_the_hard_table_ranks_only_equal_step_budgets_over_three_seeds():
 
     from agents.benchmarking.results import HARD_STEP_BUDGET, hard_ranking
     table = json.loads((ROOT / "docs/data/hard-table.json").read_text())
+    timed = copy.deepcopy(table)
+    timed["runs"] = [dict(r, time_limit_s=300.0) for r in timed["runs"]]
     with pytest.raises(ValueError, match="ranks nothing.*wall-time limit"):
-        hard_ranking(table, "nominal")
+        hard_ranking(timed, "nominal")
     fair = copy.deepcopy(table)
     fair["runs"] = [dict(r, timesteps=HARD_STEP_BUDGET, time_limit_s=None)
                     for r in fair["runs"] if r["variant"] == "nominal"]
     ranked = hard_ranking(fair, "nominal")
     keys = [r["mean_minus_std"] for r in ranked]
     assert keys == sorted(keys, reverse=True) and len(ranked) == len({r["algo"] for r in fair["runs"]})
+    rollout = copy.deepcopy(fair)                 # PPO's last whole rollout overshoots: allowed
+    rollout["runs"][0]["timesteps"] = int(HARD_STEP_BUDGET * 1.024)
+    assert len(hard_ranking(rollout, "nominal")) == len(ranked)
+    rollout["runs"][0]["timesteps"] = int(HARD_STEP_BUDGET * 1.2)
+    with pytest.raises(ValueError, match=f"{int(HARD_STEP_BUDGET * 1.2) // 1000} k steps"):
+        hard_ranking(rollout, "nominal")
     uneven = copy.deepcopy(fair)
     uneven["runs"][0]["timesteps"] = HARD_STEP_BUDGET // 2
-    with pytest.raises(ValueError, match="250 k steps"):
+    with pytest.raises(ValueError, match=f"{HARD_STEP_BUDGET // 2000} k steps"):
         hard_ranking(uneven, "nominal")
     few = copy.deepcopy(fair)
     algo = few["runs"][0]["algo"]
