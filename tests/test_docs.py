@@ -70,7 +70,7 @@ def test_results_command_builds_the_hard_algorithm_table(tmp_path, capsys):
                                                                             ("tqc", 1, "best")]
     assert len(table["runs"][0]["relevitated"]) == 200 and table["references"][0]["sensing"] == {}
     page = (root / "docs/results.md").read_text()
-    assert "### Algorithm table" in page and "300 s wall clock" in page
+    assert "### Algorithm table" in page and "wall-clock limit of 300 s" in page
     assert "| `tqc` | learned | **1.00 ± 0.00** | 1.00 ± 0.00, 1.00 ± 0.00 (200, 200 / 200) |" in page
     assert "| `whirl-brake` | designed | **1.00** |" in page and "40 k, 40 k |" in page
     assert results.main(["--root", str(root), "--hard-ref", "noisy", str(ref)]) == 2
