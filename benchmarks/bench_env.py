@@ -591,7 +591,7 @@ def step_table(res: dict) -> str:
     rows += ["", f"Paper scene, 1 ms control step, random actions, resets as episodes end; "
              f"{res['steps']} steps of every environment per case and round (a batch's N = "
              f"{res['n_envs']} each), {res['repeats']} rounds, {res['clock']} clock, "
-             f"{res['numba_threads']} numba threads; load average "
+             f"{res['numba_threads']} numba threads; load average (1 min, this run included) "
              f"{load['start']:.1f} at the start, {load['end']:.1f} at the end."]
     return "\n".join(rows) + "\n"
 
