@@ -464,6 +464,7 @@ def step_speed(repeats: int, n_envs: int, steps: int, overrides: dict | None = N
     Pendulum-v1 and of the batches to :data:`SINGLE_CASE` (medians of ``repeats`` rounds), the
     cost split of each single env (``steps`` per part and repeat), the batching bound it
     allows and the batch's default threads over one thread."""
+    load = os.getloadavg()[0]
     cases = step_cases(n_envs, steps, overrides)
     batches = [n for n in cases if " N=" in n]
     out = {"overrides": dict(overrides or {}), "repeats": repeats,
@@ -479,6 +480,7 @@ def step_speed(repeats: int, n_envs: int, steps: int, overrides: dict | None = N
     out["default over one thread (wall)"] = {
         f"N = {n}": default_vs_one_thread(DAMPING, kw, n, max(steps, 4800 // n), repeats)[0]
         for n in sorted({1, n_envs})}
+    out["load average"] = {"start": load, "end": os.getloadavg()[0]}
     return out
 
 
@@ -582,17 +584,17 @@ def step_table(res: dict) -> str:
                                                   for case, split in r["splits"].items()])
     rows += ["", "| settings | batching bound per core: nothing but the physics left | the "
              "compiled kernel kept | default threads over one thread (wall clock, runs "
-             "interleaved) |", "|---|---|---|---|"]
+             "interleaved) | load average (1 min, this run included), start → end |",
+             "|---|---|---|---|---|"]
     for label, r in runs:
-        b = r["batching bound per core (Amdahl)"]
+        b, load = r["batching bound per core (Amdahl)"], r["load average"]
         auto = ", ".join(f"{n}: {v:.2f}" for n, v in r["default over one thread (wall)"].items())
-        rows.append(f"| {label} | {b['physics']:.2f} | {b['kernel']:.2f} | {auto} |")
-    load = res["load average"]
+        rows.append(f"| {label} | {b['physics']:.2f} | {b['kernel']:.2f} | {auto} | "
+                    f"{load['start']:.1f} → {load['end']:.1f} |")
     rows += ["", f"Paper scene, 1 ms control step, random actions, resets as episodes end; "
              f"{res['steps']} steps of every environment per case and round (a batch's N = "
              f"{res['n_envs']} each), {res['repeats']} rounds, {res['clock']} clock, "
-             f"{res['numba_threads']} numba threads; load average (1 min, this run included) "
-             f"{load['start']:.1f} at the start, {load['end']:.1f} at the end."]
+             f"{res['numba_threads']} numba threads, {res['cores']} cores."]
     return "\n".join(rows) + "\n"
 
 
@@ -698,12 +700,10 @@ def main(argv=None) -> int:
         _write(args.json, res)
         return 0
     runs = [overrides] + [dict(overrides, **dict([parse_assignment(a)])) for a in args.compare_set]
-    load0 = os.getloadavg()[0]
     res = {"clock": args.clock, "n_envs": args.n_envs, "steps": args.steps or 600,
            "repeats": args.repeats, "control_dt_s": 1e-3,
-           "numba_threads": numba.config.NUMBA_NUM_THREADS,
+           "numba_threads": numba.config.NUMBA_NUM_THREADS, "cores": os.cpu_count(),
            "runs": [step_speed(args.repeats, args.n_envs, args.steps or 600, o) for o in runs]}
-    res["load average"] = {"start": load0, "end": os.getloadavg()[0]}
     for r in res["runs"]:
         _print_step(r)
     _write(args.json, res)
