@@ -1,50 +1,58 @@
 """Environment speed: env steps per second at the 1 ms control step, single and batched, and
-in the controller seat (``--control-dt``) as ratios to Gymnasium's ``Pendulum-v1``.
+in the controller seat (``--control-dt``), as ratios to Gymnasium's ``Pendulum-v1`` timed in
+the same rounds.
 
-    python benchmarks/bench_env.py [--repeats 3] [--episodes 2] [--n-envs 16] [--json out.json]
-                                   [--set KEY=VALUE ...]
+    python benchmarks/bench_env.py [--repeats 20] [--steps 600] [--n-envs 16] [--set KEY=VALUE ...]
+                                   [--compare-set solver.rtol=1e-4 ...]
+                                   [--json docs/data/bench-env.json]
     python benchmarks/bench_env.py --control-dt 2e-4 --control-dt 1e-4 [--repeats 15]
                                    [--compare-set solver.rtol=1e-4 ...] [--law whirl-brake]
                                    [--json docs/data/bench-env-seat.json]
+    python benchmarks/bench_env.py --render docs/data/bench-env.json
 
-With ``--control-dt`` (one or more control steps [s]) it measures only the controller seat
+Both modes time their cases in rounds: each round times ``Pendulum-v1`` (``gym.make``, random
+actions) and then every case once, each from a seeded reset (every round the same episodes,
+resets as episodes end; every environment of a batch steps ``--steps`` steps, as many as the
+single env). They print each rate's median and the median of its per-round ratios to
+Pendulum-v1's rate (the machine's speed cancels), then the cost split of one step of each
+single env on one trajectory (:func:`cost_split`): the physics alone (``integrate_sensed`` over
+each control step, in one compiled loop), the step kernel (physics + sub-sampled monitors,
+reward, observation), the Python ``step`` and Gymnasium's wrappers, and what the physics is
+made of (right-hand sides per step, the cost of one at the episode's states, their share of the
+physics alone). ``--json`` stores the figures; ``--render JSON`` prints the tables of
+docs/environments.md from them (:func:`render`). Every figure is timed after a JIT warm-up by
+the process CPU time (``--clock cpu``, the default: per core and robust on a machine shared
+with other jobs) or by the wall clock (``--clock wall``). ``--compare-set KEY=VALUE`` adds a
+run with that scene override (e.g. a looser ``solver.rtol``).
+
+Default mode, the 1 ms control step: paper scene, default environment settings (episode 0.3 s =
+300 steps, 5 monitor samples per step; ``--steps`` 600: two episodes), random actions:
+
+* single env: ``gym.make(id)`` (with Gymnasium's wrappers) and ``env.unwrapped``, for the passive
+  env and the damping env, for the paper scene as it is (mu = 0.25: drop, bounces, no whirl)
+  and at mu = 0.5, which whirls backward (run on through the whirl with
+  ``terminate_on_failure=False``; the physics is costliest there);
+* batched, at mu = 0.25: the SB3 batch ``BatchedRotorDropVecEnv`` of N = ``--n-envs`` damping
+  envs with 1 numba thread (the per-core figure) and with all threads, and the Gymnasium vector
+  env (``gymnasium.make_vec``, one thread), each also as the median of its per-round ratios to
+  the single damping env (``gym.make``); next to them the Amdahl bound of batching from that
+  env's cost split (``gym.make`` step over physics: nothing but the physics left; over the
+  kernel call: the Python part removed), and the batch with its default threads (chosen as it
+  runs) over one thread, N = 1 and N = ``--n-envs``, by the wall clock, runs interleaved.
+
+With ``--control-dt`` (one or more control steps [s]) it measures the controller seat
 (:mod:`agents.control.seats`): ``RotorDrop-Full-v1`` with raw coil currents
 (``command="continuous"``) and dampers, the robust suite's sensor noise and the middle of its
 sensor delay range, random actions (``--law NAME``: the actions that designed law sends on
-the same episodes, recorded and replayed: what a learner near it steps), resets as episodes
-end. Per step and repeat it times ``Pendulum-v1`` (``gym.make``, random actions) and then the
-single env (``gym.make`` and ``env.unwrapped``), the SB3 batch ``BatchedRotorDropVecEnv`` (one
-numba thread: per core) and the Gymnasium vector env (``gymnasium.make_vec``, one thread),
-each from a seeded reset (every round the same episodes; every environment of a batch steps as
-many steps as the single env), and prints each rate's median and the median of its per-repeat
-ratios to Pendulum-v1's rate (the machine's speed cancels), then the cost split of a step and
-what the physics is made of (right-hand sides per step, the cost of one at the episode's
-states, their share of the physics alone). ``--render JSON`` prints the table of
-docs/environments.md from that JSON (:func:`seat_table`).
-
-Paper scene, default environment settings (episode 0.3 s = 300 steps, 5 monitor samples per
-step), whole episodes including resets. Every figure is the median of ``--repeats`` runs after a
-JIT warm-up, timed by the process CPU time (``--clock cpu``, the default: per core and robust on
-a machine shared with other jobs) or by the wall clock (``--clock wall``).
-
-* single env: ``gym.make(id)`` (with Gymnasium's wrappers) and ``env.unwrapped``, for the passive
-  env (no action) and the damping env (uniform random actions, seeded), for the paper scene as
-  it is (mu = 0.25: drop, bounces, no whirl) and at mu = 0.5, which whirls backward (run on
-  through the whirl with ``terminate_on_failure=False``; the physics is costliest there);
-* cost split (passive and damping env, each on one trajectory: the damping env's random actions
-  are replayed as the controls they set): physics alone (``integrate_sensed`` over each 1 ms
-  step, in one compiled loop), the step kernel (physics + sub-sampled monitors, reward,
-  observation), the Python ``step`` and Gymnasium's wrappers, and the physics' share;
-* batched: ``BatchedRotorDropVecEnv`` with N envs of the damping env, with 1 numba thread (the
-  per-core figure) and with all threads, next to the Amdahl bound of batching from the damping
-  env's split (``gym.make`` step over physics: nothing but the physics left; over the kernel
-  call: the Python part removed); and with its default threads (chosen as it runs) over one
-  thread, N = 1 and N = ``--n-envs``, by the wall clock, runs interleaved.
+the same episodes, recorded and replayed: what a learner near it steps): the single env
+(``gym.make`` and ``env.unwrapped``), the SB3 batch (one numba thread: per core) and the
+vector env (one thread), and the targets they are held to (:func:`seat_table`).
 """
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import statistics
 import time
 from typing import Callable, NamedTuple
@@ -52,6 +60,7 @@ from typing import Callable, NamedTuple
 import gymnasium as gym
 import numba
 import numpy as np
+from tqdm import tqdm
 
 import rotordrop_env
 from physics._jit import bound, njit
@@ -359,6 +368,12 @@ def seat_cases(control_dt: float, n_envs: int, steps: int, overrides: dict | Non
              f"vector env N={n_envs}, per core": vector_face(
                  gym.make_vec(SEAT_ENV, num_envs=n_envs, vectorization_mode="vector_entry_point",
                               n_threads=1, **kw))}
+    return timed_cases(faces, steps, law)
+
+
+def timed_cases(faces: dict, steps: int, law: str | None = None) -> dict:
+    """Each face's run over ``steps`` steps (:func:`face_rate`; ``law``: that designed law's
+    actions, else random ones) after Pendulum-v1's over 4 x ``steps``, warmed up."""
     pendulum = single_face(gym.make(PENDULUM))
     cases = {PENDULUM: face_rate(pendulum, face_actions(pendulum, 4 * steps))}
     for name, face in faces.items():
@@ -366,6 +381,19 @@ def seat_cases(control_dt: float, n_envs: int, steps: int, overrides: dict | Non
     for run in cases.values():                          # warm-up (JIT, scenario caches)
         run()
     return cases
+
+
+def round_medians(cases: dict, repeats: int, over: dict | None = None) -> dict:
+    """``repeats`` rounds that time every case once: each rate's median (``rates``) and the
+    median of its per-round ratios to Pendulum-v1's (``ratio_to_pendulum``: the machine's speed
+    cancels); ``over``: more ratios, ``{key: (reference case, [cases])}``."""
+    rounds = [{name: run() for name, run in cases.items()} for _ in tqdm(
+        range(repeats), desc="rounds", leave=False)]
+    ratios = dict(ratio_to_pendulum=(PENDULUM, [n for n in cases if n != PENDULUM]), **(over or {}))
+    out = {"rates": {n: statistics.median(r[n] for r in rounds) for n in cases}}
+    for key, (ref, names) in ratios.items():
+        out[key] = {n: statistics.median(r[n] / r[ref] for r in rounds) for n in names}
+    return out
 
 
 def seat_speed(control_dt: float, repeats: int, n_envs: int, steps: int,
@@ -377,27 +405,114 @@ def seat_speed(control_dt: float, repeats: int, n_envs: int, steps: int,
     kw = seat_kwargs(control_dt, overrides)
     acts = face_actions(single_face(gym.make(SEAT_ENV, **kw)), steps, law) if law else None
     cases = seat_cases(control_dt, n_envs, steps, overrides, law)
-    rounds = [{name: run() for name, run in cases.items()} for _ in range(repeats)]
     out = {"control_dt_s": control_dt, "env_id": SEAT_ENV, "env_kwargs": kw, "repeats": repeats,
-           "actions": law or "random", "rates": {}, "ratio_to_pendulum": {}}
-    for name in cases:
-        out["rates"][name] = statistics.median(r[name] for r in rounds)
-        if name != PENDULUM:
-            out["ratio_to_pendulum"][name] = statistics.median(r[name] / r[PENDULUM] for r in rounds)
+           "actions": law or "random", **round_medians(cases, repeats)}
+    return dict(out, **split_of(SEAT_ENV, kw, 1, repeats, acts))
+
+
+def split_of(env_id: str, kwargs: dict, episodes: int, repeats: int, acts: list | None = None
+             ) -> dict:
+    """The cost split of one step of ``env_id`` (:func:`cost_split`, each part the median of
+    ``repeats``: ``per-step us``) and its integrator's work per step (``integrator per
+    step``)."""
     stats: dict = {}
-    out["per-step us"] = {k: _median(fn, repeats)
-                          for k, fn in cost_split(SEAT_ENV, kw, 1, stats=stats, acts=acts).items()}
-    out["integrator per step"] = stats
+    split = {k: _median(fn, repeats)
+             for k, fn in cost_split(env_id, kwargs, episodes, stats=stats, acts=acts).items()}
+    return {"per-step us": split, "integrator per step": stats}
+
+
+PASSIVE, DAMPING = "RotorDrop-Passive-v1", "RotorDrop-Damping-v1"
+#: the 1 ms figures' scenes (module doc): label -> env kwargs of the paper scene's
+SCENES = {"μ = 0.25": {},
+          "μ = 0.5, backward whirl": {"overrides": {"contact.friction": 0.5},
+                                      "terminate_on_failure": False}}
+#: the single env the 1 ms batches are compared with (the same env, scene and actions)
+SINGLE_CASE = f"Damping, {next(iter(SCENES))} (gym.make)"
+
+
+def scene_kwargs(scene: str, overrides: dict | None = None) -> dict:
+    """The env kwargs of a 1 ms scene (:data:`SCENES`) with the run's scene ``overrides``
+    (``--set``; the scene's own win)."""
+    kw = dict(SCENES[scene])
+    o = dict(overrides or {}, **kw.get("overrides", {}))
+    return dict(kw, overrides=o) if o else kw
+
+
+def step_cases(n_envs: int, steps: int, overrides: dict | None = None) -> dict:
+    """The timed runs of the 1 ms figures (each returns steps/s; :func:`timed_cases`): per
+    scene the passive and the damping env, ``gym.make``'d and unwrapped; at mu = 0.25 the
+    damping env's SB3 batch (``n_envs``, one thread and every numba thread) and vector env (one
+    thread), each of whose environments steps ``steps`` steps like the single env."""
+    faces = {}
+    for scene in SCENES:
+        kw = scene_kwargs(scene, overrides)
+        for env_id in (PASSIVE, DAMPING):
+            name = f"{env_id.split('-')[1]}, {scene}"
+            faces[f"{name} (gym.make)"] = single_face(gym.make(env_id, **kw))
+            faces[f"{name} (unwrapped)"] = single_face(gym.make(env_id, **kw).unwrapped)
+    kw = scene_kwargs(next(iter(SCENES)), overrides)
+    for threads in sorted({1, numba.config.NUMBA_NUM_THREADS}):
+        faces[f"SB3 batch N={n_envs}, {threads} thread{'s' * (threads > 1)}, per core"] = \
+            sb3_face(rotordrop_env.BatchedRotorDropVecEnv(DAMPING, n_envs, n_threads=threads, **kw))
+    faces[f"vector env N={n_envs}, 1 thread, per core"] = vector_face(gym.make_vec(
+        DAMPING, num_envs=n_envs, vectorization_mode="vector_entry_point", n_threads=1, **kw))
+    return timed_cases(faces, steps)
+
+
+def step_speed(repeats: int, n_envs: int, steps: int, overrides: dict | None = None) -> dict:
+    """The 1 ms figures (module doc) with the scene ``overrides``: rates, ratios to
+    Pendulum-v1 and of the batches to :data:`SINGLE_CASE` (medians of ``repeats`` rounds), the
+    cost split of each single env (``steps`` per part and repeat), the batching bound it
+    allows and the batch's default threads over one thread."""
+    load = os.getloadavg()[0]
+    cases = step_cases(n_envs, steps, overrides)
+    batches = [n for n in cases if " N=" in n]
+    out = {"overrides": dict(overrides or {}), "repeats": repeats,
+           **round_medians(cases, repeats, {"ratio_to_single": (SINGLE_CASE, batches)})}
+    episodes = max(1, steps // 300)                    # whole 0.3 s episodes
+    out["splits"] = {f"{env_id.split('-')[1]}, {scene}": dict(
+        split_of(env_id, scene_kwargs(scene, overrides), episodes, repeats), env_id=env_id)
+        for scene in SCENES for env_id in (PASSIVE, DAMPING)}
+    c = out["splits"][SINGLE_CASE.removesuffix(" (gym.make)")]["per-step us"]
+    out["batching bound per core (Amdahl)"] = dict(physics=c["wrapped"] / c["physics"],
+                                                   kernel=c["wrapped"] / c["kernel"])
+    kw = scene_kwargs(next(iter(SCENES)), overrides)
+    out["default over one thread (wall)"] = {
+        f"N = {n}": default_vs_one_thread(DAMPING, kw, n, max(steps, 4800 // n), repeats)[0]
+        for n in sorted({1, n_envs})}
+    out["load average"] = {"start": load, "end": os.getloadavg()[0]}
     return out
 
 
+def _settings_label(r: dict) -> str:
+    """A 1 ms run's scene overrides (``--set``, ``--compare-set``), or the defaults."""
+    return ", ".join(f"`{k}={v}`" for k, v in r["overrides"].items()) or "defaults"
+
+
+def _print_rates(title: str, r: dict) -> None:
+    print(f"{title} (median of {r['repeats']} rounds):")
+    for name, rate in r["rates"].items():
+        ratio = r["ratio_to_pendulum"].get(name)
+        single = r.get("ratio_to_single", {}).get(name)
+        print(f"  {name:40s} {rate:10.0f} steps/s"
+              + ("" if ratio is None else f"   {ratio:.2f}x Pendulum-v1")
+              + ("" if single is None else f"   {single:.2f}x the single env"))
+
+
+def _print_step(r: dict) -> None:
+    _print_rates(f"1 ms control step, paper scene, {_settings_label(r)}, random actions", r)
+    for case, sp in r["splits"].items():
+        _print_split(f"{sp['env_id']}, {case}", sp["per-step us"])
+    b = r["batching bound per core (Amdahl)"]
+    print(f"  batching bound per core (Amdahl, {SINGLE_CASE}'s split): nothing but the physics "
+          f"left {b['physics']:.2f}x, the compiled kernel kept {b['kernel']:.2f}x")
+    print("  batch with default threads over one thread, wall clock, runs interleaved: "
+          + ", ".join(f"{n}: {v:.2f}x" for n, v in r["default over one thread (wall)"].items()))
+
+
 def _print_seat(res: dict) -> None:
-    print(f"controller seat, {res['env_id']} {res['env_kwargs']}, {res.get('actions', 'random')} actions, resets as "
-          f"episodes end (median of {res['repeats']} rounds):")
-    for name, rate in res["rates"].items():
-        ratio = res["ratio_to_pendulum"].get(name)
-        print(f"  {name:32s} {rate:10.0f} steps/s"
-              + ("" if ratio is None else f"   {ratio:.2f}x Pendulum-v1"))
+    _print_rates(f"controller seat, {res['env_id']} {res['env_kwargs']}, "
+                 f"{res.get('actions', 'random')} actions, resets as episodes end", res)
     _print_split(res["env_id"], res["per-step us"])
     i = res["integrator per step"]
     print(f"    integrator per control step: {i['rhs']:.1f} right-hand sides, {i['steps']:.2f} "
@@ -440,32 +555,12 @@ def target_of(case: str) -> float | None:
 def seat_table(res: dict) -> str:
     """The markdown table of a ``--control-dt`` run's JSON (docs/environments.md pastes it
     between its markers; ``--render JSON`` prints it)."""
-    rows = ["| control step | case | env steps/s | × Pendulum-v1 (median of per-round ratios) "
-            "| target |", "|---|---|---|---|---|"]
-    for r in res["seat"]:
-        dt = _seat_label(r)
-        for name, rate in r["rates"].items():
-            ratio, target = r["ratio_to_pendulum"].get(name), target_of(name)
-            verdict = "" if target is None else \
-                f"≥ {target:g}: {'met' if ratio >= target else 'not met'}"
-            rows.append(f"| {dt} | {name} | {rate:,.0f} | "
-                        f"{'1 (reference)' if ratio is None else f'{ratio:.2f}'} | {verdict} |")
-    rows += ["", "| control step | physics | + monitors, reward, obs | + Python `step` | "
-             "+ wrappers | `env.step` | physics share | integrator steps (rejected), "
-             "right-hand sides | a right-hand side (share of the physics) | physics alone, × "
-             "Pendulum-v1 |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
-    for r in res["seat"]:
-        c = r["per-step us"]
-        rows.append(f"| {_seat_label(r)} | {c['physics']:.1f} µs | "
-                    f"{c['kernel'] - c['physics']:.1f} µs | {c['unwrapped'] - c['kernel']:.1f} µs | "
-                    f"{c['wrapped'] - c['unwrapped']:.1f} µs | {c['wrapped']:.1f} µs | "
-                    f"{100 * c['physics'] / c['wrapped']:.0f} % | "
-                    f"{r['integrator per step']['steps']:.1f} "
-                    f"({r['integrator per step']['rejected']:.2f}), "
-                    f"{r['integrator per step']['rhs']:.0f} | "
-                    f"{r['integrator per step']['rhs_ns']:.0f} ns ({100 * _rhs_share(r):.0f} %) | "
-                    f"{1e6 / c['physics'] / r['rates'][PENDULUM]:.2f} |")
+    def verdict(r, name):
+        ratio, target = r["ratio_to_pendulum"].get(name), target_of(name)
+        return "" if target is None else f"≥ {target:g}: {'met' if ratio >= target else 'not met'}"
+    runs = [(_seat_label(r), r) for r in res["seat"]]
+    rows = _rate_rows("control step", runs, "target", verdict)
+    rows += [""] + _split_rows("control step", [(label, r, r) for label, r in runs])
     kw = res["seat"][0]["env_kwargs"]
     rows += ["", f"{res['seat'][0]['env_id']}, "
              + ", ".join(f"`{k}={v!r}`" for k, v in kw.items() if k not in ("control_dt", "overrides"))
@@ -473,6 +568,74 @@ def seat_table(res: dict) -> str:
              f"N = {res['n_envs']} each), {res['seat'][0]['repeats']} rounds, {res['clock']} "
              "clock."]
     return "\n".join(rows) + "\n"
+
+
+def step_table(res: dict) -> str:
+    """The markdown tables of a 1 ms run's JSON (docs/environments.md pastes them between its
+    markers; ``--render JSON`` prints them): rates, the cost split, batching."""
+    def over_single(r, name):
+        ratio = r["ratio_to_single"].get(name)
+        return "" if ratio is None else f"{ratio:.2f}"
+    runs = [(_settings_label(r), r) for r in res["runs"]]
+    rows = _rate_rows("settings", runs, f"× the single env ({SINGLE_CASE}, median of per-round "
+                      "ratios)", over_single)
+    rows += [""] + _split_rows("settings, case", [(f"{label}, {case}", split, r)
+                                                  for label, r in runs
+                                                  for case, split in r["splits"].items()])
+    rows += ["", "| settings | batching bound per core: nothing but the physics left | the "
+             "compiled kernel kept | default threads over one thread (wall clock, runs "
+             "interleaved) | load average (1 min, this run included), start → end |",
+             "|---|---|---|---|---|"]
+    for label, r in runs:
+        b, load = r["batching bound per core (Amdahl)"], r["load average"]
+        auto = ", ".join(f"{n}: {v:.2f}" for n, v in r["default over one thread (wall)"].items())
+        rows.append(f"| {label} | {b['physics']:.2f} | {b['kernel']:.2f} | {auto} | "
+                    f"{load['start']:.1f} → {load['end']:.1f} |")
+    rows += ["", f"Paper scene, 1 ms control step, random actions, resets as episodes end; "
+             f"{res['steps']} steps of every environment per case and round (a batch's N = "
+             f"{res['n_envs']} each), {res['repeats']} rounds, {res['clock']} clock, "
+             f"{res['numba_threads']} numba threads, {res['cores']} cores."]
+    return "\n".join(rows) + "\n"
+
+
+def render(res: dict) -> str:
+    """The table of a run's JSON: the controller seat's (``--control-dt``) or the 1 ms one."""
+    return seat_table(res) if "seat" in res else step_table(res)
+
+
+def _rate_rows(first: str, runs: list, last: str, last_cell: Callable[[dict, str], str]) -> list:
+    """Rows of the rates table: per run (``(label, run)``) and case, the rate, its ratio to
+    Pendulum-v1 and a last column (``last_cell(run, case)``)."""
+    rows = [f"| {first} | case | env steps/s | × Pendulum-v1 (median of per-round ratios) "
+            f"| {last} |", "|---|---|---|---|---|"]
+    for label, r in runs:
+        for name, rate in r["rates"].items():
+            ratio = r["ratio_to_pendulum"].get(name)
+            rows.append(f"| {label} | {name} | {rate:,.0f} | "
+                        f"{'1 (reference)' if ratio is None else f'{ratio:.2f}'} | "
+                        f"{last_cell(r, name)} |")
+    return rows
+
+
+def _split_rows(first: str, splits: list) -> list:
+    """Rows of the cost-split table: per ``(label, split, run)`` the parts of one step
+    (:func:`split_of`), the integrator's work and the physics alone over the run's
+    Pendulum-v1 rate."""
+    rows = [f"| {first} | physics | + monitors, reward, obs | + Python `step` | "
+            "+ wrappers | `env.step` | physics share | integrator steps (rejected), "
+            "right-hand sides | a right-hand side (share of the physics) | physics alone, × "
+            "Pendulum-v1 |",
+            "|---|---|---|---|---|---|---|---|---|---|"]
+    for label, sp, r in splits:
+        c, i = sp["per-step us"], sp["integrator per step"]
+        rows.append(f"| {label} | {c['physics']:.1f} µs | "
+                    f"{c['kernel'] - c['physics']:.1f} µs | {c['unwrapped'] - c['kernel']:.1f} µs | "
+                    f"{c['wrapped'] - c['unwrapped']:.1f} µs | {c['wrapped']:.1f} µs | "
+                    f"{100 * c['physics'] / c['wrapped']:.0f} % | "
+                    f"{i['steps']:.1f} ({i['rejected']:.2f}), {i['rhs']:.0f} | "
+                    f"{i['rhs_ns']:.0f} ns ({100 * _rhs_share(sp):.0f} %) | "
+                    f"{1e6 / c['physics'] / r['rates'][PENDULUM]:.2f} |")
+    return rows
 
 
 def _print_split(env_id: str, split: dict) -> None:
@@ -491,7 +654,6 @@ def _print_split(env_id: str, split: dict) -> None:
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--repeats", type=int, default=3)
-    p.add_argument("--episodes", type=int, default=2, help="episodes per single-env run")
     p.add_argument("--n-envs", type=int, default=16)
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="scene override for every env, e.g. solver.rtol=1e-4")
@@ -502,27 +664,29 @@ def main(argv=None) -> int:
                    help="measure the controller seat at this control step (repeatable) against "
                         "Pendulum-v1 instead of the 1 ms figures")
     p.add_argument("--compare-set", action="append", default=[], metavar="KEY=VALUE",
-                   help="with --control-dt: one more controller-seat run at the first control "
-                        "step with this scene override (repeatable), e.g. solver.rtol=1e-4: "
-                        "what a looser tolerance buys")
+                   help="one more run with this scene override (repeatable; with --control-dt "
+                        "at the first control step), e.g. solver.rtol=1e-4: what a looser "
+                        "tolerance buys")
     p.add_argument("--law", action="append", default=[], metavar="NAME",
                    help="with --control-dt: one more run at each control step whose cases "
                         "(single, batch, vector) replay the actions this designed law sent on "
                         "the same episodes (repeatable), e.g. whirl-brake: what a learner near "
                         "the law steps")
-    p.add_argument("--steps", type=int, default=3000,
-                   help="env steps per controller-seat run (per case and round)")
+    p.add_argument("--steps", type=int, default=None,
+                   help="env steps of every environment per case and round (default 3000 with "
+                        "--control-dt, else 600: two 0.3 s episodes)")
     p.add_argument("--render", default=None, metavar="JSON",
-                   help="print the table of a --control-dt run's JSON and exit")
+                   help="print the tables of a run's JSON (--json) and exit")
     args = p.parse_args(argv)
     if args.render:
         with open(args.render) as fh:
-            print(seat_table(json.load(fh)), end="")
+            print(render(json.load(fh)), end="")
         return 0
     global CLOCK
     CLOCK = time.process_time if args.clock == "cpu" else time.perf_counter
     overrides = dict(parse_assignment(a) for a in args.overrides)
     if args.control_dt:
+        args.steps = args.steps or 3000
         res = {"clock": args.clock, "n_envs": args.n_envs, "steps": args.steps,
                "seat": [seat_speed(dt, args.repeats, args.n_envs, args.steps, overrides)
                         for dt in args.control_dt]
@@ -535,54 +699,13 @@ def main(argv=None) -> int:
             _print_seat(r)
         _write(args.json, res)
         return 0
-    kwargs = {"overrides": overrides} if overrides else {}
-    R, E = args.repeats, args.episodes
-    res: dict = {"scene": "paper", "overrides": kwargs.get("overrides", {}), "clock": args.clock,
-                 "control_dt_s": 1e-3, "numba_threads": numba.config.NUMBA_NUM_THREADS}
-
-    cases = (("mu = 0.25 (drop and bounces)", {}),
-             ("mu = 0.5 through the backward whirl", {"contact.friction": 0.5}))
-    for label, extra in cases:
-        kw = dict(kwargs, overrides=dict(kwargs.get("overrides", {}), **extra))
-        if extra:
-            kw["terminate_on_failure"] = False
-        print(f"single environment, paper scene {res['overrides'] or ''}, {label}, whole 0.3 s "
-              f"episodes (median of {R}):")
-        for env_id in ("RotorDrop-Passive-v1", "RotorDrop-Damping-v1"):
-            for unwrapped in (False, True):
-                rate = _median(single_env_rate(env_id, kw, E, unwrapped), R)
-                key = f"{label}: {env_id}{' unwrapped' if unwrapped else ''}"
-                res[key + " steps/s"] = rate
-                print(f"  {env_id + (' unwrapped' if unwrapped else ''):36s} {rate:10.0f} steps/s")
-        for env_id in ("RotorDrop-Passive-v1", "RotorDrop-Damping-v1"):
-            split = {k: _median(fn, R) for k, fn in cost_split(env_id, kw, E).items()}
-            res[f"{label}: {env_id} per-step us"] = split
-            _print_split(env_id, split)
-
-    n, steps = args.n_envs, 600
-    single = res[f"{cases[0][0]}: RotorDrop-Damping-v1 steps/s"]
-    print(f"batched VecEnv, N = {n}, RotorDrop-Damping-v1 (paper scene), random actions, "
-          f"{steps} batch steps:")
-    split = res[f"{cases[0][0]}: RotorDrop-Damping-v1 per-step us"]
-    bound = dict(physics=split["wrapped"] / split["physics"], kernel=split["wrapped"] / split["kernel"])
-    res["batching bound per core (Amdahl)"] = bound
-    for threads in sorted({1, numba.config.NUMBA_NUM_THREADS}):
-        rate = _median(batched_rate("RotorDrop-Damping-v1", kwargs, n, steps, threads), R)
-        per_core = rate if args.clock == "cpu" else rate / threads
-        res[f"batched N={n} threads={threads} steps/s per core"] = per_core
-        print(f"  {threads} thread(s): {per_core:10.0f} env steps/s per core "
-              f"({per_core / single:.2f}x the single env)"
-              + ("" if args.clock == "cpu" else f", {rate:.0f} env steps/s in all"))
-    print(f"  bound per core (Amdahl, the damping env's split above, mu = 0.25): batching can "
-          f"remove at most the non-physics share of a step, {bound['physics']:.2f}x; it keeps the "
-          f"compiled monitors, reward and observation too, {bound['kernel']:.2f}x")
-    print(f"batched VecEnv with default threads (chosen as it runs) over one thread, wall clock, "
-          f"runs interleaved (median of {R}):")
-    for n_b in sorted({1, n}):
-        ratio, auto, one = default_vs_one_thread("RotorDrop-Damping-v1", kwargs, n_b,
-                                                 max(steps, 4800 // n_b), R)
-        res[f"batched N={n_b} default/one thread (wall)"] = ratio
-        print(f"  N = {n_b:3d}: {ratio:.2f}x ({auto:.0f} vs {one:.0f} env steps/s)")
+    runs = [overrides] + [dict(overrides, **dict([parse_assignment(a)])) for a in args.compare_set]
+    res = {"clock": args.clock, "n_envs": args.n_envs, "steps": args.steps or 600,
+           "repeats": args.repeats, "control_dt_s": 1e-3,
+           "numba_threads": numba.config.NUMBA_NUM_THREADS, "cores": os.cpu_count(),
+           "runs": [step_speed(args.repeats, args.n_envs, args.steps or 600, o) for o in runs]}
+    for r in res["runs"]:
+        _print_step(r)
     _write(args.json, res)
     return 0
 
