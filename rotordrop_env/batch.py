@@ -17,7 +17,8 @@ its environments to its own stack.
 Importing this module sets ``OMP_WAIT_POLICY=PASSIVE`` unless it is already set: with numba's
 OpenMP threading layer, threads that spin at the end of each parallel step steal the core of a
 descheduled worker when the machine is shared, which made a 2-thread batch 5-10x slower than one
-thread on a loaded 2-core machine; with passive waiting it is never slower than one thread.
+thread on a loaded 2-core machine; with passive waiting it keeps up with one thread on free
+cores (on busy ones the timed trials can pick the slower count: docs/environments.md, Speed).
 """
 from __future__ import annotations
 
