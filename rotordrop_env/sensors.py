@@ -145,25 +145,14 @@ class Sensing:
         state["_Z"], state["_rows"] = None, {}  # them)
         return state
 
-    @property
-    def k(self) -> int:
-        """The episode's observation latency [control steps]."""
-        return int(self.state[1])
-
-    @property
-    def n(self) -> int:
-        """Measurements taken this episode."""
-        return int(self.state[0])
-
-    @property
-    def fresh(self) -> bool:
-        """A sensor sample instant falls on the coming measurement."""
-        return bool(self.state[3])
-
-    @property
-    def last_drawn(self) -> int:
-        """Sensor samples strictly inside the last step (:meth:`draw_step`)."""
-        return int(self.state[4])
+    #: the episode's observation latency [control steps]
+    k = property(lambda self: int(self.state[1]))
+    #: measurements taken this episode
+    n = property(lambda self: int(self.state[0]))
+    #: a sensor sample instant falls on the coming measurement
+    fresh = property(lambda self: bool(self.state[3]))
+    #: sensor samples strictly inside the last step (:meth:`draw_step`)
+    last_drawn = property(lambda self: int(self.state[4]))
 
     @property
     def compiled(self) -> bool:

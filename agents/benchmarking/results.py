@@ -419,7 +419,7 @@ def hard_row(report: dict, source: str) -> str:
 def hard_section(reports: list[tuple[dict, str]]) -> list[str]:
     out = ["## Hard benchmark", "",
            "Re-levitation on raw coil currents, learned from scratch within a budget of "
-           f"{HARD_STEP_BUDGET:,} environment steps per run".replace(",", " ") + " "
+           f"{_budget()} environment steps per run "
            "([rules and commands](agents.md#hard-benchmark-raw-currents-from-scratch)); every "
            "row is `rotordrop evaluate` on the 200 held-out drops. The designed rows on the same "
            "interface are the references a learned entry is compared with: `whirl-brake` (the "
@@ -613,7 +613,7 @@ def hard_standing(table: dict) -> str:
                           f"/ {r['runs'][0]['episodes']} per seed)" for r in learned)
         refs = ", ".join(f"`{r['name']}` {r['runs'][0]['relevitated'].count('1')} / "
                          f"{r['runs'][0]['episodes']}" for r in rows if r["kind"] == "designed")
-        out.append(f"**{variant.capitalize()}** ({title}): {_budget_text(rows)} Re-levitation "
+        out.append(f"**{variant.capitalize()}**: {title}. {_budget_text(rows)} Re-levitation "
                    f"rate, mean ± std over the seeds: {rates}; {verdict}. Designed references on "
                    f"the same drops: {refs}.")
     return "\n\n".join(out)
@@ -628,8 +628,12 @@ def _budget_text(rows: list[dict]) -> str:
         return ("Runs stopped by a wall-clock limit of "
                 + " / ".join(f"{b:g} s" for b in limits) + " (before the step budget was "
                 "the rule), so each trained its own number of steps.")
-    return (f"Every run trained {HARD_STEP_BUDGET:,} environment steps".replace(",", " ")
-            + " (up to one rollout more).")
+    return f"Every run trained {_budget()} environment steps (up to one rollout more)."
+
+
+def _budget() -> str:
+    """:data:`HARD_STEP_BUDGET` as the docs write it (``100 000``)."""
+    return f"{HARD_STEP_BUDGET:,}".replace(",", " ")
 
 
 def hard_table_section(table: dict, source: str) -> list[str]:
